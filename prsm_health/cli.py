@@ -1,0 +1,280 @@
+"""Command line: ``prsm-health <command>``.
+
+The CLI only parses arguments, calls the library and formats results; SI units on the command
+line except where an option name says otherwise (``--pressure-angle DEG``). A user error prints
+one line ``error: …`` to stderr and exits with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from . import __version__
+from .errors import PRSMHealthError
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose usage errors are one line and exit 2."""
+
+    def error(self, message):  # noqa: D401 - argparse API
+        raise _UsageError(message)
+
+
+class _UsageError(Exception):
+    pass
+
+
+def _print_json(obj) -> None:
+    print(json.dumps(obj, indent=2, default=_json_default))
+
+
+def _json_default(value):
+    import numpy as np
+
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def _print_table(rows: list[tuple[str, object, str]]) -> None:
+    width = max(len(name) for name, _, _ in rows)
+    for name, value, unit in rows:
+        text = f"{value:.6g}" if isinstance(value, float) else str(value)
+        print(f"{name:<{width}}  {text} {unit}".rstrip())
+
+
+# ----------------------------------------------------------------------------- validate
+def _cmd_validate(args) -> int:
+    from .validation import collect, summary, to_markdown
+
+    rows = collect()
+    counts = summary(rows)
+    failed = [r for r in rows if r.failed]
+    if args.json:
+        _print_json({"rows": [r.as_dict() for r in rows], "summary": counts})
+    elif args.markdown:
+        print(to_markdown(rows))
+    else:
+        _print_validation_text(rows)
+        print()
+        print("summary: " + ", ".join(f"{n} {v}" for v, n in counts.items()))
+    return 1 if failed else 0
+
+
+def _print_validation_text(rows) -> None:
+    from .validation import _fmt
+
+    header = f"{'paper':<5} {'where':<26} {'quantity':<44} {'paper':>11} {'model':>11} {'error':>9}  verdict"
+    print(header)
+    print("-" * len(header))
+    for r in rows:
+        err = "" if r.error is None else f"{100 * r.error:+.2f}%"
+        print(
+            f"{r.paper:<5} {r.where[:26]:<26} {(r.quantity + ' [' + r.unit + ']')[:44]:<44} "
+            f"{_fmt(r.paper_value):>11} {_fmt(r.model_value):>11} {err:>9}  {r.verdict}"
+        )
+
+
+# ----------------------------------------------------------------------------- kinematics
+def _cmd_kinematics(args) -> int:
+    from .design import preset
+    from .kinematics import characteristic_frequencies, speed_ratios
+
+    design = preset(args.design)
+    ratios = speed_ratios(design)
+    freqs = characteristic_frequencies(design, args.speed)
+    out = {
+        "design": design.name,
+        "variant": design.variant,
+        "screw_speed": args.speed,
+        "ratios": {
+            "carrier": ratios.carrier,
+            "roller_spin": ratios.roller_spin,
+            "roller_spin_relative": ratios.roller_spin_relative,
+        },
+        "effective_lead": ratios.effective_lead,
+        "nut_speed": ratios.nut * args.speed,
+        "frequencies": freqs.as_dict(),
+    }
+    if args.json:
+        _print_json(out)
+        return 0
+    rows = [
+        ("design", f"{design.name} ({design.variant})", ""),
+        ("carrier / screw speed", ratios.carrier, ""),
+        ("roller spin / screw speed", ratios.roller_spin, ""),
+        ("effective lead", ratios.effective_lead, "m"),
+        ("nut speed", out["nut_speed"], "m/s"),
+    ]
+    rows += [(f"f_{k}", v if v is not None else "–", "Hz") for k, v in out["frequencies"].items()]
+    _print_table(rows)
+    return 0
+
+
+# ----------------------------------------------------------------------------- stiffness
+def _cmd_stiffness_gear(args) -> int:
+    from .stiffness.gear_mesh import mesh_stiffness
+
+    result = mesh_stiffness(
+        args.z1,
+        args.z2,
+        args.module,
+        math.radians(args.pressure_angle),
+        args.face_width,
+        internal=args.internal,
+        bore_diameter=args.bore_diameter,
+        youngs_modulus=args.youngs_modulus,
+        poisson_ratio=args.poisson,
+        threaded_tooth=args.threaded_tooth,
+    )
+    out = {
+        "contact_ratio": float(result.contact_ratio),
+        "k_min": float(result.k_min),
+        "k_max": float(result.k_max),
+        "k_mean": float(result.k_mean),
+    }
+    if args.json:
+        _print_json(out)
+    else:
+        _print_table(
+            [
+                ("contact ratio", out["contact_ratio"], ""),
+                ("k_min", out["k_min"], "N/m"),
+                ("k_max", out["k_max"], "N/m"),
+                ("k_mean", out["k_mean"], "N/m"),
+            ]
+        )
+    return 0
+
+
+def _cmd_stiffness_axial(args) -> int:
+    from .design import preset
+    from .stiffness.thread import axial_stiffness
+
+    design = preset(args.design)
+    result = axial_stiffness(design, args.load)
+    out = {
+        "design": design.name,
+        "load": args.load,
+        "deformation": float(result.deformation),
+        "secant_stiffness": float(result.secant_stiffness),
+        "tangent_stiffness": float(result.tangent_stiffness),
+    }
+    if args.json:
+        _print_json(out)
+    else:
+        _print_table(
+            [
+                ("design", design.name, ""),
+                ("axial load", args.load, "N"),
+                ("deformation", out["deformation"], "m"),
+                ("secant stiffness F/δ", out["secant_stiffness"], "N/m"),
+                ("tangent stiffness dF/dδ", out["tangent_stiffness"], "N/m"),
+            ]
+        )
+    return 0
+
+
+def _cmd_stiffness_cylinder(args) -> int:
+    from .stiffness.cylinder import ElectricCylinder, cylinder_deformation
+
+    result = cylinder_deformation(ElectricCylinder.paper05(), args.load, args.extension)
+    components = {k: float(v) for k, v in result.components.items()}
+    out = {
+        "load": args.load,
+        "extension": args.extension,
+        "components": components,
+        "total": float(result.total),
+        "stiffness": float(result.stiffness),
+    }
+    if args.json:
+        _print_json(out)
+    else:
+        rows = [(f"Δl {name}", value, "m") for name, value in components.items()]
+        rows += [("Δl total", out["total"], "m"), ("stiffness F/Δl", out["stiffness"], "N/m")]
+        _print_table(rows)
+    return 0
+
+
+# ----------------------------------------------------------------------------- parser
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from .design import DEFAULT_PRESET, PRESETS
+
+    parser = _Parser(
+        prog="prsm-health",
+        description="Planetary roller screw physics, signal generation and diagnostics.",
+    )
+    parser.add_argument("--version", action="version", version=f"prsm-health {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("validate", help="compare the models with every number the papers print")
+    fmt = p.add_mutually_exclusive_group()
+    fmt.add_argument("--json", action="store_true", help="machine-readable output")
+    fmt.add_argument("--markdown", action="store_true", help="Markdown table")
+    p.set_defaults(func=_cmd_validate)
+
+    p = sub.add_parser("kinematics", help="speed ratios and characteristic frequencies")
+    p.add_argument("--design", default=DEFAULT_PRESET, choices=sorted(PRESETS))
+    p.add_argument("--speed", type=_finite_float, required=True, help="screw speed [rad/s]")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=_cmd_kinematics)
+
+    p = sub.add_parser("stiffness", help="static stiffness models")
+    ssub = p.add_subparsers(dest="model", required=True, parser_class=_Parser)
+
+    g = ssub.add_parser("gear", help="time-varying gear mesh stiffness (potential energy method)")
+    g.add_argument("--z1", type=int, required=True, help="pinion (roller gear) teeth")
+    g.add_argument("--z2", type=int, required=True, help="gear (ring gear) teeth")
+    g.add_argument("--module", type=_finite_float, required=True, help="module [m]")
+    g.add_argument("--pressure-angle", type=_finite_float, default=20.0, metavar="DEG")
+    g.add_argument("--face-width", type=_finite_float, required=True, help="[m]")
+    g.add_argument("--bore-diameter", type=_finite_float, default=0.0, help="pinion bore [m]")
+    g.add_argument("--internal", action="store_true", help="z2 is an internal ring gear")
+    g.add_argument("--youngs-modulus", type=_finite_float, default=2.1e11, metavar="PA")
+    g.add_argument("--poisson", type=_finite_float, default=0.3, metavar="V")
+    g.add_argument("--threaded-tooth", action="store_true", help="PRSM threaded roller tooth")
+    g.add_argument("--json", action="store_true")
+    g.set_defaults(func=_cmd_stiffness_gear)
+
+    a = ssub.add_parser("axial", help="axial stiffness of the whole PRSM (papers 01, 04)")
+    a.add_argument("--design", default=DEFAULT_PRESET, choices=sorted(PRESETS))
+    a.add_argument("--load", type=_finite_float, required=True, help="axial load [N]")
+    a.add_argument("--json", action="store_true")
+    a.set_defaults(func=_cmd_stiffness_axial)
+
+    c = ssub.add_parser("cylinder", help="electric-cylinder deformation and stiffness (paper 05)")
+    c.add_argument("--load", type=_finite_float, required=True, help="axial load [N]")
+    c.add_argument("--extension", type=_finite_float, required=True, help="rod extension [m]")
+    c.add_argument("--json", action="store_true")
+    c.set_defaults(func=_cmd_stiffness_cylinder)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``prsm-health`` console script."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        return args.func(args)
+    except _UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except PRSMHealthError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,58 @@
+"""Exceptions a user can cause.
+
+The CLI and the service turn every :class:`PRSMHealthError` into a one-line message
+(``error: …``, exit status 2 / HTTP 4xx); anything else is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+
+class PRSMHealthError(Exception):
+    """Base class of all errors caused by user input."""
+
+
+class ParameterError(PRSMHealthError, ValueError):
+    """A parameter is outside its allowed range.
+
+    The message names the field, the value and the allowed range.
+    """
+
+    def __init__(self, field: str, value, allowed: str):
+        self.field = field
+        self.value = value
+        self.allowed = allowed
+        super().__init__(f"{field} = {_fmt(value)} is invalid: {allowed}")
+
+
+def _fmt(value) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def require(condition: bool, field: str, value, allowed: str) -> None:
+    """Raise :class:`ParameterError` unless ``condition`` holds."""
+    if not condition:
+        raise ParameterError(field, value, allowed)
+
+
+def require_positive(field: str, value: float) -> None:
+    """Require a finite, strictly positive number."""
+    require(
+        isinstance(value, (int, float)) and value > 0 and value < float("inf"),
+        field,
+        value,
+        "must be a finite number > 0",
+    )
+
+
+def require_range(
+    field: str, value: float, low: float, high: float, *, inclusive=True, unit: str = ""
+) -> None:
+    """Require ``low <= value <= high`` (or strict when ``inclusive`` is False)."""
+    ok = isinstance(value, (int, float)) and (
+        low <= value <= high if inclusive else low < value < high
+    )
+    brackets = ("[", "]") if inclusive else ("(", ")")
+    suffix = f" {unit}" if unit else ""
+    require(ok, field, value, f"must lie in {brackets[0]}{low:g}, {high:g}{brackets[1]}{suffix}")
