@@ -360,7 +360,11 @@ class PRSMDesign:
     def _validate_roller_count(self) -> None:
         # Neighbouring rollers must not touch: chord between centres > roller major diameter.
         chord = self.orbit_diameter * math.sin(math.pi / self.n_rollers)
-        max_geometric = int(math.floor(math.pi / math.asin(min(1.0, self.roller_major_diameter / self.orbit_diameter))))
+        max_geometric = int(
+            math.floor(
+                math.pi / math.asin(min(1.0, self.roller_major_diameter / self.orbit_diameter))
+            )
+        )
         require(
             chord > self.roller_major_diameter,
             "design.n_rollers",

@@ -78,7 +78,9 @@ def speed_ratios(design: PRSMDesign) -> SpeedRatios:
     else:
         # Roller moves relative to the screw by the screw lead and its own lead (it spins the
         # other way); it is axially locked to the nut. Paper 04's s(θ_S).
-        nut = (1.0 - carrier) * (r_r * design.screw_lead + r_s * design.roller_lead) / (TWO_PI * r_r)
+        nut = (
+            (1.0 - carrier) * (r_r * design.screw_lead + r_s * design.roller_lead) / (TWO_PI * r_r)
+        )
     return SpeedRatios(carrier, roller_spin, roller_spin - carrier, nut)
 
 

@@ -153,18 +153,26 @@ class HertzContact:
         ratio = self.b_coef / self.a_coef
         if ratio - 1.0 < 1e-12:
             return 0.0
-        return brentq(_axis_ratio_equation, 1e-12, 1.0 - 1e-15, args=(ratio,), xtol=1e-15, rtol=1e-14)
+        return brentq(
+            _axis_ratio_equation, 1e-12, 1.0 - 1e-15, args=(ratio,), xtol=1e-15, rtol=1e-14
+        )
 
     def _major_axis_coefficient(self) -> float:
         # a³ = 3P(K − E)/(2π E* e² A)  →  a = α·P^(1/3)
         m = self.eccentricity_sq
-        return (3.0 * _k_minus_e_over_m(m) / (2.0 * math.pi * self.contact_modulus * self.a_coef)) ** (1 / 3)
+        return (
+            3.0 * _k_minus_e_over_m(m) / (2.0 * math.pi * self.contact_modulus * self.a_coef)
+        ) ** (1 / 3)
 
     @property
     def compliance_coefficient(self) -> float:
         # δ = 3P·K(e)/(2π a E*)
         m = self.eccentricity_sq
-        return 3.0 * ellipk(m) / (2.0 * math.pi * self.contact_modulus * self._major_axis_coefficient())
+        return (
+            3.0
+            * ellipk(m)
+            / (2.0 * math.pi * self.contact_modulus * self._major_axis_coefficient())
+        )
 
     @property
     def equivalent_radius(self) -> float:

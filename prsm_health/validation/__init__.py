@@ -85,7 +85,9 @@ def inconsistent(paper, where, quantity, unit, paper_value, model_value, note) -
     """A paper number that contradicts the paper's own formulas or physics; say why."""
     if not note:
         raise ValueError("an inconsistent row needs its reason")
-    return Row(paper, where, quantity, unit, paper_value, model_value, PAPER_INCONSISTENT, None, note)
+    return Row(
+        paper, where, quantity, unit, paper_value, model_value, PAPER_INCONSISTENT, None, note
+    )
 
 
 def not_computable(paper, where, quantity, unit, paper_value, model_value, note) -> Row:

@@ -80,7 +80,12 @@ def rows() -> list[Row]:
         )
     out.append(
         not_computable(
-            "01", "§3.3", "FEA dominant axial frequency, b = 30 µm", "Hz", 488.0, None,
+            "01",
+            "§3.3",
+            "FEA dominant axial frequency, b = 30 µm",
+            "Hz",
+            488.0,
+            None,
             "FEA model not described in the paper",
         )
     )

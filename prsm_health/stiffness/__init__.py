@@ -1,0 +1,1 @@
+"""Stiffness models: gear mesh, thread contact, electric cylinder."""

@@ -1,0 +1,98 @@
+"""The prsm-health command line: output contracts and one-line errors with exit status 2."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from prsm_health.cli import main
+
+GEAR = [
+    "stiffness",
+    "gear",
+    "--z1",
+    "13",
+    "--z2",
+    "65",
+    "--module",
+    "0.0005",
+    "--pressure-angle",
+    "20",
+    "--face-width",
+    "0.003",
+    "--bore-diameter",
+    "0",
+]
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_kinematics_json(capsys):
+    code, out, _ = run(capsys, "kinematics", "--design", "paper01", "--speed", "100", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["ratios"]["carrier"] == pytest.approx(0.375)
+    assert data["frequencies"]["gear_mesh"] == pytest.approx(387.94, abs=0.01)
+
+
+def test_stiffness_gear_json_contract(capsys):
+    code, out, _ = run(capsys, *GEAR, "--internal", "--threaded-tooth", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert set(data) >= {"contact_ratio", "k_min", "k_max", "k_mean"}
+    assert 1.0 < data["contact_ratio"] < 3.0
+    assert 0 < data["k_min"] <= data["k_mean"] <= data["k_max"]
+
+
+def test_stiffness_axial_and_cylinder(capsys):
+    code, out, _ = run(
+        capsys, "stiffness", "axial", "--design", "paper04", "--load", "10000", "--json"
+    )
+    assert code == 0
+    data = json.loads(out)
+    assert data["secant_stiffness"] > 0 and data["deformation"] > 0
+    code, out, _ = run(
+        capsys, "stiffness", "cylinder", "--load", "1000", "--extension", "0.3", "--json"
+    )
+    assert code == 0
+    data = json.loads(out)
+    assert data["total"] == pytest.approx(sum(data["components"].values()), rel=1e-9)
+    assert data["stiffness"] == pytest.approx(1000 / data["total"], rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["stiffness", "gear", "--z1", "-3", *GEAR[4:]], "z1"),
+        (["stiffness", "gear", *GEAR[2:8], "--face-width", "-1"], "face_width"),
+        (["stiffness", "axial", "--design", "nope", "--load", "1"], "--design"),
+        (["stiffness", "axial", "--design", "paper01", "--load", "-5"], "load"),
+        (["stiffness", "cylinder", "--load", "100", "--extension", "-1"], "extension"),
+        (["kinematics", "--speed", "fast"], "--speed"),
+        (["frobnicate"], "frobnicate"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(capsys, argv, needle):
+    code, out, err = run(capsys, *argv)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ")
+    assert needle in lines[0]
+    assert "Traceback" not in err
+
+
+def test_console_script_runs_as_a_process():
+    # The real entry point, as a user types it: exit 2 and a one-line error, no traceback.
+    proc = subprocess.run(
+        [sys.executable, "-m", "prsm_health.cli", *GEAR[:2], "--z1", "-3", *GEAR[4:]],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.startswith("error: ") and "Traceback" not in proc.stderr
