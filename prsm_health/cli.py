@@ -201,6 +201,83 @@ def _cmd_stiffness_cylinder(args) -> int:
     return 0
 
 
+# ----------------------------------------------------------------------------- simulate
+def _cmd_simulate(args) -> int:
+    from pathlib import Path
+
+    from .design import preset
+    from .dynamics.model import SimulationOptions
+    from .dynamics.simulate import simulate
+    from .kinematics import characteristic_frequencies
+    from .sensors import SensorModel
+    from .states import HealthState, ManufacturingVariation, OperatingProfile
+
+    out = Path(args.out)
+    if out.suffix not in (".parquet",):
+        raise PRSMHealthError(f"--out {out}: unsupported extension {out.suffix!r} (use .parquet)")
+    if not out.parent.exists():
+        raise PRSMHealthError(f"--out {out}: directory {out.parent} does not exist")
+    design = preset(args.design)
+    health = HealthState(
+        clearance_screw=args.clearance,
+        clearance_nut=args.clearance,
+        clearance_gear=args.clearance if args.gear_clearance is None else args.gear_clearance,
+        wear_spread=args.wear_spread,
+        friction_scale=args.friction_scale,
+    )
+    profile = OperatingProfile(
+        duration=args.duration,
+        motion=args.profile,
+        speed=args.speed,
+        accel_time=args.accel_time,
+        motion_period=args.period,
+        load_profile=args.load_profile,
+        load=args.load,
+        load_amplitude=args.load_amplitude,
+        load_frequency=args.load_frequency,
+    )
+    sensors = SensorModel(sample_rate=args.sample_rate, accel_noise=args.accel_noise)
+    options = SimulationOptions(
+        max_step=args.max_step,
+        contact_law=args.contact_law,
+        variation=ManufacturingVariation.ideal() if args.ideal else ManufacturingVariation(),
+    )
+    run = simulate(
+        design, health, profile, sensors, args.seed, options=options, progress=not args.json
+    )
+    run.to_parquet(out)
+    mesh = characteristic_frequencies(design, args.speed).gear_mesh
+    if args.plot:
+        from .plots import plot_run
+
+        plot_run(run, args.plot, mesh_frequency=mesh)
+    summary = {
+        "out": str(out),
+        "samples": len(run),
+        "sample_rate": run.sample_rate,
+        "duration": profile.duration,
+        "gear_mesh_frequency": mesh,
+        "integration_step": run.scenario["integration_step"],
+        "highest_natural_frequency": run.scenario["highest_natural_frequency"],
+        "energy": run.energy,
+        "labels": run.labels,
+    }
+    if args.json:
+        _print_json(summary)
+    else:
+        _print_table(
+            [
+                ("wrote", str(out), ""),
+                ("samples", len(run), f"at {run.sample_rate:g} Hz"),
+                ("gear mesh frequency", mesh, "Hz"),
+                ("integration step", run.scenario["integration_step"], "s"),
+                ("drive energy", run.energy["drive"], "J"),
+                ("dissipated energy", run.energy["dissipated"], "J"),
+            ]
+        )
+    return 0
+
+
 # ----------------------------------------------------------------------------- parser
 def _finite_float(text: str) -> float:
     value = float(text)
@@ -259,7 +336,45 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--extension", type=_finite_float, required=True, help="rod extension [m]")
     c.add_argument("--json", action="store_true")
     c.set_defaults(func=_cmd_stiffness_cylinder)
+
+    _add_simulate_parser(sub, DEFAULT_PRESET, PRESETS)
     return parser
+
+
+def _add_simulate_parser(sub, default_preset, presets) -> None:
+    from .states import LOADS, MOTIONS
+
+    s = sub.add_parser("simulate", help="simulate a PRSM run (paper 01 dynamics) and write it")
+    s.add_argument("--design", default=default_preset, choices=sorted(presets))
+    s.add_argument(
+        "--clearance", type=_finite_float, default=10e-6, help="thread half-clearance b [m]"
+    )
+    s.add_argument(
+        "--gear-clearance", type=_finite_float, default=None, help="gear backlash b_g [m]"
+    )
+    s.add_argument("--wear-spread", type=_finite_float, default=0.0, help="uneven roller wear [-]")
+    s.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
+    s.add_argument("--speed", type=_finite_float, default=100.0, help="screw speed [rad/s]")
+    s.add_argument("--load", type=_finite_float, default=100.0, help="resisting axial load [N]")
+    s.add_argument("--profile", choices=MOTIONS, default="constant", help="screw motion profile")
+    s.add_argument("--accel-time", type=_finite_float, default=0.02, help="[s]")
+    s.add_argument("--period", type=_finite_float, default=0.1, help="reversing motion period [s]")
+    s.add_argument("--load-profile", choices=LOADS, default="constant")
+    s.add_argument("--load-amplitude", type=_finite_float, default=0.0, help="[N]")
+    s.add_argument("--load-frequency", type=_finite_float, default=20.0, help="[Hz]")
+    s.add_argument("--duration", type=_finite_float, default=0.2, help="[s]")
+    s.add_argument("--sample-rate", type=_finite_float, default=20000.0, help="[Hz]")
+    s.add_argument(
+        "--accel-noise", type=_finite_float, default=0.0, help="RMS accelerometer noise [m/s²]"
+    )
+    s.add_argument("--contact-law", choices=("linear", "hertz"), default="linear")
+    s.add_argument("--max-step", type=_finite_float, default=5e-6, help="largest RK4 step [s]")
+    s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--out", required=True, help="output file (.parquet)")
+    s.add_argument("--plot", default=None, help="PNG with time traces and spectra")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=_cmd_simulate)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -96,3 +96,46 @@ def test_console_script_runs_as_a_process():
     )
     assert proc.returncode == 2
     assert proc.stderr.startswith("error: ") and "Traceback" not in proc.stderr
+
+
+def test_simulate_writes_parquet_and_plot(tmp_path, capsys):
+    out = tmp_path / "run.parquet"
+    png = tmp_path / "run.png"
+    code, stdout, _ = run(
+        capsys,
+        "simulate",
+        "--duration",
+        "0.02",
+        "--seed",
+        "2",
+        "--out",
+        str(out),
+        "--plot",
+        str(png),
+        "--json",
+    )
+    assert code == 0
+    summary = json.loads(stdout)
+    assert summary["gear_mesh_frequency"] == pytest.approx(387.94, abs=0.01)
+    import pandas as pd
+
+    frame = pd.read_parquet(out)
+    assert len(frame) == summary["samples"] and "nut_axial_accel" in frame
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    "extra, needle",
+    [
+        (["--out", "x.csv"], "unsupported extension"),
+        (["--out", "x.parquet", "--clearance=-1e-6"], "health.clearance_screw"),
+        (["--out", "x.parquet", "--profile", "zigzag"], "--profile"),
+        (["--out", "x.parquet", "--max-step", "1e-4"], "stable limit"),
+        (["--out", "no/such/dir/x.parquet", "--duration", "0.001"], "does not exist"),
+    ],
+)
+def test_simulate_bad_input(tmp_path, capsys, monkeypatch, extra, needle):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, "simulate", *extra)
+    assert code == 2
+    assert err.startswith("error: ") and needle in err and len(err.strip().splitlines()) == 1

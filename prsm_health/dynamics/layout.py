@@ -1,0 +1,116 @@
+"""Index layout of the flat float64 arrays shared by the dynamics kernel and its Python side.
+
+Plain integers only, so numba folds them as compile-time constants. The physical meaning of
+every entry is documented in :mod:`prsm_health.dynamics.model`, which fills them.
+"""
+
+# ----------------------------------------------------------------- generalised coordinates q
+# Screw: lateral x, y and rotation θ_s (axially fixed).
+Q_XS, Q_YS, Q_THS = 0, 1, 2
+# Nut (with ring gear): lateral x, y, rotation θ_N, axial z_N.
+Q_XN, Q_YN, Q_THN, Q_ZN = 3, 4, 5, 6
+# Carrier: lateral x, y, rotation θ_p.
+Q_XP, Q_YP, Q_THP = 7, 8, 9
+# Roller i occupies Q_ROLLER0 + 4·i + (0: X, 1: Y absolute centre position, 2: spin θ, 3: axial z).
+Q_ROLLER0 = 10
+ROLLER_DOF = 4
+
+
+def n_coordinates(n_rollers: int) -> int:
+    return Q_ROLLER0 + ROLLER_DOF * n_rollers
+
+
+# Extra integrated quantities appended after [q, q̇]: cumulative energies [J] for the power
+# balance and the speed-loop integrator state. After them, one traction state per roller:
+# the elastic tangential displacement s_i [m] of its screw–roller contact.
+X_W_DRIVE, X_W_LOAD, X_W_DISS, X_W_FRIC, X_SPEED_INT = 0, 1, 2, 3, 4
+N_EXTRA = 5
+
+
+def n_state(n_rollers: int) -> int:
+    return 2 * n_coordinates(n_rollers) + N_EXTRA + n_rollers
+
+
+# ----------------------------------------------------------------- scalar parameters p
+P_M_S, P_J_S, P_M_N, P_J_N, P_M_P, P_J_P, P_M_C, P_J_C = 0, 1, 2, 3, 4, 5, 6, 7
+P_ORBIT_R = 8  # nominal roller-centre orbit radius R = r_s + r_r [m]
+P_RB_RING = 9  # ring-gear base radius [m]
+P_RB_ROLLER = 10  # roller-gear base radius [m]
+P_COS_A0, P_SIN_A0 = 11, 12  # gear pressure angle
+P_COT_BETA = 13  # radial-to-axial closure factor of a thread flank, cot β
+P_LEAD_S, P_LEAD_R, P_LEAD_N = 14, 15, 16  # leads over 2π [m/rad]
+P_Z_RING = 17
+P_R_NUT, P_R_SCREW, P_R_ROLLER = 18, 19, 20  # pitch radii [m]
+P_K_THREAD_S, P_K_THREAD_N = 21, 22  # axial contact law coefficient per roller side
+P_EXPONENT = 23  # 1 (linear) or 1.5 (Hertzian) flank law
+P_C_THREAD_S, P_C_THREAD_N, P_C_MESH = 24, 25, 26
+P_K_S, P_C_S = 27, 28  # screw lateral support
+P_K_N, P_C_N = 29, 30  # nut lateral guide
+P_K_ND, P_C_ND = 31, 32  # nut anti-rotation
+P_K_PN, P_C_PN = 33, 34  # carrier–nut lateral coupling
+P_C_PND = 35  # carrier–nut rotational damping [N·m·s/rad]
+P_K_CP, P_C_CP = 36, 37  # roller pocket in the carrier
+P_C_NA = 38  # nut axial damping to ground [N·s/m]
+P_C_SD = 39  # screw rotational damping [N·m·s/rad]
+P_MU_VISC, P_MU_COUL, P_K_TAN, P_FRICTION_SCALE = 40, 41, 42, 43
+P_DRIVE_MODE = 44  # 0 prescribed screw motion, 1 speed loop
+P_KP, P_KI, P_TORQUE_LIMIT = 45, 46, 47
+P_LOAD_SIN_AMP, P_LOAD_SIN_FREQ = 48, 49
+P_SIN_BETA = 50
+P_C_TAN = 51  # damping of the tangential contact compliance while sticking [N·s/m]
+P_V_NUT_REF = 52  # reference speed of the nut axial damper (0: guide friction to ground) [m/s]
+N_PARAMS = 53
+
+DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP = 0, 1
+
+# ----------------------------------------------------------------- per-roller parameters
+R_COS_PSI, R_SIN_PSI = 0, 1  # angular position of the pocket on the carrier
+R_POCKET_R = 2  # pocket radius (orbit radius + eccentricity) [m]
+R_B_S, R_B_N, R_B_G = 3, 4, 5  # half-clearance on each flank: screw, nut threads, gear [m]
+R_E_S, R_E_N = 6, 7  # axial position error of the roller thread vs screw / nut [m]
+R_E_G = 8  # gear transmission error offset [m]
+R_MESH_PHASE = 9  # mesh phase error added to the geometric phase [cycles]
+R_MESH_SCALE = 10  # mesh stiffness scale (tooth-to-tooth variation) [-]
+R_PSI = 11  # angular position of the pocket [rad]
+N_ROLLER_PARAMS = 12
+
+# ----------------------------------------------------------------- recorded channels
+(
+    C_SCREW_ANGLE,
+    C_SCREW_SPEED,
+    C_CARRIER_SPEED,
+    C_NUT_POSITION,
+    C_NUT_AXIAL_ACCEL,
+    C_NUT_TANGENTIAL_ACCEL,
+    C_NUT_RADIAL_X_ACCEL,
+    C_NUT_RADIAL_Y_ACCEL,
+    C_DRIVE_TORQUE,
+    C_FRICTION_TORQUE,
+    C_AXIAL_LOAD,
+) = range(11)
+N_CHANNELS = 11
+
+#: Channel names in record order (the signal-channel contract of ../shared/DESIGN.md).
+CHANNELS = (
+    "screw_angle",
+    "screw_speed",
+    "carrier_speed",
+    "nut_position",
+    "nut_axial_accel",
+    "nut_tangential_accel",
+    "nut_radial_x_accel",
+    "nut_radial_y_accel",
+    "drive_torque",
+    "friction_torque",
+    "axial_load",
+)
+
+# Auxiliary outputs of one right-hand-side evaluation.
+# Auxiliary outputs of one right-hand-side evaluation; after them, per roller, the Coulomb
+# limit μ·N of its screw–roller traction [N].
+A_DRIVE_TORQUE, A_FRICTION_TORQUE, A_AXIAL_LOAD, A_P_DRIVE, A_P_LOAD, A_P_DISS, A_P_FRIC = range(7)
+N_AUX = 7
+
+
+def n_aux(n_rollers: int) -> int:
+    return N_AUX + n_rollers

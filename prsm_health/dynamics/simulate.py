@@ -1,0 +1,292 @@
+"""Run orchestration: step choice, step guard, chunked RK4 integration, sensors, Run.
+
+:func:`simulate` is the public entry point (re-exported as ``prsm_health.simulate``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from ..design import PRSMDesign, preset
+from ..errors import PRSMHealthError, require
+from ..run import Run
+from ..sensors import SensorModel, measure
+from ..states import HealthState, OperatingProfile
+from . import _kernels
+from . import layout as L
+from .model import Model, SimulationOptions, build_model, initial_state
+
+#: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
+STABILITY_MARGIN = 0.9
+
+
+class SimulationError(PRSMHealthError):
+    """The integration cannot proceed (unstable step, non-finite state)."""
+
+
+def _rk4_amplification(z: np.ndarray) -> np.ndarray:
+    return np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+
+def linearised_eigenvalues(model: Model) -> np.ndarray:
+    """Eigenvalues [1/s] of the model linearised on the loaded flanks at the operating load.
+
+    Clearances are closed and every roller carries the operating load on one flank of each
+    thread and on the gear, so all contact stiffnesses act (at their tangent values for the
+    Hertzian law): the stiffest state a run normally meets. The Jacobian is taken by central
+    differences of the kernel's right-hand side; the prescribed screw angle is not a state.
+    """
+    nq = model.n_coordinates
+    rollers = model.rollers.copy()
+    rollers[:, L.R_B_S] = 0.0
+    rollers[:, L.R_B_N] = 0.0
+    rollers[:, L.R_B_G] = 0.0
+    operating = model.roller_load * model.n_rollers
+    loaded = replace(
+        model, rollers=rollers, load_knots=np.array([[0.0, 1.0], [operating, operating]])
+    )
+    y0 = initial_state(loaded)
+    prescribed = model.params[L.P_DRIVE_MODE] == L.DRIVE_PRESCRIBED
+    extras = range(2 * nq, 2 * nq + L.N_EXTRA)
+    free = [
+        j
+        for j in range(model.n_state)
+        if j not in extras and not (prescribed and j in (L.Q_THS, nq + L.Q_THS))
+    ]
+    velocity = (np.arange(model.n_state) >= nq) & (np.arange(model.n_state) < 2 * nq)
+    scale = np.where(velocity, 1e-7, 1e-10)
+    f_plus = np.empty(model.n_state)
+    f_minus = np.empty(model.n_state)
+    aux = np.zeros(L.n_aux(model.n_rollers))
+    jac = np.empty((len(free), len(free)))
+    args = (model.params, rollers, model.mesh_table, model.motion, loaded.load_knots)
+    for col, j in enumerate(free):
+        y = y0.copy()
+        y[j] += scale[j]
+        _kernels.rhs(0.0, y, *args[:4], args[4], f_plus, aux)
+        y[j] -= 2 * scale[j]
+        _kernels.rhs(0.0, y, *args[:4], args[4], f_minus, aux)
+        jac[:, col] = (f_plus[free] - f_minus[free]) / (2 * scale[j])
+    return np.linalg.eigvals(jac)
+
+
+def max_stable_step(model: Model) -> tuple[float, float]:
+    """Largest stable RK4 step [s] (with :data:`STABILITY_MARGIN`) and the highest natural frequency [Hz]."""
+    eig = linearised_eigenvalues(model)
+    omega_max = float(np.max(np.abs(eig)))
+    # Slow modes (rigid-body motion, the rolling mechanism, friction creep) are resolved by any
+    # usable step; their finite-difference noise must not decide the step limit.
+    eig = eig[np.abs(eig) > 1e-3 * omega_max]
+    lo, hi = 0.0, 4.0 / max(omega_max, 1.0)
+    for _ in range(60):  # bisection on the RK4 stability region |R(hλ)| ≤ 1
+        mid = 0.5 * (lo + hi)
+        if np.all(_rk4_amplification(mid * eig) <= 1.0 + 1e-12):
+            lo = mid
+        else:
+            hi = mid
+    return STABILITY_MARGIN * lo, omega_max / (2 * math.pi)
+
+
+def settling_model(model: Model) -> Model:
+    """The model with the nut axial motion critically damped about its rigid-body speed.
+
+    Used before t = 0 only: the rollers find their (uneven) load shares without ringing, so a
+    run starts in its loaded steady state.
+    """
+    from ..kinematics import speed_ratios
+
+    params = model.params.copy()
+    k_axial = model.n_rollers / (1 / model.thread_stiffness[0] + 1 / model.thread_stiffness[1])
+    c_settle = 2.0 * math.sqrt(k_axial * params[L.P_M_N])
+    c_guide = params[L.P_C_NA]
+    v_rigid = speed_ratios(model.design).nut * float(model.motion[1, 0])
+    # settling damper c_s·(v − v_rigid) plus the guide's own c_g·v, as one damper
+    params[L.P_C_NA] = c_settle + c_guide
+    params[L.P_V_NUT_REF] = c_settle * v_rigid / (c_settle + c_guide)
+    return replace(model, params=params)
+
+
+def choose_step(max_step: float, sample_rate: float) -> tuple[float, int]:
+    """Integration step h = 1/(m·f_s) ≤ max_step with the smallest integer m."""
+    m = max(1, math.ceil(1.0 / (max_step * sample_rate) - 1e-9))
+    return 1.0 / (m * sample_rate), m
+
+
+def simulate(
+    design: PRSMDesign | str | None = None,
+    health: HealthState | None = None,
+    profile: OperatingProfile | None = None,
+    sensors: SensorModel | None = None,
+    seed: int = 0,
+    *,
+    options: SimulationOptions | None = None,
+    progress: bool = False,
+) -> Run:
+    """Simulate a PRSM run and return its sampled sensor channels.
+
+    Parameters
+    ----------
+    design : PRSMDesign or preset name, default "paper01"
+    health : HealthState, default HealthState()
+    profile : OperatingProfile, default OperatingProfile()
+    sensors : SensorModel, default SensorModel()
+    seed : int
+        Seeds manufacturing variation, uneven wear and sensor noise: same seed, same run
+        (bit-identical).
+    options : SimulationOptions
+    progress : bool
+        Show a progress bar (long runs).
+
+    Returns
+    -------
+    Run
+        Contract channels at ``sensors.sample_rate``; ``run.energy`` holds the energy book.
+
+    Raises
+    ------
+    SimulationError
+        When the requested step is beyond the RK4 stability limit of the model, or the state
+        becomes non-finite (the error names the time).
+    ParameterError
+        For any invalid input.
+    """
+    design = preset(design) if isinstance(design, str) or design is None else design
+    health = health or HealthState()
+    profile = profile or OperatingProfile()
+    sensors = sensors or SensorModel()
+    options = options or SimulationOptions()
+    require(
+        isinstance(seed, (int, np.integer)) and seed >= 0, "seed", seed, "must be an integer ≥ 0"
+    )
+    seed = int(seed)
+
+    model = build_model(design, health, profile, options, seed)
+    h, factor = choose_step(options.max_step, sensors.sample_rate)
+    h_stable, f_max = max_stable_step(model)
+    if h > h_stable:
+        raise SimulationError(
+            f"integration step {h:.3g} s is above the stable limit {h_stable:.3g} s of this model "
+            f"(highest natural frequency {f_max:.0f} Hz, RK4 needs ω·h ≤ 2.8): lower "
+            "options.max_step, or soften the contacts (lower load, or options.traction_stiffness_ratio)"
+        )
+    n_steps = int(round(profile.duration / h))
+    n_settle = int(round(options.settle_time / h))
+    y = initial_state(model, -n_settle * h)
+    if n_settle:
+        _integrate(settling_model(model), y, h, n_settle, False, t0=-n_settle * h, record=False)
+        y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
+            0.0  # energy book starts at t = 0
+        )
+    raw = _integrate(model, y, h, n_steps, progress)
+    channels = measure(
+        {name: raw[:, k] for k, name in enumerate(L.CHANNELS)},
+        1.0 / h,
+        sensors,
+        np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
+    )
+    n_out = len(channels["screw_angle"])
+    time = np.arange(n_out) / sensors.sample_rate
+    nq = model.n_coordinates
+    energy = {
+        "drive": float(y[2 * nq + L.X_W_DRIVE]),
+        "load": float(y[2 * nq + L.X_W_LOAD]),
+        "dissipated": float(y[2 * nq + L.X_W_DISS]),
+        "friction": float(y[2 * nq + L.X_W_FRIC]),
+    }
+    return Run(
+        time=time,
+        channels=channels,
+        sample_rate=sensors.sample_rate,
+        labels=run_labels(design, health, profile, seed),
+        scenario={
+            "design": design.name,
+            "health": health.as_dict(),
+            "profile": profile.as_dict(),
+            "sensors": sensors.as_dict(),
+            "options": options.as_dict(),
+            "seed": seed,
+            "integration_step": h,
+            "stable_step": h_stable,
+            "highest_natural_frequency": f_max,
+        },
+        energy=energy,
+    )
+
+
+def run_labels(
+    design: PRSMDesign, health: HealthState, profile: OperatingProfile, seed: int
+) -> dict:
+    """Run labels of the contract (nominal values, SI)."""
+    return {
+        "design": design.name,
+        "clearance_screw": health.clearance_screw,
+        "clearance_nut": health.clearance_nut,
+        "clearance_gear": health.clearance_gear,
+        "wear_spread": health.wear_spread,
+        "friction_scale": health.friction_scale,
+        "screw_speed": profile.speed,
+        "axial_load": profile.load,
+        "motion": profile.motion,
+        "load_profile": profile.load_profile,
+        "load_amplitude": profile.load_amplitude,
+        "seed": seed,
+    }
+
+
+def _integrate(
+    model: Model,
+    y: np.ndarray,
+    h: float,
+    n_steps: int,
+    progress: bool,
+    t0: float = 0.0,
+    record: bool = True,
+) -> np.ndarray:
+    raw = np.empty((n_steps if record else 1, L.N_CHANNELS))
+    work = [np.empty(model.n_state) for _ in range(5)]
+    aux = np.zeros(L.n_aux(model.n_rollers))
+    chunk = max(1, min(n_steps, int(0.02 / h)))  # 20 ms of simulated time per kernel call
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(
+            total=n_steps * h,
+            unit="sim s",
+            unit_scale=False,
+            bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]",
+        )
+    done = 0
+    while done < n_steps:
+        count = min(chunk, n_steps - done)
+        status, step = _kernels.integrate(
+            y,
+            t0 + done * h,
+            h,
+            count,
+            1 if record else count + 1,
+            model.params,
+            model.rollers,
+            model.mesh_table,
+            model.motion,
+            model.load_knots,
+            raw[done : done + count] if record else raw,
+            *work,
+            aux,
+        )
+        if status != 0:
+            t_fail = t0 + (done + step) * h
+            raise SimulationError(
+                f"the state became non-finite at t = {t_fail:.6g} s: the step {h:.3g} s is too "
+                "large for the contact stiffness reached there (a load or clearance impact "
+                "beyond the linearised bound) — lower options.max_step"
+            )
+        done += count
+        if bar is not None:
+            bar.update(count * h)
+    if bar is not None:
+        bar.close()
+    return raw

@@ -1,0 +1,263 @@
+"""Health states, operating profiles and manufacturing variation of a simulated PRSM.
+
+Frozen dataclasses grouped by lifetime: a :class:`HealthState` is what wears (clearances,
+lubricant), an :class:`OperatingProfile` what the actuator is asked to do (screw motion, axial
+load), :class:`ManufacturingVariation` the as-built scatter between rollers. All SI.
+
+Sign convention for the axial load: ``load`` is the *resisting* force on the nut, positive when
+it opposes the nut motion produced by a positive screw speed (a compressive load on an
+extending actuator). Reversing load profiles swing it through zero.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .errors import require, require_positive, require_range
+
+MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
+LOADS = ("constant", "sinusoidal", "reversing")
+DRIVES = ("prescribed", "speed_loop")
+
+
+@dataclass(frozen=True)
+class HealthState:
+    """Wear and lubrication state.
+
+    Parameters
+    ----------
+    clearance_screw, clearance_nut, clearance_gear : float [m]
+        Half-clearance b on each flank of the screw–roller thread, roller–nut thread and roller
+        gear mesh (paper 01's backlash function f(δ, b), total play 2b). Paper 01 §3.3 uses
+        b_s = b_N = 10, 20, 30 µm.
+    wear_spread : float [-]
+        Uneven wear between rollers: roller i's thread clearances are scaled by
+        (1 + wear_spread·u_i), u_i uniform in [−1, 1] drawn from the run seed. 0 = even wear.
+    friction_scale : float [-]
+        Multiplies the thread friction coefficients; 1 = new lubricant, > 1 degraded.
+    """
+
+    clearance_screw: float = 10e-6
+    clearance_nut: float = 10e-6
+    clearance_gear: float = 10e-6
+    wear_spread: float = 0.0
+    friction_scale: float = 1.0
+
+    def __post_init__(self):
+        for name in ("clearance_screw", "clearance_nut", "clearance_gear"):
+            require_range(f"health.{name}", getattr(self, name), 0.0, 500e-6, unit="m")
+        require_range("health.wear_spread", self.wear_spread, 0.0, 1.0)
+        require_range("health.friction_scale", self.friction_scale, 0.0, 20.0)
+
+    @classmethod
+    def uniform(cls, clearance: float, **kw) -> HealthState:
+        """The same clearance on screw, nut and gear engagements [m]."""
+        return cls(
+            clearance_screw=clearance, clearance_nut=clearance, clearance_gear=clearance, **kw
+        )
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class OperatingProfile:
+    """Screw motion and axial load over a run.
+
+    Parameters
+    ----------
+    duration : float [s]
+    motion : {"constant", "ramp", "trapezoid", "reversing"}
+        constant: ω from t = 0; ramp: 0 → ω over ``accel_time`` then constant; trapezoid:
+        ramp up, hold, ramp down to rest at ``duration``; reversing: ±ω alternating every
+        half ``motion_period`` with ``accel_time`` ramps through zero.
+    speed : float [rad/s]
+        Screw speed magnitude ω.
+    accel_time : float [s]
+    motion_period : float [s]
+        Period of the reversing motion.
+    load_profile : {"constant", "sinusoidal", "reversing"}
+    load : float [N]
+        Mean resisting axial load on the nut (see module docstring for the sign).
+    load_amplitude : float [N]
+        Sinusoidal: amplitude around ``load``; reversing: the load swings ±``load_amplitude``
+        around ``load`` as a trapezoidal wave with ``accel_time`` transitions.
+    load_frequency : float [Hz]
+        Frequency of the sinusoidal or reversing load.
+    drive : {"prescribed", "speed_loop"}
+        Prescribed screw motion (ideal servo), or a PI speed loop on the screw with its gains.
+    speed_loop_bandwidth : float [Hz]
+        Closed-loop bandwidth of the speed loop (sets the PI gains from the screw inertia).
+    torque_limit : float [N·m]
+        Motor torque limit of the speed loop.
+    """
+
+    duration: float = 0.2
+    motion: str = "constant"
+    speed: float = 100.0
+    accel_time: float = 0.02
+    motion_period: float = 0.1
+    load_profile: str = "constant"
+    load: float = 100.0
+    load_amplitude: float = 0.0
+    load_frequency: float = 20.0
+    drive: str = "prescribed"
+    speed_loop_bandwidth: float = 50.0
+    torque_limit: float = 50.0
+
+    def __post_init__(self):
+        require_range("profile.duration", self.duration, 1e-4, 3600.0, unit="s")
+        require(
+            self.motion in MOTIONS,
+            "profile.motion",
+            self.motion,
+            f"must be one of {', '.join(MOTIONS)}",
+        )
+        require(
+            self.load_profile in LOADS,
+            "profile.load_profile",
+            self.load_profile,
+            f"must be one of {', '.join(LOADS)}",
+        )
+        require(
+            self.drive in DRIVES, "profile.drive", self.drive, f"must be one of {', '.join(DRIVES)}"
+        )
+        require_range("profile.speed", self.speed, 0.0, 2000.0, unit="rad/s")
+        require_range("profile.accel_time", self.accel_time, 0.0, 10.0, unit="s")
+        require_positive("profile.motion_period", self.motion_period)
+        if self.motion == "reversing":
+            require(
+                0 < self.accel_time < self.motion_period / 2,
+                "profile.accel_time",
+                self.accel_time,
+                f"must lie in (0, motion_period/2 = {self.motion_period / 2:g}) s for a "
+                "reversing motion (the screw ramps through zero speed)",
+            )
+        if self.motion == "trapezoid":
+            require(
+                2 * self.accel_time < self.duration,
+                "profile.accel_time",
+                self.accel_time,
+                f"must be < duration/2 = {self.duration / 2:g} s for a trapezoid",
+            )
+        require_range("profile.load", self.load, -1e6, 1e6, unit="N")
+        require_range("profile.load_amplitude", self.load_amplitude, 0.0, 1e6, unit="N")
+        require_range("profile.load_frequency", self.load_frequency, 0.0, 1e4, unit="Hz")
+        require_positive("profile.speed_loop_bandwidth", self.speed_loop_bandwidth)
+        require_positive("profile.torque_limit", self.torque_limit)
+
+    # ------------------------------------------------------------------ knots for the kernel
+    def motion_knots(self) -> np.ndarray:
+        """Piecewise-linear screw speed as a (3, K) array: times [s], speeds [rad/s], angles [rad]."""
+        w, ta, T = self.speed, self.accel_time, self.duration
+        if self.motion == "constant" or (self.motion == "ramp" and ta == 0):
+            times, speeds = [0.0, T], [w, w]
+        elif self.motion == "ramp":
+            times, speeds = [0.0, ta, max(T, ta * 1.000001)], [0.0, w, w]
+        elif self.motion == "trapezoid":
+            times, speeds = [0.0, ta, T - ta, T], [0.0, w, w, 0.0]
+        else:  # reversing: +ω, ramp through zero to −ω every half period
+            half = self.motion_period / 2
+            times, speeds = [0.0], [w]
+            k = 1
+            while k * half - ta / 2 < T:
+                sign = 1.0 if k % 2 == 0 else -1.0
+                times += [k * half - ta / 2, k * half + ta / 2]
+                speeds += [-sign * w, sign * w]
+                k += 1
+            times.append(max(T, times[-1] + 1e-6))
+            speeds.append(speeds[-1])
+        times = np.asarray(times, dtype=float)
+        speeds = np.asarray(speeds, dtype=float)
+        angles = np.concatenate(
+            ([0.0], np.cumsum(0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times)))
+        )
+        return np.vstack([times, speeds, angles])
+
+    def load_knots(self) -> tuple[np.ndarray, float, float]:
+        """Axial load as (2, K) knots [s, N] plus sinusoid amplitude [N] and frequency [Hz]."""
+        T, F = self.duration, self.load
+        if self.load_profile == "constant":
+            return np.array([[0.0, T], [F, F]]), 0.0, 0.0
+        if self.load_profile == "sinusoidal":
+            return np.array([[0.0, T], [F, F]]), self.load_amplitude, self.load_frequency
+        # reversing: trapezoidal wave F ± A
+        A = self.load_amplitude
+        half = 0.5 / self.load_frequency if self.load_frequency > 0 else T
+        ramp = min(self.accel_time, 0.5 * half) or 1e-6
+        times, values = [0.0], [F + A]
+        k = 1
+        while k * half - ramp / 2 < T:
+            sign = -1.0 if k % 2 else 1.0
+            times += [k * half - ramp / 2, k * half + ramp / 2]
+            values += [F - sign * A, F + sign * A]
+            k += 1
+        times.append(max(T, times[-1] + 1e-6))
+        values.append(values[-1])
+        return np.vstack([np.asarray(times), np.asarray(values)]), 0.0, 0.0
+
+    @property
+    def has_reversals(self) -> bool:
+        """True when the motion or the load changes sign during the run."""
+        return self.motion == "reversing" or (
+            self.load_profile in ("sinusoidal", "reversing")
+            and self.load_amplitude > abs(self.load)
+        )
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class ManufacturingVariation:
+    """As-built scatter between rollers, drawn per run from its seed (standard deviations).
+
+    Defaults are ISO-grade-5-like tolerances for a precision PRSM: the papers give none. They
+    make the rollers share load unequally and break the perfect mesh-phase cancellation, so
+    the mesh fundamental appears in the nut vibration as on real hardware
+    (../shared/notes/dynamics-findings.md).
+
+    Parameters
+    ----------
+    pitch_error : float [m]
+        Axial position error of each roller's thread against screw and nut.
+    position_error : float [rad]
+        Angular position error of each carrier pocket.
+    eccentricity : float [m]
+        Radial position error of each pocket (roller runout).
+    mesh_stiffness_spread : float [-]
+        Relative scatter of each roller's gear mesh stiffness.
+    transmission_error : float [m]
+        Static transmission-error offset of each roller gear along the line of action.
+    """
+
+    pitch_error: float = 2e-6
+    position_error: float = math.radians(0.02)
+    eccentricity: float = 2e-6
+    mesh_stiffness_spread: float = 0.03
+    transmission_error: float = 1e-6
+
+    def __post_init__(self):
+        for name, high in (
+            ("pitch_error", 1e-4),
+            ("position_error", 0.05),
+            ("eccentricity", 1e-4),
+            ("mesh_stiffness_spread", 0.5),
+            ("transmission_error", 1e-4),
+        ):
+            require_range(f"variation.{name}", getattr(self, name), 0.0, high)
+
+    @classmethod
+    def ideal(cls) -> ManufacturingVariation:
+        """No scatter: every roller identical and exactly placed."""
+        return cls(0.0, 0.0, 0.0, 0.0, 0.0)
+
+    @property
+    def is_ideal(self) -> bool:
+        return not any(asdict(self).values())
+
+    def as_dict(self) -> dict:
+        return asdict(self)

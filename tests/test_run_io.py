@@ -1,0 +1,54 @@
+"""Run → Parquet → Run, read back by independent readers; damaged files give clear errors."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+from prsm_health import HealthState, OperatingProfile, SensorModel, simulate
+from prsm_health.dynamics.layout import CHANNELS
+from prsm_health.errors import PRSMHealthError
+from prsm_health.run import UNITS, Run
+
+
+@pytest.fixture(scope="module")
+def run():
+    return simulate("paper01", HealthState(), OperatingProfile(duration=0.02), SensorModel(), 4)
+
+
+def test_round_trip_exact(tmp_path, run):
+    path = run.to_parquet(tmp_path / "run.parquet")
+    back = Run.from_parquet(path)
+    assert back.sample_rate == run.sample_rate
+    assert np.array_equal(back.time, run.time)
+    for name in CHANNELS:
+        assert np.array_equal(back[name], run[name]), name
+    assert back.labels == json.loads(json.dumps(run.labels))
+
+
+def test_independent_readers(tmp_path, run):
+    path = run.to_parquet(tmp_path / "run.parquet")
+    frame = pd.read_parquet(path)
+    assert list(frame.columns) == ["time", *CHANNELS]
+    meta = pq.read_schema(path).metadata
+    assert json.loads(meta[b"prsm_health.units"])["nut_axial_accel"] == UNITS["nut_axial_accel"]
+    assert float(meta[b"prsm_health.sample_rate"]) == run.sample_rate
+
+
+def test_damaged_files(tmp_path):
+    bad = tmp_path / "bad.parquet"
+    bad.write_bytes(b"PAR1 not really")
+    with pytest.raises(PRSMHealthError, match="not a readable Parquet"):
+        Run.from_parquet(bad)
+    with pytest.raises(PRSMHealthError, match="no such file"):
+        Run.from_parquet(tmp_path / "missing.parquet")
+    pd.DataFrame({"x": [1.0, 2.0]}).to_parquet(tmp_path / "other.parquet")
+    with pytest.raises(PRSMHealthError, match="no 'time' column"):
+        Run.from_parquet(tmp_path / "other.parquet")
+
+
+def test_unknown_channel(run):
+    with pytest.raises(PRSMHealthError, match="unknown channel"):
+        run["vibration"]
