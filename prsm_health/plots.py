@@ -5,24 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy import signal
 
 from .run import UNITS, Run
-
-
-def amplitude_spectrum(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """Single-sided amplitude spectrum of the mean-removed signal, Hann window.
-
-    Scaled so a sinusoid of amplitude A reads A at its bin (window coherent gain corrected).
-
-    Returns
-    -------
-    (frequency [Hz], amplitude [signal unit])
-    """
-    x = np.asarray(x, float) - np.mean(x)
-    window = signal.windows.hann(len(x), sym=False)
-    spectrum = np.abs(np.fft.rfft(x * window)) * 2.0 / np.sum(window)
-    return np.fft.rfftfreq(len(x), 1.0 / sample_rate), spectrum
+from .spectra import amplitude_spectrum
 
 
 def plot_run(

@@ -21,7 +21,7 @@ from prsm_health import (
 )
 from prsm_health.dynamics.model import build_model
 from prsm_health.dynamics.simulate import linearised_eigenvalues, max_stable_step
-from prsm_health.plots import amplitude_spectrum
+from prsm_health.spectra import amplitude_spectrum, dominant_frequency
 from prsm_health.stiffness.thread import roller_side_stiffness
 
 IDEAL = SimulationOptions(variation=ManufacturingVariation.ideal())
@@ -90,11 +90,9 @@ def test_ideal_rollers_cancel_the_mesh_fundamental():
     assert a_real > 10 * a_ideal
 
 
-def _dominant(x, rate, lo=150.0, hi=1500.0):
-    # Welch PSD, Hann window, 512-sample segments (39 Hz resolution), 75 % overlap.
-    f, p = signal.welch(x - np.mean(x), fs=rate, window="hann", nperseg=512, noverlap=384)
-    band = (f > lo) & (f < hi)
-    return f[band][np.argmax(p[band])]
+def _dominant(x, rate):
+    # Welch PSD, Hann, 512-sample segments (39 Hz bins), parabolic sub-bin peak, 150–1500 Hz.
+    return dominant_frequency(x, rate, (150.0, 1500.0), 512)
 
 
 def test_nut_axial_mode_matches_thread_stiffness():
