@@ -211,3 +211,15 @@ def test_reversing_motion_reverses_nut():
     r = run(duration=0.2, motion="reversing", motion_period=0.1, accel_time=0.01)
     v = np.gradient(r["nut_position"], r.time)
     assert v.max() > 0.1 and v.min() < -0.1
+
+
+def test_blow_up_is_reported_with_its_time():
+    # Bypass the guard with a step 20× beyond the stable limit: the run must stop with an error
+    # naming the time, not return NaNs.
+    from prsm_health.dynamics.model import initial_state
+    from prsm_health.dynamics.simulate import _integrate
+
+    model = build_model(preset("paper01"), HealthState(), OperatingProfile(), SimulationOptions(), 0)
+    h = 20 * max_stable_step(model)[0]
+    with pytest.raises(SimulationError, match=r"non-finite at t = [0-9.e-]+ s"):
+        _integrate(model, initial_state(model), h, 20_000, False)
