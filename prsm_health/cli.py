@@ -28,17 +28,9 @@ class _UsageError(Exception):
 
 
 def _print_json(obj) -> None:
-    print(json.dumps(obj, indent=2, default=_json_default))
+    from .run import json_default
 
-
-def _json_default(value):
-    import numpy as np
-
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+    print(json.dumps(obj, indent=2, default=json_default))
 
 
 def _print_table(rows: list[tuple[str, object, str]]) -> None:

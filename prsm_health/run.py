@@ -90,8 +90,8 @@ class Run:
         meta = {
             b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
             b"prsm_health.sample_rate": repr(float(self.sample_rate)).encode(),
-            b"prsm_health.labels": json.dumps(self.labels, default=_json_default).encode(),
-            b"prsm_health.scenario": json.dumps(self.scenario, default=_json_default).encode(),
+            b"prsm_health.labels": json.dumps(self.labels, default=json_default).encode(),
+            b"prsm_health.scenario": json.dumps(self.scenario, default=json_default).encode(),
         }
         table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
         tmp = path.with_name(path.name + ".partial")
@@ -133,7 +133,8 @@ class Run:
         return cls(time, channels, rate, labels, scenario)
 
 
-def _json_default(value):
+def json_default(value):
+    """``json.dumps`` fallback for numpy arrays and scalars."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):

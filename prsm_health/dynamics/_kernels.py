@@ -192,6 +192,30 @@ def _flank(closure, rate, k, c, exponent):
 
 
 @njit(cache=True, inline="always")
+def _roller_frame(xr, yr, vxr, vyr, xb, yb, vxb, vyb, c, s, w_p):
+    # Roller centre relative to a body centre in the pocket frame (e_r, e_t): radial and
+    # tangential offsets and their rates (the frame turns with the carrier at w_p).
+    dx, dy = xr - xb, yr - yb
+    dvx, dvy = vxr - vxb, vyr - vyb
+    rho = dx * c + dy * s
+    tau = -dx * s + dy * c
+    return rho, tau, dvx * c + dvy * s + tau * w_p, -dvx * s + dvy * c - rho * w_p
+
+
+@njit(cache=True, inline="always")
+def _thread_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c, expo):
+    # Both flanks of one thread engagement: closure ±δ_axial + cot β·approach beyond the
+    # half-clearance. Returns (plus-flank force, minus-flank force, dissipated power).
+    f_plus, d1 = _flank(
+        d_ax + cot_b * approach - clearance, d_ax_dot + cot_b * approach_dot, k, c, expo
+    )
+    f_minus, d2 = _flank(
+        -d_ax + cot_b * approach - clearance, -d_ax_dot + cot_b * approach_dot, k, c, expo
+    )
+    return f_plus, f_minus, d1 + d2
+
+
+@njit(cache=True, inline="always")
 def _mesh_stiffness(table, phase):
     n = table.shape[0]
     x = (phase - math.floor(phase)) * n
@@ -273,26 +297,17 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
         phi = th_p + rollers[i, R_PSI]
 
         # ---------------- screw–roller thread
-        dx, dyy = xr - x_s, yr - y_s
-        dvx, dvy = vxr - vx_s, vyr - vy_s
-        rho = dx * c + dyy * s
-        tau = -dx * s + dyy * c
-        rho_dot = dvx * c + dvy * s + tau * w_p
-        tau_dot = -dvx * s + dvy * c - rho * w_p
+        rho, tau, rho_dot, tau_dot = _roller_frame(
+            xr, yr, vxr, vyr, x_s, y_s, vx_s, vy_s, c, s, w_p
+        )
         th_rev = th_p + tau / orbit
         w_rev = w_p + tau_dot / orbit
-        approach = orbit - rho
-        approach_dot = -rho_dot
         d_ax = lead_s * (th_s - th_rev) - lead_r * (th_c - th_rev) - z_c + rollers[i, R_E_S]
         d_ax_dot = lead_s * (w_s - w_rev) - lead_r * (w_c - w_rev) - vz_c
-        bs = rollers[i, R_B_S]
-        f_plus, d1 = _flank(
-            d_ax + cot_b * approach - bs, d_ax_dot + cot_b * approach_dot, k_ts, c_ts, expo
+        f_plus, f_minus, diss = _thread_pair(
+            d_ax, d_ax_dot, orbit - rho, -rho_dot, rollers[i, R_B_S], cot_b, k_ts, c_ts, expo
         )
-        f_minus, d2 = _flank(
-            -d_ax + cot_b * approach - bs, -d_ax_dot + cot_b * approach_dot, k_ts, c_ts, expo
-        )
-        p_diss += d1 + d2
+        p_diss += diss
         f_ax = f_plus - f_minus  # axial force of the screw on the roller (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller outward, screw inward
         g_tan = f_ax * (lead_s - lead_r) / orbit  # along e_t of the roller, from θ_rev
@@ -330,26 +345,17 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
         dy[v0 + b + 3] += f_ax
 
         # ---------------- roller–nut thread
-        dx, dyy = xr - x_n, yr - y_n
-        dvx, dvy = vxr - vx_n, vyr - vy_n
-        rho = dx * c + dyy * s
-        tau = -dx * s + dyy * c
-        rho_dot = dvx * c + dvy * s + tau * w_p
-        tau_dot = -dvx * s + dvy * c - rho * w_p
+        rho, tau, rho_dot, tau_dot = _roller_frame(
+            xr, yr, vxr, vyr, x_n, y_n, vx_n, vy_n, c, s, w_p
+        )
         th_rev = th_p + tau / orbit
         w_rev = w_p + tau_dot / orbit
-        approach = rho - orbit
-        approach_dot = rho_dot
         d_ax = z_c - z_n + lead_r * (th_c - th_rev) - lead_n * (th_n - th_rev) + rollers[i, R_E_N]
         d_ax_dot = vz_c - vz_n + lead_r * (w_c - w_rev) - lead_n * (w_n - w_rev)
-        bn = rollers[i, R_B_N]
-        f_plus, d1 = _flank(
-            d_ax + cot_b * approach - bn, d_ax_dot + cot_b * approach_dot, k_tn, c_tn, expo
+        f_plus, f_minus, diss = _thread_pair(
+            d_ax, d_ax_dot, rho - orbit, rho_dot, rollers[i, R_B_N], cot_b, k_tn, c_tn, expo
         )
-        f_minus, d2 = _flank(
-            -d_ax + cot_b * approach - bn, -d_ax_dot + cot_b * approach_dot, k_tn, c_tn, expo
-        )
-        p_diss += d1 + d2
+        p_diss += diss
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
         g_tan = -f_ax * (lead_n - lead_r) / orbit
