@@ -193,6 +193,41 @@ def _cmd_stiffness_cylinder(args) -> int:
     return 0
 
 
+# ----------------------------------------------------------------------------- friction
+def _cmd_friction(args) -> int:
+    from .design import preset
+    from .friction import FrictionParameters, simulate_friction
+
+    if args.design:
+        params = FrictionParameters.from_design(
+            preset(args.design), friction_scale=args.friction_scale
+        )
+    else:
+        params = FrictionParameters(friction_scale=args.friction_scale)
+    result = simulate_friction(params, args.load, args.speed, args.accel_time, args.duration)
+    out = {
+        "source": args.design or "paper02 table",
+        "load": args.load,
+        "speed": args.speed,
+        "accel_time": args.accel_time,
+    }
+    out.update(result.summary())
+    if args.json:
+        _print_json(out)
+    else:
+        _print_table(
+            [
+                ("parameters", out["source"], ""),
+                ("peak friction torque", result.peak_friction_torque, "N·m"),
+                ("steady friction torque", result.steady_friction_torque, "N·m"),
+                ("minimum efficiency", result.min_efficiency, ""),
+                ("overall efficiency", result.overall_efficiency, ""),
+                ("steady efficiency", result.steady_efficiency, ""),
+            ]
+        )
+    return 0
+
+
 # ----------------------------------------------------------------------------- simulate
 def _cmd_simulate(args) -> int:
     from pathlib import Path
@@ -330,6 +365,20 @@ def build_parser() -> argparse.ArgumentParser:
     c.set_defaults(func=_cmd_stiffness_cylinder)
 
     _add_simulate_parser(sub, DEFAULT_PRESET, PRESETS)
+
+    f = sub.add_parser("friction", help="friction torque and efficiency at start-up (paper 02)")
+    f.add_argument("--load", type=_finite_float, required=True, help="output axial force [N]")
+    f.add_argument("--speed", type=_finite_float, default=1.0, help="final screw speed [rad/s]")
+    f.add_argument("--accel-time", type=_finite_float, default=0.02, help="ramp time [s]")
+    f.add_argument(
+        "--duration", type=_finite_float, default=None, help="[s], default accel-time + 0.1"
+    )
+    f.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
+    f.add_argument(
+        "--design", default=None, choices=sorted(PRESETS), help="default: paper 02's table"
+    )
+    f.add_argument("--json", action="store_true")
+    f.set_defaults(func=_cmd_friction)
     return parser
 
 

@@ -577,8 +577,8 @@ def _paper02() -> PRSMDesign:
             nut_inertia=0.5 * 0.5 * (r_n**2 + (30e-3) ** 2),
             roller_mass=roller_mass,
             roller_inertia=_solid_cylinder_inertia(roller_mass, r_r),
-            carrier_mass=0.02,
-            carrier_inertia=0.02 * (r_s + r_r) ** 2,
+            carrier_mass=0.1,
+            carrier_inertia=0.1 * (r_s + r_r) ** 2,
         ),
         reference="paper 02 parameter table (r_n0 corrected 15 → 20 mm; masses partly defaults)",
     )

@@ -70,6 +70,7 @@ from .layout import (
     P_K_THREAD_S,
     P_KI,
     P_KP,
+    P_LEAD_EFF,
     P_LEAD_N,
     P_LEAD_R,
     P_LEAD_S,
@@ -80,6 +81,7 @@ from .layout import (
     P_M_P,
     P_M_S,
     P_MU_COUL,
+    P_MU_ROLL,
     P_MU_VISC,
     P_ORBIT_R,
     P_R_NUT,
@@ -90,7 +92,9 @@ from .layout import (
     P_SIN_A0,
     P_SIN_BETA,
     P_TORQUE_LIMIT,
+    P_V_AXIAL,
     P_V_NUT_REF,
+    P_W_ROLL,
     P_Z_RING,
     Q_ROLLER0,
     Q_THN,
@@ -273,6 +277,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
     fscale = p[P_FRICTION_SCALE]
     mu_c, mu_v = p[P_MU_COUL] * fscale, p[P_MU_VISC] * fscale
     k_tan, c_tan = p[P_K_TAN], p[P_C_TAN]
+    mu_r = p[P_MU_ROLL] * fscale
+    v_axial, w_roll, lead_eff = p[P_V_AXIAL], p[P_W_ROLL], p[P_LEAD_EFF]
     s0 = 2 * nq + N_EXTRA  # offset of the traction states
     z_ring = p[P_Z_RING]
 
@@ -280,7 +286,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
     sin_p = math.sin(th_p)
 
     torque_screw = 0.0  # contact torque acting on the screw [N·m]
-    friction_force_sum = 0.0
+    friction_torque = 0.0  # friction part of the screw torque, paper 02's reduction [N·m]
     p_diss = 0.0
     p_fric = 0.0
 
@@ -332,17 +338,28 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
             p_fric += c_tan * v_slide * v_slide
         f_fric += mu_v * v_slide
         p_fric += mu_v * v_slide * v_slide
-        friction_force_sum += f_fric
-        torque_screw += -f_ax * lead_s - r_s * f_fric
-        # on the roller: radial push f_rad·e_r, helix reaction and friction along e_t
-        fx_r = f_rad * c - (g_tan + f_fric) * s
-        fy_r = f_rad * s + (g_tan + f_fric) * c
+        # Paper 02's steady losses: Coulomb friction μ2·N against the roller's axial sliding on
+        # the screw (screw axially fixed) and the differential-sliding torque μ3·N on the
+        # screw, reacted by the roller's revolution.
+        normal = (f_plus + f_minus) / sin_b
+        f_axial = -mu_c * normal * math.tanh(vz_c / v_axial)
+        p_fric -= f_axial * vz_c
+        w_rel = w_s - w_rev
+        m_diff = mu_r * normal * math.tanh(w_rel / w_roll)
+        p_fric += m_diff * w_rel
+        friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
+        torque_screw += -f_ax * lead_s - r_s * f_fric - m_diff
+        # on the roller: radial push f_rad·e_r, helix reaction, traction and the reaction of the
+        # differential-sliding torque along e_t
+        tangential = g_tan + f_fric + m_diff / orbit
+        fx_r = f_rad * c - tangential * s
+        fy_r = f_rad * s + tangential * c
         dy[v0 + Q_XS] -= fx_r
         dy[v0 + Q_YS] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
         dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric
-        dy[v0 + b + 3] += f_ax
+        dy[v0 + b + 3] += f_ax + f_axial
 
         # ---------------- roller–nut thread
         rho, tau, rho_dot, tau_dot = _roller_frame(
@@ -483,7 +500,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
     dy[e0 + X_W_DISS] = p_diss + p_fric
     dy[e0 + X_W_FRIC] = p_fric
     aux[A_DRIVE_TORQUE] = drive
-    aux[A_FRICTION_TORQUE] = r_s * friction_force_sum
+    aux[A_FRICTION_TORQUE] = friction_torque
     aux[A_AXIAL_LOAD] = load
     aux[A_P_DRIVE] = p_drive
     aux[A_P_LOAD] = p_load

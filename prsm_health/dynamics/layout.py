@@ -59,7 +59,11 @@ P_LOAD_SIN_AMP, P_LOAD_SIN_FREQ = 48, 49
 P_SIN_BETA = 50
 P_C_TAN = 51  # damping of the tangential contact compliance while sticking [N·s/m]
 P_V_NUT_REF = 52  # reference speed of the nut axial damper (0: guide friction to ground) [m/s]
-N_PARAMS = 53
+P_MU_ROLL = 53  # differential-sliding coefficient μ3 of paper 02 [m]
+P_V_AXIAL = 54  # regularisation speed of the axial Coulomb sliding [m/s]
+P_W_ROLL = 55  # regularisation speed of the differential-sliding torque [rad/s]
+P_LEAD_EFF = 56  # effective lead per radian (nut travel per screw radian) [m/rad]
+N_PARAMS = 57
 
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP = 0, 1
 

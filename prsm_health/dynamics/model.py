@@ -72,7 +72,10 @@ class SimulationOptions:
     support_damping_ratio : float [-]
         Damping ratio of bearings, guides and pockets.
     friction_coefficient : float [-]
-        Coulomb coefficient of screw–roller sliding (paper 02: μ2 = 0.1).
+        Coulomb coefficient of screw–roller sliding (paper 02: μ2 = 0.1), for the traction
+        limit and the axial sliding of the rollers on the screw.
+    rolling_friction : float [m]
+        Differential-sliding coefficient μ3 of paper 02 (1.5e-6 m).
     viscous_friction : float [N·s/m]
         Paper 01 table: μ_sc = 25 N·s/m.
     traction_stiffness_ratio : float [-]
@@ -97,6 +100,7 @@ class SimulationOptions:
     contact_damping_ratio: float = 0.03
     support_damping_ratio: float = 0.05
     friction_coefficient: float = 0.1
+    rolling_friction: float = 1.5e-6
     viscous_friction: float = 25.0
     traction_stiffness_ratio: float = 0.82
     screw_support_stiffness: float = 1e8
@@ -120,6 +124,7 @@ class SimulationOptions:
         require_range("options.contact_damping_ratio", self.contact_damping_ratio, 0.0, 1.0)
         require_range("options.support_damping_ratio", self.support_damping_ratio, 0.0, 1.0)
         require_range("options.friction_coefficient", self.friction_coefficient, 0.0, 1.0)
+        require_range("options.rolling_friction", self.rolling_friction, 0.0, 1e-3, unit="m")
         require_range("options.viscous_friction", self.viscous_friction, 0.0, 1e5, unit="N·s/m")
         require_range("options.traction_stiffness_ratio", self.traction_stiffness_ratio, 0.01, 1.0)
         for name in (
@@ -284,6 +289,12 @@ def build_model(
     p[L.P_C_SD] = 1e-4
     p[L.P_MU_VISC] = options.viscous_friction
     p[L.P_MU_COUL] = options.friction_coefficient
+    p[L.P_MU_ROLL] = options.rolling_friction
+    # Regularisation speeds of the sliding laws: far below running speeds, wide enough for a
+    # 5 µs step at kN loads (the step guard checks the combination).
+    p[L.P_V_AXIAL] = 0.01
+    p[L.P_W_ROLL] = 0.1
+    p[L.P_LEAD_EFF] = speed_ratios(design).nut
     # Normal-direction stiffness of one roller's screw side is k_axial / sin²β.
     p[L.P_K_TAN] = (
         options.traction_stiffness_ratio * tangents[0] / math.sin(design.contact_angle) ** 2

@@ -62,13 +62,13 @@ def linearised_eigenvalues(model: Model) -> np.ndarray:
     f_minus = np.empty(model.n_state)
     aux = np.zeros(L.n_aux(model.n_rollers))
     jac = np.empty((len(free), len(free)))
-    args = (model.params, rollers, model.mesh_table, model.motion, loaded.load_knots)
+    args = (model.params, rollers, model.mesh_table, loaded.motion, loaded.load_knots)
     for col, j in enumerate(free):
         y = y0.copy()
         y[j] += scale[j]
-        _kernels.rhs(0.0, y, *args[:4], args[4], f_plus, aux)
+        _kernels.rhs(0.0, y, *args, f_plus, aux)
         y[j] -= 2 * scale[j]
-        _kernels.rhs(0.0, y, *args[:4], args[4], f_minus, aux)
+        _kernels.rhs(0.0, y, *args, f_minus, aux)
         jac[:, col] = (f_plus[free] - f_minus[free]) / (2 * scale[j])
     return np.linalg.eigvals(jac)
 
