@@ -379,7 +379,8 @@ class PRSMDesign:
                 self.n_rollers < limit,
                 "design.n_rollers",
                 self.n_rollers,
-                f"must be < π·d_c·tan(α/2)/p = {limit:.4g} (paper 03 eq. 14)",
+                f"must be < π·d_c·tan(α/2)/(2·lead) = {limit:.4g}: at most one roller in the "
+                "threadless area (paper 03 eqs. 11–14)",
             )
 
     # ---------------------------------------------------------------- derived geometry
@@ -483,7 +484,7 @@ class PRSMDesign:
 
 
 def recirculating_roller_limit(design: PRSMDesign) -> float:
-    """Upper bound on the roller count of a recirculating PRSM, π·d_c·tan(α/2)/p_s.
+    """Upper bound on the roller count of a recirculating PRSM, π·d_c·tan(α/2)/(2·L).
 
     Parameters
     ----------
@@ -496,9 +497,21 @@ def recirculating_roller_limit(design: PRSMDesign) -> float:
 
     References
     ----------
-    Paper 03, eqs. (11)–(14): the orbital angle a roller needs to cross one screw thread in the
-    threadless area, β = p_s·360°/(π d_c tan(α/2)), must be below half the roller spacing.
+    Paper 03, eqs. (11)–(13): a roller crossing one thread (a reset stroke of one lead L) in
+    the threadless area sweeps the orbital angle β = 2L/(d_c·tan(α/2)) rad (eq. 11), which must
+    stay below half the roller spacing, β < φ/2 = π/N (eq. 13). The printed eq. (14),
+    N < π·d_c·tan(α/2)/p, drops the factor 2 (it states β < φ); see docs/validation.md.
     """
+    return (
+        math.pi
+        * design.orbit_diameter
+        * math.tan(design.roller_tooth_angle / 2)
+        / (2.0 * design.screw_lead)
+    )
+
+
+def printed_eq14_limit(design: PRSMDesign) -> float:
+    """Paper 03's printed eq. (14) bound π·d_c·tan(α/2)/p, twice the bound of eqs. (11)–(13) [-]."""
     return math.pi * design.orbit_diameter * math.tan(design.roller_tooth_angle / 2) / design.pitch
 
 

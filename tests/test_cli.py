@@ -139,3 +139,27 @@ def test_simulate_bad_input(tmp_path, capsys, monkeypatch, extra, needle):
     code, _, err = run(capsys, "simulate", *extra)
     assert code == 2
     assert err.startswith("error: ") and needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_kinematics_recirculating_and_friction_json(capsys):
+    code, out, _ = run(
+        capsys,
+        "kinematics",
+        "--design",
+        "paper03",
+        "--speed",
+        str(40 * 3.141592653589793),
+        "--json",
+    )
+    assert code == 0
+    data = json.loads(out)
+    assert data["variant"] == "recirculating"
+    assert data["frequencies"]["gear_mesh"] is None
+    assert data["nut_speed"] == pytest.approx(20.00e-3, rel=1e-9)  # paper 03: v_n = 20 mm/s
+    code, out, _ = run(
+        capsys, "friction", "--load", "1000", "--accel-time", "0.02", "--speed", "1", "--json"
+    )
+    assert code == 0
+    data = json.loads(out)
+    assert data["steady_friction_torque"] == pytest.approx(0.115, abs=1e-3)
+    assert data["min_efficiency"] <= data["overall_efficiency"] <= data["steady_efficiency"] <= 1

@@ -81,15 +81,16 @@ def test_gear_ratio_must_match_thread_ratio():
         d.with_(gear=dataclasses.replace(d.gear, roller_teeth=12))
 
 
-def test_recirculating_eq14_limit():
+def test_recirculating_roller_limit():
     d = preset("paper03")
-    # Paper 03 eq. (14) with α = 90°, d_c = 39.5 mm, p = 1 mm: N < π·39.5 = 124.1.
-    assert recirculating_roller_limit(d) == pytest.approx(math.pi * 39.5, rel=1e-12)
-    # A coarse 10 mm pitch lowers the limit to 12.4: 12 rollers fit, 13 do not — while the
+    # Paper 03 eqs. (11)–(13) with α = 90°, d_c = 39.5 mm, one 1 mm lead: N < π·39.5/2 = 62.0
+    # (the printed eq. 14 omits the factor 2; docs/validation.md).
+    assert recirculating_roller_limit(d) == pytest.approx(math.pi * 39.5 / 2, rel=1e-12)
+    # A coarse 5 mm pitch lowers the limit to 12.4: 12 rollers fit, 13 do not — while the
     # rollers still fit geometrically on the orbit (thin crests keep the overlap check away).
-    coarse = d.with_(pitch=10e-3, thread_addendum=0.25e-3)
+    coarse = d.with_(pitch=5e-3, thread_addendum=0.25e-3)
     assert coarse.n_rollers == 12
-    with pytest.raises(ParameterError, match="eq. 14"):
+    with pytest.raises(ParameterError, match="eqs. 11–14"):
         coarse.with_(n_rollers=13)
 
 

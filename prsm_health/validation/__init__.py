@@ -19,7 +19,7 @@ PAPER_INCONSISTENT = "paper inconsistent"
 NOT_COMPUTABLE = "not computable"
 
 #: Modules contributing rows, in report order.
-PAPER_MODULES = ("paper01", "paper02", "paper04", "paper05")
+PAPER_MODULES = ("paper01", "paper02", "paper03", "paper04", "paper05")
 
 
 @dataclass(frozen=True)
