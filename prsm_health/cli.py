@@ -228,6 +228,42 @@ def _cmd_friction(args) -> int:
     return 0
 
 
+# ----------------------------------------------------------------------------- generate
+def _cmd_generate(args) -> int:
+    from .dataset import dataset_throughput, generate, load_recipe
+
+    recipe = load_recipe(args.recipe)
+    try:
+        report = generate(
+            recipe,
+            args.out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            formats=args.format,
+            progress=not args.json,
+        )
+    except KeyboardInterrupt:
+        print(
+            f"interrupted: completed batches are kept in {args.out}; run the same command to resume",
+            file=sys.stderr,
+        )
+        return 130
+    if args.json:
+        _print_json(
+            {
+                "out": str(report.out),
+                "runs": report.total_runs,
+                "generated": report.generated_runs,
+                "resumed": report.resumed_runs,
+                "seconds": report.seconds,
+                "runs_per_minute": report.runs_per_minute,
+            }
+        )
+    else:
+        print(f"{recipe.name}: {dataset_throughput(report)} → {report.out}")
+    return 0
+
+
 # ----------------------------------------------------------------------------- simulate
 def _cmd_simulate(args) -> int:
     from pathlib import Path
@@ -365,6 +401,17 @@ def build_parser() -> argparse.ArgumentParser:
     c.set_defaults(func=_cmd_stiffness_cylinder)
 
     _add_simulate_parser(sub, DEFAULT_PRESET, PRESETS)
+
+    g = sub.add_parser("generate", help="generate a labelled dataset from a recipe (resumable)")
+    g.add_argument("recipe", help="TOML recipe (see datasets/)")
+    g.add_argument("--out", required=True, help="dataset directory")
+    g.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
+    g.add_argument(
+        "--scheduler", default=None, help="Dask scheduler address (or DASK_SCHEDULER_ADDRESS)"
+    )
+    g.add_argument("--format", choices=("parquet", "mcap", "both"), default="parquet")
+    g.add_argument("--json", action="store_true")
+    g.set_defaults(func=_cmd_generate)
 
     f = sub.add_parser("friction", help="friction torque and efficiency at start-up (paper 02)")
     f.add_argument("--load", type=_finite_float, required=True, help="output axial force [N]")

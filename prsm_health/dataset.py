@@ -1,0 +1,739 @@
+"""Labelled datasets from recipes: sweeps, parallel generation, resumable Parquet (and MCAP) output.
+
+A **recipe** (TOML, see datasets/*.toml and docs/formats.md) names a design, a run duration and
+sample rate, profile/sensor/option settings, a seed and a **sweep** over clearance, speed,
+load, friction scale and per-roller wear spread — as a grid, or as random or Latin-hypercube
+samples over ranges — with repeats, a test split and the fault-class thresholds.
+
+Generation is deterministic: run i always gets the same parameters and seed (derived from the
+recipe seed and i), and runs are grouped into fixed batches, so the dataset is identical
+whatever the worker count or scheduler. Each batch is written by its worker as one Parquet
+shard (one row group per run), atomically (temporary name, then rename); a batch whose shard
+exists is done. An interrupted generation (Ctrl-C, kill, crash) therefore resumes on the next
+call with no duplicate and no missing run, and never shows a half-written file.
+
+Layout (contract, ../shared/DESIGN.md)::
+
+    DIR/manifest.json        recipe, package version, sample rate, units, counts
+    DIR/runs.parquet         one row per run: labels and parameters
+    DIR/signals/part-NNNNN.parquet   run_id, time and the channels; row group = run
+    DIR/mcap/run-NNNNNN.mcap         with --format mcap|both
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import os
+import sys
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+from .design import PRESETS
+from .dynamics.layout import CHANNELS
+from .errors import ParameterError, PRSMHealthError, require
+from .run import UNITS, Run
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+FORMATS = ("parquet", "mcap", "both")
+SWEEP_MODES = ("grid", "random", "lhs")
+#: Swept quantities and their units (a range is [min, max]).
+SWEPT = {
+    "clearance": "m",
+    "clearance_screw": "m",
+    "clearance_nut": "m",
+    "clearance_gear": "m",
+    "speed": "rad/s",
+    "load": "N",
+    "friction_scale": "-",
+    "wear_spread": "-",
+}
+FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
+DEFAULT_BATCH = 8
+
+
+class RecipeError(PRSMHealthError):
+    """A recipe that cannot be used (names the key)."""
+
+
+@dataclass(frozen=True)
+class FaultThresholds:
+    """Fault taxonomy thresholds (recipe ``[faults]``).
+
+    A run's class, in this order of precedence: ``severe_wear`` when its largest thread
+    clearance ≥ ``severe_wear`` [m]; ``wear`` when ≥ ``wear`` [m]; ``lubrication`` when its
+    friction scale ≥ ``lubrication`` [-]; else ``healthy``. Wear comes first because it is
+    irreversible and what maintenance acts on; a degraded lubricant on a worn actuator is
+    labelled by its wear.
+    """
+
+    wear: float = 15e-6
+    severe_wear: float = 30e-6
+    lubrication: float = 1.8
+
+    def classify(self, clearance: float, friction_scale: float) -> str:
+        if clearance >= self.severe_wear:
+            return "severe_wear"
+        if clearance >= self.wear:
+            return "wear"
+        if friction_scale >= self.lubrication:
+            return "lubrication"
+        return "healthy"
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """A parsed, validated recipe. Build with :func:`load_recipe` or :meth:`from_dict`."""
+
+    name: str
+    design: str
+    duration: float
+    sample_rate: float
+    seed: int
+    sweep: dict
+    profile: dict = field(default_factory=dict)
+    sensors: dict = field(default_factory=dict)
+    options: dict = field(default_factory=dict)
+    faults: FaultThresholds = field(default_factory=FaultThresholds)
+    test_fraction: float = 0.2
+    batch_size: int = DEFAULT_BATCH
+    dtype: str = "float32"
+    source: dict = field(default_factory=dict, compare=False)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Recipe:
+        data = dict(data)
+        for key in ("name", "design", "duration", "sample_rate", "seed", "sweep"):
+            if key not in data:
+                raise RecipeError(f"recipe: missing key {key!r}")
+        known = {f.name for f in fields(cls)} - {"source"}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise RecipeError(f"recipe: unknown key(s) {', '.join(unknown)}")
+        faults = data.pop("faults", {})
+        try:
+            thresholds = FaultThresholds(**faults)
+        except TypeError as exc:
+            raise RecipeError(f"recipe [faults]: {exc}") from None
+        recipe = cls(**data, faults=thresholds, source=dict(data, faults=faults))
+        recipe._validate()
+        return recipe
+
+    def _validate(self) -> None:
+        def check(ok, key, value, allowed):
+            if not ok:
+                raise RecipeError(f"recipe: {key} = {value!r} is invalid: {allowed}")
+
+        check(
+            isinstance(self.name, str) and self.name,
+            "name",
+            self.name,
+            "must be a non-empty string",
+        )
+        check(
+            self.design in PRESETS,
+            "design",
+            self.design,
+            f"must be one of {', '.join(sorted(PRESETS))}",
+        )
+        check(
+            isinstance(self.duration, (int, float)) and 0 < self.duration <= 60,
+            "duration",
+            self.duration,
+            "must lie in (0, 60] s",
+        )
+        check(
+            isinstance(self.sample_rate, (int, float)) and 100 <= self.sample_rate <= 1e6,
+            "sample_rate",
+            self.sample_rate,
+            "must lie in [100, 1e6] Hz",
+        )
+        check(
+            isinstance(self.seed, int) and self.seed >= 0,
+            "seed",
+            self.seed,
+            "must be an integer ≥ 0",
+        )
+        check(
+            0 <= self.test_fraction < 1, "test_fraction", self.test_fraction, "must lie in [0, 1)"
+        )
+        check(
+            isinstance(self.batch_size, int) and self.batch_size >= 1,
+            "batch_size",
+            self.batch_size,
+            "must be an integer ≥ 1",
+        )
+        check(
+            self.dtype in ("float32", "float64"), "dtype", self.dtype, "must be float32 or float64"
+        )
+        sweep = self.sweep
+        check(isinstance(sweep, dict), "sweep", sweep, "must be a table")
+        mode = sweep.get("mode", "grid")
+        check(mode in SWEEP_MODES, "sweep.mode", mode, f"must be one of {', '.join(SWEEP_MODES)}")
+        unknown = sorted(set(sweep) - set(SWEPT) - {"mode", "repeats", "samples"})
+        check(
+            not unknown,
+            "sweep",
+            unknown,
+            f"unknown key(s); allowed: mode, repeats, samples, {', '.join(SWEPT)}",
+        )
+        repeats = sweep.get("repeats", 1)
+        check(
+            isinstance(repeats, int) and repeats >= 1,
+            "sweep.repeats",
+            repeats,
+            "must be an integer ≥ 1",
+        )
+        for key in SWEPT:
+            if key not in sweep:
+                continue
+            value = sweep[key]
+            if mode == "grid":
+                ok = (
+                    isinstance(value, list)
+                    and value
+                    and all(isinstance(v, (int, float)) for v in value)
+                )
+                check(
+                    ok,
+                    f"sweep.{key}",
+                    value,
+                    f"must be a non-empty list of numbers [{SWEPT[key]}] in grid mode",
+                )
+            else:
+                ok = (
+                    isinstance(value, list)
+                    and len(value) == 2
+                    and all(isinstance(v, (int, float)) for v in value)
+                    and value[0] <= value[1]
+                )
+                check(
+                    ok,
+                    f"sweep.{key}",
+                    value,
+                    f"must be a range [min, max] [{SWEPT[key]}] in {mode} mode",
+                )
+        if mode != "grid":
+            samples = sweep.get("samples")
+            check(
+                isinstance(samples, int) and samples >= 1,
+                "sweep.samples",
+                samples,
+                f"must be an integer ≥ 1 in {mode} mode",
+            )
+        # Build every run's objects once, so a bad value fails now, not in a worker.
+        specs = self.runs()
+        for spec in (specs[0], specs[-1]) if specs else ():
+            try:
+                spec.build()
+            except ParameterError as exc:
+                raise RecipeError(f"recipe (run {spec.run_id}): {exc}") from None
+
+    @property
+    def fingerprint(self) -> str:
+        """Stable hash of the recipe content (guards a dataset directory against another recipe)."""
+        return hashlib.sha256(
+            json.dumps(self.source, sort_keys=True, default=str).encode()
+        ).hexdigest()[:16]
+
+    # ------------------------------------------------------------------ runs
+    def runs(self) -> list[RunSpec]:
+        """Every run of the recipe, in run-id order (deterministic)."""
+        points = self._points()
+        repeats = self.sweep.get("repeats", 1)
+        specs = []
+        n_total = len(points) * repeats
+        test = _test_set(n_total, self.test_fraction, self.seed)
+        run_id = 0
+        for point in points:
+            for _ in range(repeats):
+                seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
+                specs.append(
+                    RunSpec(self, run_id, point, seed, "test" if run_id in test else "train")
+                )
+                run_id += 1
+        return specs
+
+    def _points(self) -> list[dict]:
+        keys = [k for k in SWEPT if k in self.sweep]
+        mode = self.sweep.get("mode", "grid")
+        if mode == "grid":
+            values = [self.sweep[k] for k in keys]
+            return [dict(zip(keys, combo)) for combo in itertools.product(*values)]
+        n = self.sweep["samples"]
+        if mode == "random":
+            unit = np.random.default_rng([self.seed, 0x5357]).random((n, len(keys)))
+        else:
+            from scipy.stats import qmc
+
+            unit = qmc.LatinHypercube(
+                d=max(len(keys), 1), seed=np.random.default_rng([self.seed, 0x4C48])
+            ).random(n)
+        out = []
+        for row in unit:
+            point = {}
+            for j, k in enumerate(keys):
+                lo, hi = self.sweep[k]
+                point[k] = float(lo + row[j] * (hi - lo))
+            out.append(point)
+        return out
+
+    def batches(self) -> list[list[int]]:
+        """Run ids grouped into the fixed batches that workers write as one shard each."""
+        ids = list(range(len(self.runs())))
+        return [ids[i : i + self.batch_size] for i in range(0, len(ids), self.batch_size)]
+
+
+def _test_set(n: int, fraction: float, seed: int) -> set[int]:
+    k = int(round(n * fraction))
+    return set(np.random.default_rng([seed, 0x54455354]).permutation(n)[:k].tolist())
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a recipe: its id, swept values, seed and split."""
+
+    recipe: Recipe
+    run_id: int
+    point: dict
+    seed: int
+    split: str
+
+    def build(self):
+        """(design, health, profile, sensors, options) objects of this run (validates)."""
+        from .design import preset
+        from .dynamics.model import SimulationOptions
+        from .sensors import SensorModel
+        from .states import HealthState, ManufacturingVariation, OperatingProfile
+
+        r, p = self.recipe, self.point
+        base = p.get("clearance", 10e-6)
+        try:
+            health = HealthState(
+                clearance_screw=p.get("clearance_screw", base),
+                clearance_nut=p.get("clearance_nut", base),
+                clearance_gear=p.get("clearance_gear", base),
+                wear_spread=p.get("wear_spread", 0.0),
+                friction_scale=p.get("friction_scale", 1.0),
+            )
+            profile = OperatingProfile(
+                duration=r.duration,
+                speed=p.get("speed", 100.0),
+                load=p.get("load", 100.0),
+                **r.profile,
+            )
+            sensors = SensorModel(sample_rate=r.sample_rate, **r.sensors)
+            options = dict(r.options)
+            ideal = options.pop("ideal", False)
+            if ideal:
+                options["variation"] = ManufacturingVariation.ideal()
+            sim_options = SimulationOptions(**options)
+        except TypeError as exc:
+            raise RecipeError(f"recipe: {exc}") from None
+        return preset(r.design), health, profile, sensors, sim_options
+
+    def labels(self, run: Run | None = None) -> dict:
+        """The run's labels (contract names; nominal values)."""
+        _, health, profile, _, _ = self.build()
+        clearance = max(health.clearance_screw, health.clearance_nut)
+        out = {
+            "run_id": self.run_id,
+            "split": self.split,
+            "fault_class": self.recipe.faults.classify(clearance, health.friction_scale),
+            "design": self.recipe.design,
+            "clearance_screw": health.clearance_screw,
+            "clearance_nut": health.clearance_nut,
+            "clearance_gear": health.clearance_gear,
+            "wear_spread": health.wear_spread,
+            "friction_scale": health.friction_scale,
+            "screw_speed": profile.speed,
+            "axial_load": profile.load,
+            "load_amplitude": profile.load_amplitude,
+            "motion": profile.motion,
+            "load_profile": profile.load_profile,
+            "duration": profile.duration,
+            "seed": self.seed,
+        }
+        if run is not None:
+            out["n_samples"] = len(run)
+        return out
+
+
+def load_recipe(path: str | Path) -> Recipe:
+    """Parse and validate a TOML recipe; errors name the key."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise RecipeError(f"{path}: no such recipe file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise RecipeError(f"{path}: not valid TOML ({exc})") from None
+    return Recipe.from_dict(data)
+
+
+# ---------------------------------------------------------------------- generation
+def _shard_path(out: Path, batch: int) -> Path:
+    return out / "signals" / f"part-{batch:05d}.parquet"
+
+
+def _mcap_path(out: Path, run_id: int) -> Path:
+    return out / "mcap" / f"run-{run_id:06d}.mcap"
+
+
+def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> list[dict]:
+    """Simulate one batch and write its shard (and MCAP files); returns the batch's labels.
+
+    Runs in a worker process (local pool or Dask worker): takes only plain data, writes its own
+    files, returns only the small label dicts.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from .dynamics.simulate import simulate
+
+    recipe = Recipe.from_dict(recipe_source)
+    out = Path(out_dir)
+    specs = recipe.runs()
+    dtype = np.float32 if recipe.dtype == "float32" else np.float64
+    tables, labels = [], []
+    for run_id in recipe.batches()[batch]:
+        spec = specs[run_id]
+        design, health, profile, sensors, options = spec.build()
+        run = simulate(design, health, profile, sensors, spec.seed, options=options)
+        label = spec.labels(run)
+        run.labels = dict(run.labels, **label)
+        if formats in ("mcap", "both"):
+            from .mcap_io import write_mcap
+
+            write_mcap(run, _mcap_path(out, run_id))
+        columns = {
+            "run_id": pa.array(np.full(len(run), run_id, np.int32)),
+            "time": pa.array(run.time),
+        }
+        for name in CHANNELS:
+            columns[name] = pa.array(run.channels[name].astype(dtype))
+        tables.append(pa.table(columns))
+        labels.append(label)
+    # One shard per batch, one row group per run; the labels ride in the footer so a shard and
+    # its labels appear together, atomically (temporary name, then rename).
+    metadata = _schema_metadata(recipe)
+    metadata[b"prsm_health.labels"] = json.dumps(labels).encode()
+    shard = _shard_path(out, batch)
+    tmp = shard.with_name(shard.name + f".partial-{os.getpid()}")
+    try:
+        with pq.ParquetWriter(
+            tmp, tables[0].schema.with_metadata(metadata), compression="zstd"
+        ) as writer:
+            for table in tables:
+                writer.write_table(table, row_group_size=table.num_rows)
+        tmp.replace(shard)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return labels
+
+
+def _schema_metadata(recipe: Recipe) -> dict:
+    return {
+        b"prsm_health.units": json.dumps({k: UNITS[k] for k in ("time", *CHANNELS)}).encode(),
+        b"prsm_health.sample_rate": repr(float(recipe.sample_rate)).encode(),
+        b"prsm_health.recipe": recipe.name.encode(),
+    }
+
+
+def _shard_labels(path: Path) -> list[dict]:
+    import pyarrow.parquet as pq
+
+    meta = pq.read_schema(path).metadata or {}
+    return json.loads(meta[b"prsm_health.labels"])
+
+
+@dataclass
+class GenerationReport:
+    """What one call of :func:`generate` did."""
+
+    out: Path
+    total_runs: int
+    generated_runs: int
+    resumed_runs: int
+    seconds: float
+
+    @property
+    def runs_per_minute(self) -> float:
+        return 60.0 * self.generated_runs / self.seconds if self.seconds > 0 else float("nan")
+
+
+def generate(
+    recipe: Recipe | str | Path,
+    out: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler: str | object | None = None,
+    formats: str = "parquet",
+    progress: bool = True,
+    on_batch: Callable[[int], None] | None = None,
+) -> GenerationReport:
+    """Generate (or resume) a dataset.
+
+    Parameters
+    ----------
+    recipe : Recipe or path to a TOML recipe
+    out : path
+        Dataset directory; created if missing. A directory holding another recipe's dataset is
+        refused.
+    workers : int or None
+        Local worker processes (default: CPU count). 1 runs in this process.
+    scheduler : str, distributed.Client or None
+        Dask scheduler address (or a Client); default from ``DASK_SCHEDULER_ADDRESS``. When set,
+        batches run on the cluster and workers write the files (shared filesystem).
+    formats : {"parquet", "mcap", "both"}
+    progress : bool
+        Progress bar with runs done, rate and ETA.
+    on_batch : callable or None
+        Called with each finished batch index (tests use it to interrupt).
+    """
+    import time
+
+    recipe = recipe if isinstance(recipe, Recipe) else load_recipe(recipe)
+    require(formats in FORMATS, "format", formats, f"must be one of {', '.join(FORMATS)}")
+    out = Path(out)
+    _prepare(out, recipe, formats)
+    batches = recipe.batches()
+    total = sum(len(b) for b in batches)
+    pending = [i for i in range(len(batches)) if not _shard_path(out, i).exists()]
+    resumed = total - sum(len(batches[i]) for i in pending)
+    scheduler = (
+        scheduler if scheduler is not None else os.environ.get("DASK_SCHEDULER_ADDRESS") or None
+    )
+    start = time.perf_counter()
+    bar = None
+    if progress and pending:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total, initial=resumed, unit="run", desc=recipe.name, smoothing=0.1)
+    done_runs = 0
+
+    def finished(batch: int) -> None:
+        nonlocal done_runs
+        done_runs += len(batches[batch])
+        if bar is not None:
+            bar.update(len(batches[batch]))
+        if on_batch is not None:
+            on_batch(batch)
+
+    try:
+        if scheduler:
+            _run_dask(scheduler, recipe, out, formats, pending, finished)
+        else:
+            _run_local(workers, recipe, out, formats, pending, finished)
+    finally:
+        if bar is not None:
+            bar.close()
+    _finalise(out, recipe, formats)
+    return GenerationReport(out, total, done_runs, resumed, time.perf_counter() - start)
+
+
+def _prepare(out: Path, recipe: Recipe, formats: str) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "signals").mkdir(exist_ok=True)
+    if formats in ("mcap", "both"):
+        (out / "mcap").mkdir(exist_ok=True)
+    stamp = out / ".recipe.json"
+    if stamp.exists():
+        previous = json.loads(stamp.read_text())
+        if previous.get("fingerprint") != recipe.fingerprint:
+            raise PRSMHealthError(
+                f"{out} holds a dataset of another recipe ({previous.get('name')!r}); "
+                "use a new --out directory"
+            )
+    else:
+        _atomic_write(stamp, json.dumps({"name": recipe.name, "fingerprint": recipe.fingerprint}))
+    for stale in (out / "signals").glob("*.partial-*"):
+        stale.unlink(missing_ok=True)  # a killed worker's unfinished shard
+
+
+def _run_local(workers, recipe, out, formats, pending, finished) -> None:
+    workers = workers or os.cpu_count() or 1
+    require(isinstance(workers, int) and workers >= 1, "workers", workers, "must be an integer ≥ 1")
+    if workers == 1:
+        for batch in pending:
+            run_batch(recipe.source, batch, str(out), formats)
+            finished(batch)
+        return
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    pool = ProcessPoolExecutor(max_workers=workers)
+    try:
+        futures = {pool.submit(run_batch, recipe.source, b, str(out), formats): b for b in pending}
+        remaining = set(futures)
+        while remaining:
+            done, remaining = wait(remaining, return_when=FIRST_COMPLETED)
+            for fut in done:
+                fut.result()
+                finished(futures[fut])
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown()
+
+
+def _run_dask(scheduler, recipe, out, formats, pending, finished) -> None:
+    from distributed import Client, as_completed
+
+    client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+    try:
+        futures = client.map(
+            run_batch,
+            [recipe.source] * len(pending),
+            pending,
+            [str(out)] * len(pending),
+            [formats] * len(pending),
+            pure=False,
+        )
+        index = {f.key: b for f, b in zip(futures, pending)}
+        for fut in as_completed(futures):
+            fut.result()
+            finished(index[fut.key])
+    finally:
+        if client is not scheduler:
+            client.close()
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".partial")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
+def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
+    """Assemble runs.parquet and manifest.json from the shards (idempotent)."""
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from . import __version__
+
+    rows = []
+    for batch in range(len(recipe.batches())):
+        shard = _shard_path(out, batch)
+        for group, label in enumerate(_shard_labels(shard)):
+            rows.append(dict(label, shard=f"signals/{shard.name}", row_group=group))
+    frame = pd.DataFrame(rows).sort_values("run_id").reset_index(drop=True)
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    tmp = out / "runs.parquet.partial"
+    pq.write_table(table, tmp)
+    tmp.replace(out / "runs.parquet")
+    manifest = {
+        "name": recipe.name,
+        "recipe": recipe.source,
+        "package": {"name": "prsm_health", "version": __version__},
+        "sample_rate": recipe.sample_rate,
+        "duration": recipe.duration,
+        "channels": {k: UNITS[k] for k in ("time", *CHANNELS)},
+        "dtype": recipe.dtype,
+        "formats": formats,
+        "fault_taxonomy": {
+            "classes": list(FAULT_CLASSES),
+            "thresholds": {
+                "wear": recipe.faults.wear,
+                "severe_wear": recipe.faults.severe_wear,
+                "lubrication": recipe.faults.lubrication,
+            },
+            "rule": FaultThresholds.__doc__.split("\n\n")[1].strip().replace("\n    ", " "),
+        },
+        "counts": {
+            "runs": len(frame),
+            "train": int((frame["split"] == "train").sum()),
+            "test": int((frame["split"] == "test").sum()),
+            "fault_class": {
+                k: int(v) for k, v in frame["fault_class"].value_counts().sort_index().items()
+            },
+        },
+    }
+    _atomic_write(out / "manifest.json", json.dumps(manifest, indent=2, default=_plain))
+
+
+def _plain(value):
+    if isinstance(value, (np.integer, np.floating)):
+        return value.item()
+    raise TypeError(type(value).__name__)
+
+
+# ---------------------------------------------------------------------- reading
+class Dataset:
+    """A generated dataset directory: labels table and per-run signals."""
+
+    def __init__(self, path: str | Path):
+        import pandas as pd
+
+        self.path = Path(path)
+        manifest = self.path / "manifest.json"
+        if not manifest.exists():
+            raise PRSMHealthError(f"{self.path}: not a dataset directory (no manifest.json)")
+        try:
+            self.manifest = json.loads(manifest.read_text())
+            self.runs = pd.read_parquet(self.path / "runs.parquet")
+        except Exception as exc:  # damaged files
+            raise PRSMHealthError(f"{self.path}: unreadable dataset ({exc})") from None
+
+    @property
+    def sample_rate(self) -> float:
+        return float(self.manifest["sample_rate"])
+
+    def __len__(self) -> int:
+        return len(self.runs)
+
+    def run(self, run_id: int) -> Run:
+        """The signals of one run as a :class:`~prsm_health.run.Run` (one row group read)."""
+        import pyarrow.parquet as pq
+
+        rows = self.runs[self.runs["run_id"] == run_id]
+        if rows.empty:
+            raise PRSMHealthError(f"run_id {run_id} is not in {self.path}")
+        row = rows.iloc[0]
+        table = pq.ParquetFile(self.path / row["shard"]).read_row_group(int(row["row_group"]))
+        channels = {name: table.column(name).to_numpy().astype(float) for name in CHANNELS}
+        labels = {
+            k: (v.item() if hasattr(v, "item") else v)
+            for k, v in row.items()
+            if k not in ("shard", "row_group")
+        }
+        return Run(
+            table.column("time").to_numpy(),
+            channels,
+            self.sample_rate,
+            labels,
+            {"recipe": self.manifest["recipe"]},
+        )
+
+    def iter_runs(self, run_ids: Iterable[int] | None = None):
+        for run_id in run_ids if run_ids is not None else self.runs["run_id"]:
+            yield self.run(int(run_id))
+
+
+def dataset_throughput(report: GenerationReport) -> str:
+    """One line for logs and docs: runs, time, runs/min."""
+    return (
+        f"{report.generated_runs} runs in {report.seconds:.1f} s "
+        f"({report.runs_per_minute:.0f} runs/min; {report.resumed_runs} already done)"
+    )
+
+
+__all__ = [
+    "Dataset",
+    "FaultThresholds",
+    "GenerationReport",
+    "Recipe",
+    "RecipeError",
+    "RunSpec",
+    "generate",
+    "load_recipe",
+    "run_batch",
+]

@@ -1,0 +1,193 @@
+"""Recipes, deterministic parallel generation, resume after a kill, Dask, independent readers."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+from prsm_health.dataset import Dataset, Recipe, RecipeError, generate, load_recipe
+from prsm_health.dynamics.layout import CHANNELS
+from prsm_health.dynamics.simulate import simulate
+
+TINY = textwrap.dedent(
+    """
+    name = "tiny"
+    design = "paper01"
+    duration = 0.02
+    sample_rate = 20000
+    seed = 11
+    batch_size = 2
+    test_fraction = 0.34
+    [sweep]
+    clearance = [5e-6, 25e-6, 40e-6]
+    speed = [80.0]
+    load = [100.0, 200.0]
+    repeats = 1
+    """
+)
+
+
+@pytest.fixture
+def recipe_path(tmp_path):
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY)
+    return path
+
+
+def _signals(out):
+    frames = [pd.read_parquet(p) for p in sorted((out / "signals").glob("part-*.parquet"))]
+    return pd.concat(frames).sort_values(["run_id", "time"]).reset_index(drop=True)
+
+
+def test_minimal_recipe_and_run_enumeration(recipe_path):
+    r = load_recipe(recipe_path)
+    specs = r.runs()
+    assert len(specs) == 6 and [s.run_id for s in specs] == list(range(6))
+    assert sum(s.split == "test" for s in specs) == 2  # round(6 × 0.34)
+    assert specs == load_recipe(recipe_path).runs()  # deterministic
+    assert len({s.seed for s in specs}) == 6
+    assert [len(b) for b in r.batches()] == [2, 2, 2]
+
+
+def test_latin_hypercube_and_bad_recipes():
+    base = dict(name="x", design="paper01", duration=0.01, sample_rate=20000, seed=1)
+    lhs = Recipe.from_dict(
+        dict(
+            base,
+            sweep={"mode": "lhs", "samples": 10, "clearance": [0.0, 4e-5], "speed": [50.0, 100.0]},
+        )
+    )
+    points = np.array([[s.point["clearance"], s.point["speed"]] for s in lhs.runs()])
+    # Latin hypercube: each of the 10 strata of each axis holds exactly one sample.
+    assert sorted(np.floor(points[:, 0] / 4e-6).astype(int)) == list(range(10))
+    for bad, key in [
+        (dict(base, sweep={"clearance": 1e-5}), "sweep.clearance"),
+        (dict(base, sweep={"speed": [1.0]}, colour="red"), "colour"),
+        (dict(base, sweep={"clearance": [-1e-6]}), "health.clearance_screw"),
+        (dict(base, design="paper99", sweep={}), "design"),
+        ({k: v for k, v in base.items() if k != "seed"} | {"sweep": {}}, "seed"),
+        (dict(base, sweep={"mode": "lhs", "clearance": [0, 1e-5]}), "sweep.samples"),
+    ]:
+        with pytest.raises(RecipeError, match=key):
+            Recipe.from_dict(bad)
+
+
+def test_workers_1_and_2_identical_and_readers(recipe_path, tmp_path):
+    a = generate(recipe_path, tmp_path / "a", workers=1, progress=False)
+    b = generate(recipe_path, tmp_path / "b", workers=2, progress=False)
+    assert a.generated_runs == b.generated_runs == 6
+    sa, sb = _signals(tmp_path / "a"), _signals(tmp_path / "b")
+    pd.testing.assert_frame_equal(sa, sb)
+    ra = pd.read_parquet(tmp_path / "a" / "runs.parquet")
+    assert list(ra["run_id"]) == list(range(6))
+    manifest = json.loads((tmp_path / "a" / "manifest.json").read_text())
+    assert manifest["counts"]["runs"] == 6 and manifest["channels"]["nut_axial_accel"] == "m/s^2"
+    # units and sample rate in the Parquet schema metadata too
+    meta = pq.read_schema(next((tmp_path / "a" / "signals").glob("*.parquet"))).metadata
+    assert float(meta[b"prsm_health.sample_rate"]) == 20000.0
+    # independent readers, no custom code: polars and duckdb
+    import duckdb
+    import polars as pl
+
+    runs_pl = pl.read_parquet(tmp_path / "a" / "runs.parquet")
+    assert runs_pl.height == 6
+    signals_pl = pl.read_parquet(str(tmp_path / "a" / "signals" / "*.parquet"))
+    assert set(CHANNELS) <= set(signals_pl.columns)
+    counts = duckdb.sql(
+        f"select run_id, count(*) n from read_parquet('{tmp_path / 'a' / 'signals' / '*.parquet'}') group by run_id order by run_id"
+    ).fetchall()
+    assert [c[1] for c in counts] == list(ra["n_samples"])
+
+
+def test_dataset_run_equals_simulation(recipe_path, tmp_path):
+    generate(recipe_path, tmp_path / "d", workers=1, progress=False)
+    ds = Dataset(tmp_path / "d")
+    spec = load_recipe(recipe_path).runs()[4]
+    design, health, profile, sensors, options = spec.build()
+    direct = simulate(design, health, profile, sensors, spec.seed, options=options)
+    stored = ds.run(4)
+    assert np.array_equal(stored.time, direct.time)
+    for name in CHANNELS:  # float32 storage: equal to float32 precision
+        assert np.array_equal(stored[name], direct[name].astype(np.float32).astype(float)), name
+    assert stored.labels["clearance_screw"] == health.clearance_screw
+
+
+def test_interrupt_and_resume_in_process(recipe_path, tmp_path):
+    def stop(batch):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        generate(recipe_path, tmp_path / "r", workers=1, progress=False, on_batch=stop)
+    assert len(list((tmp_path / "r" / "signals").glob("part-*.parquet"))) == 1
+    report = generate(recipe_path, tmp_path / "r", workers=1, progress=False)
+    assert report.resumed_runs == 2 and report.generated_runs == 4
+    runs = pd.read_parquet(tmp_path / "r" / "runs.parquet")
+    assert sorted(runs["run_id"]) == list(range(6))
+
+
+def test_killed_process_resumes_without_duplicates_or_holes(recipe_path, tmp_path):
+    out = tmp_path / "k"
+    code = f"from prsm_health.dataset import generate; generate({str(recipe_path)!r}, {str(out)!r}, workers=1, progress=False)"
+    proc = subprocess.Popen([sys.executable, "-c", code])
+    deadline = time.time() + 300
+    while time.time() < deadline and not list((out / "signals").glob("part-*.parquet")):
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    done_before = len(list((out / "signals").glob("part-*.parquet")))
+    assert 1 <= done_before
+    # nothing half-written under a final name: only complete shards or hidden partials
+    for path in (out / "signals").iterdir():
+        assert path.name.startswith("part-") and (
+            path.suffix == ".parquet" or ".partial-" in path.name
+        )
+    generate(recipe_path, out, workers=2, progress=False)
+    runs = pd.read_parquet(out / "runs.parquet")
+    assert sorted(runs["run_id"]) == list(range(6))
+    signals = _signals(out)
+    assert signals.groupby("run_id").size().tolist() == list(
+        runs.sort_values("run_id")["n_samples"]
+    )
+    assert not list((out / "signals").glob("*.partial-*"))
+    reference = tmp_path / "ref"
+    generate(recipe_path, reference, workers=1, progress=False)
+    pd.testing.assert_frame_equal(signals, _signals(reference))
+
+
+def test_dask_local_cluster_same_dataset(recipe_path, tmp_path):
+    from distributed import Client, LocalCluster
+
+    generate(recipe_path, tmp_path / "local", workers=1, progress=False)
+    with (
+        LocalCluster(
+            n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        generate(recipe_path, tmp_path / "dask", scheduler=client, progress=False)
+    pd.testing.assert_frame_equal(_signals(tmp_path / "local"), _signals(tmp_path / "dask"))
+
+
+def test_other_recipe_in_same_directory_refused(recipe_path, tmp_path):
+    generate(recipe_path, tmp_path / "x", workers=1, progress=False)
+    other = tmp_path / "other.toml"
+    other.write_text(TINY.replace('name = "tiny"', 'name = "other"'))
+    from prsm_health.errors import PRSMHealthError
+
+    with pytest.raises(PRSMHealthError, match="another recipe"):
+        generate(other, tmp_path / "x", workers=1, progress=False)
+
+
+def test_shipped_recipes_parse():
+    root = os.path.join(os.path.dirname(__file__), "..", "datasets")
+    for name in ("demo.toml", "clearance-study.toml"):
+        r = load_recipe(os.path.join(root, name))
+        assert len(r.runs()) > 20
