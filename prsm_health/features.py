@@ -1,0 +1,333 @@
+"""Condition indicators of a run or a window: gear mesh, shifted axial frequency, classic, torque.
+
+Every indicator is a named float with a documented unit (:data:`FEATURES`); an indicator that a
+window cannot support (no reversal for lost motion, no speed for mesh lines) is NaN — the
+estimators handle missing values. Spectra use Hann windows with explicit scaling:
+
+* amplitude spectra are corrected for the window's coherent gain (a sinusoid of amplitude A
+  reads A) — :func:`prsm_health.spectra.amplitude_spectrum`;
+* power spectral densities are Welch estimates (Hann, 75 % overlap, density scaling, units²/Hz);
+  band energies integrate them (units², i.e. the band's mean-square value).
+
+Gear-mesh lines are located from the measured speeds: the carrier speed channel when present,
+else the screw speed through the rigid-body ratio; when the speed varies by more than 5 % in a
+window the signal is resampled to uniform screw angle (order domain) before the spectrum.
+
+The shifted-axial-frequency indicator compares the dominant nut axial frequency with the healthy
+baseline the physics predicts for the same design and load: √(k_axial/m_N)/2π, k_axial the
+paper-04 thread stiffness of all rollers (screw and nut sides in series) at the run's mean load.
+
+References
+----------
+Paper 01 §3.2–3.3 (mesh frequency, axial frequency shift with clearance); paper 04 (axial
+stiffness); paper 02 (friction torque, efficiency).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+from scipy import signal, stats
+
+from .design import PRSMDesign, preset
+from .errors import PRSMHealthError
+from .kinematics import speed_ratios
+from .run import Run
+from .spectra import amplitude_spectrum, dominant_frequency
+
+VIBRATION = ("nut_axial_accel", "nut_tangential_accel", "nut_radial_x_accel", "nut_radial_y_accel")
+SHORT = {
+    "nut_axial_accel": "ax",
+    "nut_tangential_accel": "tan",
+    "nut_radial_x_accel": "rx",
+    "nut_radial_y_accel": "ry",
+}
+BANDS = ((50.0, 300.0), (300.0, 1000.0), (1000.0, 3000.0), (3000.0, 10000.0))
+MESH_CHANNELS = ("nut_tangential_accel", "nut_radial_x_accel")
+MIN_SAMPLES = 256
+ORDER_TRACKING_SPREAD = 0.05
+
+
+def _feature_table() -> dict[str, str]:
+    units = {}
+    for s in SHORT.values():
+        units[f"{s}_rms"] = "m/s²"
+        units[f"{s}_peak"] = "m/s²"
+        units[f"{s}_crest"] = "-"
+        units[f"{s}_kurtosis"] = "-"
+        units[f"{s}_skewness"] = "-"
+        for lo, hi in BANDS:
+            units[f"{s}_band_{int(lo)}_{int(hi)}"] = "(m/s²)²"
+    for ch in MESH_CHANNELS:
+        s = SHORT[ch]
+        for k in (1, 2, 3):
+            units[f"{s}_mesh_h{k}"] = "m/s²"
+        units[f"{s}_mesh_sidebands"] = "m/s²"
+    units.update(
+        {
+            "mesh_frequency": "Hz",
+            "axial_dominant_frequency": "Hz",
+            "axial_baseline_frequency": "Hz",
+            "axial_frequency_shift": "Hz",
+            "axial_frequency_shift_relative": "-",
+            "axial_dominant_amplitude": "m/s²",
+            "friction_torque_mean": "N·m",
+            "friction_torque_ripple": "N·m",
+            "drive_torque_mean": "N·m",
+            "drive_torque_ripple": "N·m",
+            "efficiency": "-",
+            "lost_motion": "m",
+            "speed_mean": "rad/s",
+            "load_mean": "N",
+            "load_range": "N",
+        }
+    )
+    return units
+
+
+#: Indicator name → unit, in the column order of :func:`extract_features`.
+FEATURES: dict[str, str] = _feature_table()
+
+#: Indicator groups for importance and ablation studies.
+GROUPS = {
+    "mesh": [k for k in FEATURES if "_mesh_" in k] + ["mesh_frequency"],
+    "axial_frequency": [k for k in FEATURES if k.startswith("axial_")],
+    "classic": [k for k in FEATURES if k.split("_")[0] in SHORT.values() and "_mesh_" not in k],
+    "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
+    "lost_motion": ["lost_motion"],
+    "operating": ["speed_mean", "load_mean", "load_range"],
+}
+
+
+@lru_cache(maxsize=256)
+def axial_baseline_frequency(design_name: str, load: float) -> float:
+    """Healthy nut axial frequency √(k_axial/m_N)/2π [Hz] at an axial load [N] (paper 04 stiffness)."""
+    from .stiffness.thread import roller_side_stiffness
+
+    design = preset(design_name)
+    per_roller = max(abs(load), 20.0) / design.n_rollers
+    k_s = float(roller_side_stiffness(design, per_roller, "screw"))
+    k_n = float(roller_side_stiffness(design, per_roller, "nut"))
+    k = design.n_rollers * k_s * k_n / (k_s + k_n)
+    return math.sqrt(k / design.masses.nut_mass) / (2 * math.pi)
+
+
+def _classic(x: np.ndarray, rate: float, prefix: str, out: dict) -> None:
+    centred = x - np.mean(x)
+    rms = float(np.sqrt(np.mean(centred**2)))
+    peak = float(np.max(np.abs(centred)))
+    out[f"{prefix}_rms"] = rms
+    out[f"{prefix}_peak"] = peak
+    out[f"{prefix}_crest"] = peak / rms if rms > 0 else np.nan
+    out[f"{prefix}_kurtosis"] = float(stats.kurtosis(centred, fisher=False)) if rms > 0 else np.nan
+    out[f"{prefix}_skewness"] = float(stats.skew(centred)) if rms > 0 else np.nan
+    nperseg = min(1024, len(x))
+    f, psd = signal.welch(
+        centred,
+        fs=rate,
+        window="hann",
+        nperseg=nperseg,
+        noverlap=3 * nperseg // 4,
+        scaling="density",
+    )
+    df = f[1] - f[0]
+    for lo, hi in BANDS:
+        band = (f >= lo) & (f < min(hi, rate / 2))
+        out[f"{prefix}_band_{int(lo)}_{int(hi)}"] = (
+            float(np.sum(psd[band]) * df) if band.any() else np.nan
+        )
+
+
+def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
+    # Largest amplitude within ±max(2 bins, 0.5 %) of the target: the line may fall between
+    # bins and the speed estimate carries its own error.
+    if not np.isfinite(target) or target <= 0 or target >= freq[-1]:
+        return np.nan
+    half = max(2 * (freq[1] - freq[0]), 0.005 * target)
+    band = (freq >= target - half) & (freq <= target + half)
+    return float(np.max(amp[band])) if band.any() else np.nan
+
+
+def _order_resample(x: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, float]:
+    # Uniform screw-angle grid with the same number of samples: spectrum in orders per radian.
+    grid = np.linspace(angle[0], angle[-1], len(angle))
+    return np.interp(grid, angle, x), (grid[1] - grid[0])
+
+
+def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[str, float]:
+    """All indicators of one run or window.
+
+    Parameters
+    ----------
+    run : Run
+        Contract channels at ``run.sample_rate``; missing channels give NaN indicators.
+    design : PRSMDesign, preset name or None
+        Default: the run's ``labels["design"]``, else paper01.
+
+    Returns
+    -------
+    dict of name → float, in :data:`FEATURES` order and units.
+    """
+    if len(run) < MIN_SAMPLES:
+        raise PRSMHealthError(
+            f"window too short: {len(run)} samples, need at least {MIN_SAMPLES} "
+            f"({MIN_SAMPLES / run.sample_rate:.3g} s at {run.sample_rate:g} Hz)"
+        )
+    if not any(ch in run.channels for ch in VIBRATION) and "nut_position" not in run.channels:
+        raise PRSMHealthError(
+            "no usable channels: need nut accelerations or nut position (contract names)"
+        )
+    for name, values in run.channels.items():
+        if not np.all(np.isfinite(values)):
+            raise PRSMHealthError(f"channel {name} contains NaN or infinite values")
+    if design is None:
+        design = run.labels.get("design", "paper01")
+    design = preset(design) if isinstance(design, str) else design
+    rate = run.sample_rate
+    out = dict.fromkeys(FEATURES, np.nan)
+    ch = run.channels
+
+    for name, prefix in SHORT.items():
+        if name in ch:
+            _classic(ch[name], rate, prefix, out)
+
+    speed = ch.get("screw_speed")
+    load = ch.get("axial_load")
+    ratios = speed_ratios(design)
+    if speed is not None:
+        out["speed_mean"] = float(np.mean(speed))
+    if load is not None:
+        out["load_mean"] = float(np.mean(load))
+        out["load_range"] = float(np.ptp(load))
+
+    # ---- gear mesh lines
+    if "carrier_speed" in ch:
+        f_c = abs(float(np.mean(ch["carrier_speed"]))) / (2 * math.pi)
+    elif speed is not None:
+        f_c = abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi)
+    else:
+        f_c = np.nan
+    if design.gear is not None and np.isfinite(f_c) and f_c > 0:
+        z = design.gear.ring_teeth
+        out["mesh_frequency"] = z * f_c
+        varying = speed is not None and np.std(speed) > ORDER_TRACKING_SPREAD * abs(np.mean(speed))
+        for name in MESH_CHANNELS:
+            if name not in ch:
+                continue
+            s = SHORT[name]
+            if (
+                varying
+                and "screw_angle" in ch
+                and np.all(np.diff(ch["screw_angle"]) * np.sign(np.mean(speed)) > 0)
+            ):
+                # order domain: mesh order = z·(carrier/screw) per screw radian
+                x, d_angle = _order_resample(ch[name], ch["screw_angle"])
+                orders, amp = amplitude_spectrum(x, 1.0 / d_angle)
+                base, side = (
+                    z * abs(ratios.carrier) / (2 * math.pi),
+                    abs(ratios.carrier) / (2 * math.pi),
+                )
+            else:
+                orders, amp = amplitude_spectrum(ch[name], rate)
+                base, side = z * f_c, f_c
+            for k in (1, 2, 3):
+                out[f"{s}_mesh_h{k}"] = _line(orders, amp, k * base)
+            out[f"{s}_mesh_sidebands"] = np.nansum(
+                [_line(orders, amp, base - side), _line(orders, amp, base + side)]
+            )
+
+    # ---- shifted axial frequency
+    if "nut_axial_accel" in ch:
+        x = ch["nut_axial_accel"]
+        f_dom = dominant_frequency(x, rate, (100.0, min(2000.0, 0.45 * rate)), min(512, len(x)))
+        out["axial_dominant_frequency"] = f_dom
+        nperseg = min(512, len(x))
+        f, psd = signal.welch(
+            x - np.mean(x), fs=rate, window="hann", nperseg=nperseg, noverlap=3 * nperseg // 4
+        )
+        band = (f > 0.9 * f_dom) & (f < 1.1 * f_dom)
+        out["axial_dominant_amplitude"] = (
+            float(np.sqrt(np.sum(psd[band]) * (f[1] - f[0]))) if band.any() else np.nan
+        )
+        mean_load = abs(out["load_mean"]) if np.isfinite(out["load_mean"]) else 100.0
+        if design.gear is not None:
+            f0 = axial_baseline_frequency(
+                design.name if design.name in _preset_names() else "paper01", round(mean_load, 1)
+            )
+            out["axial_baseline_frequency"] = f0
+            out["axial_frequency_shift"] = f_dom - f0
+            out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
+
+    # ---- torque
+    if "friction_torque" in ch:
+        out["friction_torque_mean"] = float(np.mean(ch["friction_torque"]))
+        out["friction_torque_ripple"] = float(np.std(ch["friction_torque"]))
+    if "drive_torque" in ch:
+        out["drive_torque_mean"] = float(np.mean(ch["drive_torque"]))
+        out["drive_torque_ripple"] = float(np.std(ch["drive_torque"]))
+        if speed is not None and load is not None and "nut_position" in ch:
+            p_in = float(np.mean(ch["drive_torque"] * speed))
+            v_nut = np.gradient(ch["nut_position"], run.time)
+            p_out = float(np.mean(load * v_nut))
+            out["efficiency"] = p_out / p_in if p_in > 0 else np.nan
+
+    # ---- lost motion at reversals: nut lag behind the rigid kinematics across a reversal
+    if "nut_position" in ch and "screw_angle" in ch:
+        reversal = (speed is not None and np.min(speed) < 0 < np.max(speed)) or (
+            load is not None and np.min(load) < 0 < np.max(load)
+        )
+        if reversal:
+            residual = ch["nut_position"] - ratios.nut * ch["screw_angle"]
+            residual = residual - np.mean(residual)
+            out["lost_motion"] = float(np.percentile(residual, 99) - np.percentile(residual, 1))
+    return out
+
+
+@lru_cache(maxsize=1)
+def _preset_names() -> frozenset:
+    from .design import PRESETS
+
+    return frozenset(PRESETS)
+
+
+def windows(run: Run, length: float, hop: float | None = None):
+    """Split a run into windows of ``length`` seconds (hop defaults to length), as Runs."""
+    n = int(round(length * run.sample_rate))
+    step = int(round((hop or length) * run.sample_rate))
+    if n < MIN_SAMPLES:
+        raise PRSMHealthError(
+            f"window length {length:g} s gives {n} samples, need at least {MIN_SAMPLES}"
+        )
+    for start in range(0, len(run) - n + 1, step):
+        sl = slice(start, start + n)
+        yield Run(
+            run.time[sl],
+            {k: v[sl] for k, v in run.channels.items()},
+            run.sample_rate,
+            run.labels,
+            run.scenario,
+        )
+
+
+def dataset_features(dataset, run_ids=None, progress: bool = False):
+    """Indicators of every run of a :class:`~prsm_health.dataset.Dataset` as a DataFrame.
+
+    Columns: :data:`FEATURES` plus the run labels (run_id, split, fault_class, clearances, …).
+    """
+    import pandas as pd
+
+    rows = []
+    ids = list(dataset.runs["run_id"] if run_ids is None else run_ids)
+    iterator = ids
+    if progress:
+        from tqdm import tqdm
+
+        iterator = tqdm(ids, unit="run", desc="features")
+    for run_id in iterator:
+        run = dataset.run(int(run_id))
+        row = extract_features(run)
+        row.update(run.labels)
+        rows.append(row)
+    return pd.DataFrame(rows)
