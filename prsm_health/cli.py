@@ -264,6 +264,52 @@ def _cmd_generate(args) -> int:
     return 0
 
 
+# ----------------------------------------------------------------------------- replay
+def _rate(text: str) -> float | None:
+    if text == "max":
+        return None
+    value = float(text)
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"{text!r}: use a positive real-time factor or 'max'")
+    return value
+
+
+def _cmd_replay(args) -> int:
+    import warnings
+
+    from .mcap_io import TruncatedRecordingWarning, iter_windows, window_statistics
+
+    caught: list[str] = []
+
+    def note(message, category, *rest):
+        caught.append(str(message))
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always", TruncatedRecordingWarning)
+        warnings.showwarning = note
+        windows = []
+        stream = iter_windows(args.file, args.window, rate=args.rate)
+        try:
+            for window in stream:
+                stats = window_statistics(window)
+                windows.append({"index": window.index, "start": window.start, "end": window.end, "statistics": stats})
+                if not args.json:
+                    ax = stats.get("nut_axial_accel", {})
+                    print(
+                        f"window {window.index:4d}  {window.start:8.3f}–{window.end:8.3f} s  "
+                        f"axial rms {ax.get('rms', float('nan')):.4g} m/s²  peak {ax.get('peak', float('nan')):.4g} m/s²"
+                    )
+        finally:
+            stream.close()
+    for message in caught:
+        print(f"warning: {message}", file=sys.stderr)
+    if args.json:
+        _print_json({"file": args.file, "window": args.window, "windows": windows, "warnings": caught})
+    elif not windows:
+        print("no complete window in the recording")
+    return 0
+
+
 # ----------------------------------------------------------------------------- simulate
 def _cmd_simulate(args) -> int:
     from pathlib import Path
@@ -276,8 +322,8 @@ def _cmd_simulate(args) -> int:
     from .states import HealthState, ManufacturingVariation, OperatingProfile
 
     out = Path(args.out)
-    if out.suffix not in (".parquet",):
-        raise PRSMHealthError(f"--out {out}: unsupported extension {out.suffix!r} (use .parquet)")
+    if out.suffix not in (".parquet", ".mcap"):
+        raise PRSMHealthError(f"--out {out}: unsupported extension {out.suffix!r} (use .parquet or .mcap)")
     if not out.parent.exists():
         raise PRSMHealthError(f"--out {out}: directory {out.parent} does not exist")
     design = preset(args.design)
@@ -308,7 +354,12 @@ def _cmd_simulate(args) -> int:
     run = simulate(
         design, health, profile, sensors, args.seed, options=options, progress=not args.json
     )
-    run.to_parquet(out)
+    if out.suffix == ".mcap":
+        from .mcap_io import write_mcap
+
+        write_mcap(run, out)
+    else:
+        run.to_parquet(out)
     mesh = characteristic_frequencies(design, args.speed).gear_mesh
     if args.plot:
         from .plots import plot_run
@@ -413,6 +464,13 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--json", action="store_true")
     g.set_defaults(func=_cmd_generate)
 
+    r = sub.add_parser("replay", help="stream an MCAP recording as fixed windows")
+    r.add_argument("file", help="MCAP recording")
+    r.add_argument("--window", type=_finite_float, default=1.0, help="window length [s]")
+    r.add_argument("--rate", type=_rate, default=None, help="real-time factor, or 'max' (default)")
+    r.add_argument("--json", action="store_true")
+    r.set_defaults(func=_cmd_replay)
+
     f = sub.add_parser("friction", help="friction torque and efficiency at start-up (paper 02)")
     f.add_argument("--load", type=_finite_float, required=True, help="output axial force [N]")
     f.add_argument("--speed", type=_finite_float, default=1.0, help="final screw speed [rad/s]")
@@ -459,7 +517,7 @@ def _add_simulate_parser(sub, default_preset, presets) -> None:
     s.add_argument("--max-step", type=_finite_float, default=5e-6, help="largest RK4 step [s]")
     s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
     s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--out", required=True, help="output file (.parquet)")
+    s.add_argument("--out", required=True, help="output file (.parquet or .mcap)")
     s.add_argument("--plot", default=None, help="PNG with time traces and spectra")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=_cmd_simulate)

@@ -163,3 +163,22 @@ def test_kinematics_recirculating_and_friction_json(capsys):
     data = json.loads(out)
     assert data["steady_friction_torque"] == pytest.approx(0.115, abs=1e-3)
     assert data["min_efficiency"] <= data["overall_efficiency"] <= data["steady_efficiency"] <= 1
+
+
+def test_simulate_mcap_and_replay(tmp_path, capsys):
+    out = tmp_path / "run.mcap"
+    code, _, _ = run(capsys, "simulate", "--duration", "0.2", "--out", str(out), "--json")
+    assert code == 0
+    from mcap.reader import make_reader
+
+    with open(out, "rb") as f:  # the independent reader sees both contract topics
+        topics = {c.topic for c in make_reader(f).get_summary().channels.values()}
+    assert {"/prsm/nut_accel", "/prsm/drive"} <= topics
+    code, stdout, _ = run(capsys, "replay", str(out), "--window", "0.05", "--json")
+    assert code == 0
+    windows = json.loads(stdout)["windows"]
+    assert len(windows) == 4 and windows[1]["start"] == pytest.approx(0.05)
+    truncated = tmp_path / "cut.mcap"
+    truncated.write_bytes(out.read_bytes()[:200])
+    code, _, err = run(capsys, "replay", str(truncated))
+    assert code == 2 and err.startswith("error: ") and len(err.strip().splitlines()) == 1

@@ -191,3 +191,15 @@ def test_shipped_recipes_parse():
     for name in ("demo.toml", "clearance-study.toml"):
         r = load_recipe(os.path.join(root, name))
         assert len(r.runs()) > 20
+
+
+def test_generate_both_formats(recipe_path, tmp_path):
+    from prsm_health.mcap_io import read_mcap
+
+    generate(recipe_path, tmp_path / "m", workers=1, formats="both", progress=False)
+    files = sorted((tmp_path / "m" / "mcap").glob("run-*.mcap"))
+    assert len(files) == 6
+    run = read_mcap(files[2])
+    assert run.labels["run_id"] == 2
+    stored = Dataset(tmp_path / "m").run(2)
+    assert np.allclose(run["nut_axial_accel"], stored["nut_axial_accel"], rtol=1e-6, atol=1e-9)
