@@ -277,36 +277,121 @@ def _rate(text: str) -> float | None:
 def _cmd_replay(args) -> int:
     import warnings
 
-    from .mcap_io import TruncatedRecordingWarning, iter_windows, window_statistics
+    from .mcap_io import DiagnosisWriter, TruncatedRecordingWarning, iter_windows, window_statistics
 
+    bundle = None
+    if not args.statistics_only:
+        from .diagnosis import load_bundle
+
+        bundle = load_bundle(args.model)
+    window_length = args.window or (bundle.window if bundle else 1.0)
     caught: list[str] = []
 
     def note(message, category, *rest):
         caught.append(str(message))
 
+    writer = DiagnosisWriter(args.file, args.out) if (args.out and bundle) else None
+    results = []
     with warnings.catch_warnings():
         warnings.simplefilter("always", TruncatedRecordingWarning)
         warnings.showwarning = note
-        windows = []
-        stream = iter_windows(args.file, args.window, rate=args.rate)
+        stream = iter_windows(args.file, window_length, rate=args.rate)
         try:
             for window in stream:
-                stats = window_statistics(window)
-                windows.append({"index": window.index, "start": window.start, "end": window.end, "statistics": stats})
+                entry = {"index": window.index, "start": window.start, "end": window.end}
+                if bundle is not None:
+                    entry["diagnosis"] = _diagnose_window(window, bundle)
+                    if writer is not None:
+                        writer.add(window.end_ns, entry["diagnosis"])
+                else:
+                    entry["statistics"] = window_statistics(window)
+                results.append(entry)
                 if not args.json:
-                    ax = stats.get("nut_axial_accel", {})
-                    print(
-                        f"window {window.index:4d}  {window.start:8.3f}–{window.end:8.3f} s  "
-                        f"axial rms {ax.get('rms', float('nan')):.4g} m/s²  peak {ax.get('peak', float('nan')):.4g} m/s²"
-                    )
+                    print(_replay_line(entry))
+        except BaseException:
+            if writer is not None:
+                writer.abort()
+            raise
         finally:
             stream.close()
+    if writer is not None:
+        writer.close()
     for message in caught:
         print(f"warning: {message}", file=sys.stderr)
     if args.json:
-        _print_json({"file": args.file, "window": args.window, "windows": windows, "warnings": caught})
-    elif not windows:
+        _print_json({"file": args.file, "window": window_length, "windows": results, "warnings": caught, "out": args.out})
+    elif not results:
         print("no complete window in the recording")
+    elif args.out and writer is not None:
+        print(f"wrote {args.out} with {len(results)} /prsm/diagnosis messages")
+    return 0
+
+
+def _diagnose_window(window, bundle) -> dict:
+    from .diagnosis import diagnose_indicators
+    from .features import extract_features
+    from .run import Run
+
+    run = Run(window.time, window.channels, window.sample_rate, window.labels)
+    return diagnose_indicators([extract_features(run, bundle.design)], bundle)[0]
+
+
+def _replay_line(entry) -> str:
+    head = f"window {entry['index']:4d}  {entry['start']:8.3f}–{entry['end']:8.3f} s  "
+    if "diagnosis" in entry:
+        d = entry["diagnosis"]
+        c = d["clearance"]
+        return head + f"{d['fault_class']:<12} clearance {_um(c['estimate'])} µm [{_um(c['lower'])}, {_um(c['upper'])}]"
+    ax = entry["statistics"].get("nut_axial_accel", {})
+    return head + f"axial rms {ax.get('rms', float('nan')):.4g} m/s²  peak {ax.get('peak', float('nan')):.4g} m/s²"
+
+
+def _um(value) -> str:
+    return "  –" if value is None else f"{1e6 * value:5.1f}"
+
+
+# ----------------------------------------------------------------------------- diagnose / train
+def _cmd_diagnose(args) -> int:
+    from .diagnosis import diagnose, load_bundle, plot_diagnosis, read_recording
+
+    bundle = load_bundle(args.model)
+    run = read_recording(args.file)
+    result = diagnose(run, bundle, window=args.window)
+    if args.plot:
+        plot_diagnosis(result, args.plot)
+    if args.json:
+        _print_json(result)
+        return 0
+    c = result["clearance"]
+    rows = [
+        ("file", args.file, ""),
+        ("fault class", result["fault_class"], ""),
+        ("clearance", f"{_um(c['estimate'])} [{_um(c['lower'])}, {_um(c['upper'])}]", "µm (90 % interval)"),
+    ]
+    rows += [(f"P({k})", v, "") for k, v in result["class_probabilities"].items()]
+    rows += [("windows", len(result["windows"]), ""), ("model", f"{result['model']['name']} v{result['model']['version']}", "")]
+    _print_table(rows)
+    return 0
+
+
+def _cmd_train(args) -> int:
+    from .training import train
+
+    metrics = train(args.dataset, args.out, target=args.target, cv=args.cv, progress=not args.json)
+    if args.json:
+        _print_json(metrics)
+        return 0
+    rows = [("model", metrics["model"]["path"], ""), ("metrics", metrics["metrics_path"], "")]
+    for key, label in (("clearance_cv", "clearance CV"), ("clearance_test", "clearance held-out")):
+        if key in metrics:
+            m = metrics[key]
+            rows.append((f"{label} MAE", 1e6 * m["mae"], "µm"))
+            rows.append((f"{label} 90 % interval coverage", m["interval_coverage"], ""))
+            rows.append((f"{label} mean interval width", 1e6 * m["mean_interval_width"], "µm"))
+    for key, label in (("fault_cv", "fault CV"), ("fault_test", "fault held-out")):
+        if key in metrics:
+            rows.append((f"{label} macro-F1", metrics[key]["macro_f1"], ""))
+    _print_table(rows)
     return 0
 
 
@@ -464,12 +549,31 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--json", action="store_true")
     g.set_defaults(func=_cmd_generate)
 
-    r = sub.add_parser("replay", help="stream an MCAP recording as fixed windows")
+    r = sub.add_parser("replay", help="stream an MCAP recording as windows through the diagnosis")
     r.add_argument("file", help="MCAP recording")
-    r.add_argument("--window", type=_finite_float, default=1.0, help="window length [s]")
+    r.add_argument("--window", type=_finite_float, default=None, help="window length [s] (default: the model's)")
     r.add_argument("--rate", type=_rate, default=None, help="real-time factor, or 'max' (default)")
+    r.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
+    r.add_argument("--out", default=None, help="copy of the recording with /prsm/diagnosis messages")
+    r.add_argument("--statistics-only", action="store_true", help="window statistics, no model")
     r.add_argument("--json", action="store_true")
     r.set_defaults(func=_cmd_replay)
+
+    d = sub.add_parser("diagnose", help="diagnose a recording (.mcap, .parquet or .csv)")
+    d.add_argument("file")
+    d.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
+    d.add_argument("--window", type=_finite_float, default=None, help="window length [s] (default: the model's)")
+    d.add_argument("--plot", default=None, help="PNG of the per-window estimates")
+    d.add_argument("--json", action="store_true")
+    d.set_defaults(func=_cmd_diagnose)
+
+    t = sub.add_parser("train", help="train the clearance estimator and fault classifier on a dataset")
+    t.add_argument("dataset", help="dataset directory (prsm-health generate)")
+    t.add_argument("--out", required=True, help="model file (.skops); metrics JSON beside it")
+    t.add_argument("--target", choices=("clearance", "fault", "both"), default="both")
+    t.add_argument("--cv", type=int, default=5, help="cross-validation folds")
+    t.add_argument("--json", action="store_true")
+    t.set_defaults(func=_cmd_train)
 
     f = sub.add_parser("friction", help="friction torque and efficiency at start-up (paper 02)")
     f.add_argument("--load", type=_finite_float, required=True, help="output axial force [N]")

@@ -53,6 +53,7 @@ SWEPT = {
     "clearance_gear": "m",
     "speed": "rad/s",
     "load": "N",
+    "load_amplitude": "N",
     "friction_scale": "-",
     "wear_spread": "-",
 }
@@ -196,7 +197,10 @@ class Recipe:
             if key not in sweep:
                 continue
             value = sweep[key]
-            if mode == "grid":
+            if mode == "grid" and isinstance(value, dict):
+                ok = set(value) == {"uniform"} and _is_range(value["uniform"])
+                check(ok, f"sweep.{key}", value, f"a drawn value must be {{uniform = [min, max]}} [{SWEPT[key]}]")
+            elif mode == "grid":
                 ok = (
                     isinstance(value, list)
                     and value
@@ -206,7 +210,7 @@ class Recipe:
                     ok,
                     f"sweep.{key}",
                     value,
-                    f"must be a non-empty list of numbers [{SWEPT[key]}] in grid mode",
+                    f"must be a non-empty list of numbers [{SWEPT[key]}], or {{uniform = [min, max]}}, in grid mode",
                 )
             else:
                 ok = (
@@ -253,11 +257,18 @@ class Recipe:
         n_total = len(points) * repeats
         test = _test_set(n_total, self.test_fraction, self.seed)
         run_id = 0
+        drawn = {k: v["uniform"] for k, v in self.sweep.items() if isinstance(v, dict)}
         for point in points:
             for _ in range(repeats):
                 seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
+                run_point = dict(point)
+                if drawn:
+                    # grid keys given as {uniform = [min, max]}: a fresh value for every run
+                    unit = np.random.default_rng([self.seed, run_id, 0x44524157]).random(len(drawn))
+                    for u, (k, (lo, hi)) in zip(unit, sorted(drawn.items())):
+                        run_point[k] = float(lo + u * (hi - lo))
                 specs.append(
-                    RunSpec(self, run_id, point, seed, "test" if run_id in test else "train")
+                    RunSpec(self, run_id, run_point, seed, "test" if run_id in test else "train")
                 )
                 run_id += 1
         return specs
@@ -266,6 +277,7 @@ class Recipe:
         keys = [k for k in SWEPT if k in self.sweep]
         mode = self.sweep.get("mode", "grid")
         if mode == "grid":
+            keys = [k for k in keys if not isinstance(self.sweep[k], dict)]
             values = [self.sweep[k] for k in keys]
             return [dict(zip(keys, combo)) for combo in itertools.product(*values)]
         n = self.sweep["samples"]
@@ -290,6 +302,15 @@ class Recipe:
         """Run ids grouped into the fixed batches that workers write as one shard each."""
         ids = list(range(len(self.runs())))
         return [ids[i : i + self.batch_size] for i in range(0, len(ids), self.batch_size)]
+
+
+def _is_range(value) -> bool:
+    return (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) for v in value)
+        and value[0] <= value[1]
+    )
 
 
 def _test_set(n: int, fraction: float, seed: int) -> set[int]:
@@ -328,7 +349,7 @@ class RunSpec:
                 duration=r.duration,
                 speed=p.get("speed", 100.0),
                 load=p.get("load", 100.0),
-                **r.profile,
+                **{**r.profile, **({"load_amplitude": p["load_amplitude"]} if "load_amplitude" in p else {})},
             )
             sensors = SensorModel(sample_rate=r.sample_rate, **r.sensors)
             options = dict(r.options)

@@ -1,0 +1,207 @@
+"""Training on a small dataset, diagnosis of recordings, the regime gate, bad input, the CLI."""
+
+import json
+import textwrap
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOptions, simulate
+from prsm_health.cli import main
+from prsm_health.dataset import generate
+from prsm_health.diagnosis import diagnose, load_bundle, read_recording
+from prsm_health.errors import PRSMHealthError
+from prsm_health.estimators import ModelVersionError
+from prsm_health.mcap_io import write_mcap
+from prsm_health.training import train
+
+RECIPE = textwrap.dedent(
+    """
+    name = "diag-test"
+    design = "paper01"
+    duration = 0.2
+    sample_rate = 20000
+    seed = 5
+    test_fraction = 0.2
+    [profile]
+    load_profile = "reversing"
+    load_amplitude = 300.0
+    load_frequency = 10.0
+    accel_time = 0.002
+    [options]
+    contact_law = "hertz"
+    [sweep]
+    clearance = [2e-6, 10e-6, 18e-6, 26e-6, 34e-6]
+    speed = [60.0, 100.0]
+    load = [0.0, 100.0]
+    friction_scale = [1.0, 2.2]
+    repeats = 1
+    """
+)
+
+REVERSING = dict(
+    load=0.0, load_profile="reversing", load_amplitude=300.0, load_frequency=10.0, accel_time=0.002
+)
+
+
+@pytest.fixture(scope="module")
+def model(tmp_path_factory):
+    root = tmp_path_factory.mktemp("diag")
+    recipe = root / "r.toml"
+    recipe.write_text(RECIPE)
+    generate(recipe, root / "ds", workers=2, progress=False)
+    metrics = train(root / "ds", root / "model.skops", cv=2, progress=False)
+    return root / "model.skops", metrics
+
+
+def recording(clearance, duration=0.4, seed=9, **profile):
+    return simulate(
+        "paper01",
+        HealthState.uniform(clearance),
+        OperatingProfile(duration=duration, **(profile or REVERSING)),
+        SensorModel(),
+        seed,
+        options=SimulationOptions(contact_law="hertz"),
+    )
+
+
+def test_training_writes_model_and_metrics(model):
+    path, metrics = model
+    assert path.exists() and path.with_name("model.metrics.json").exists()
+    stored = json.loads(path.with_name("model.metrics.json").read_text())
+    assert stored["clearance_test"]["mae"] == pytest.approx(metrics["clearance_test"]["mae"])
+    assert {"clearance_cv", "fault_cv", "clearance_importance", "fault_importance"} <= set(stored)
+    groups = {r["name"] for r in stored["clearance_importance"] if r["kind"] == "group"}
+    assert {"mesh", "axial_frequency", "lost_motion"} <= groups
+
+
+def test_diagnosis_contract_and_accuracy(model):
+    bundle = load_bundle(model[0])
+    result = diagnose(recording(26e-6), bundle)
+    assert set(result) >= {
+        "clearance",
+        "fault_class",
+        "class_probabilities",
+        "indicators",
+        "model",
+        "windows",
+    }
+    assert set(result["clearance"]) == {"estimate", "lower", "upper"}
+    assert sum(result["class_probabilities"].values()) == pytest.approx(1.0)
+    # a small training set (40 runs): still within 5 µm and inside its interval
+    c = result["clearance"]
+    assert c["estimate"] == pytest.approx(26e-6, abs=5e-6)
+    assert c["lower"] <= 26e-6 <= c["upper"]
+    assert result["fault_class"] == "wear"
+    assert result["model"]["name"] == "diag-test-model"
+    json.dumps(result)  # plain JSON (NaN indicators become null)
+
+
+def test_regime_gate_reports_the_trained_range_without_reversal(model):
+    bundle = load_bundle(model[0])
+    steady = diagnose(recording(26e-6, load=100.0), bundle)
+    assert steady["indicators"]["lost_motion"] is None
+    span = bundle.metadata["clearance_range"]
+    assert [steady["clearance"]["lower"], steady["clearance"]["upper"]] == pytest.approx(span)
+
+
+def test_sources_mcap_parquet_csv_agree(model, tmp_path):
+    run = recording(10e-6)
+    write_mcap(run, tmp_path / "r.mcap")
+    run.to_parquet(tmp_path / "r.parquet")
+    run.to_frame().to_csv(tmp_path / "r.csv", index=False)
+    bundle = load_bundle(model[0])
+    estimates = [
+        diagnose(read_recording(tmp_path / f"r.{ext}"), bundle)["clearance"]["estimate"]
+        for ext in ("mcap", "parquet", "csv")
+    ]
+    assert estimates[0] == pytest.approx(estimates[1], rel=1e-9)
+    assert estimates[2] == pytest.approx(estimates[1], rel=1e-6)  # CSV: 17-digit text
+
+
+def test_bad_inputs(model, tmp_path, capsys):
+    path = str(model[0])
+    run = recording(10e-6, duration=0.01)
+    run.to_parquet(tmp_path / "short.parquet")
+    pd.DataFrame({"time": np.arange(5000) / 2e4, "temperature": np.ones(5000)}).to_csv(
+        tmp_path / "nochan.csv", index=False
+    )
+    frame = recording(10e-6).to_frame()
+    frame.loc[100, "nut_axial_accel"] = np.nan
+    frame.to_csv(tmp_path / "nan.csv", index=False)
+    cases = [
+        (["diagnose", str(tmp_path / "short.parquet"), "--model", path], "too short"),
+        (["diagnose", str(tmp_path / "nochan.csv"), "--model", path], "no usable channels"),
+        (["diagnose", str(tmp_path / "nan.csv"), "--model", path], "NaN"),
+        (["diagnose", str(tmp_path / "missing.mcap"), "--model", path], "no such file"),
+        (
+            ["diagnose", str(tmp_path / "nochan.csv"), "--model", str(tmp_path / "nochan.csv")],
+            "model",
+        ),
+    ]
+    for argv, needle in cases:
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("error: ") and needle in err and len(err.strip().splitlines()) == 1, (
+            err
+        )
+
+
+def test_model_from_another_version(model, tmp_path, capsys, monkeypatch):
+    import prsm_health.estimators as est
+
+    monkeypatch.setattr(est, "_package_version", lambda: "9.9.0")
+    with pytest.raises(ModelVersionError):
+        load_bundle(model[0])
+    recording(10e-6).to_parquet(tmp_path / "r.parquet")
+    assert main(["diagnose", str(tmp_path / "r.parquet"), "--model", str(model[0])]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "9.9.0" in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_diagnose_plot_and_replay_with_diagnosis(model, tmp_path, capsys):
+    run = recording(18e-6, duration=0.6)
+    write_mcap(run, tmp_path / "r.mcap")
+    assert (
+        main(
+            [
+                "diagnose",
+                str(tmp_path / "r.mcap"),
+                "--model",
+                str(model[0]),
+                "--json",
+                "--plot",
+                str(tmp_path / "d.png"),
+            ]
+        )
+        == 0
+    )
+    result = json.loads(capsys.readouterr().out)
+    assert len(result["windows"]) == 3
+    assert (tmp_path / "d.png").read_bytes()[:4] == b"\x89PNG"
+    out = tmp_path / "diag.mcap"
+    assert (
+        main(
+            [
+                "replay",
+                str(tmp_path / "r.mcap"),
+                "--model",
+                str(model[0]),
+                "--out",
+                str(out),
+                "--json",
+            ]
+        )
+        == 0
+    )
+    replay = json.loads(capsys.readouterr().out)
+    assert len(replay["windows"]) == 3
+    from mcap.reader import make_reader
+
+    with open(out, "rb") as f:
+        messages = [
+            json.loads(m.data)
+            for _, c, m in make_reader(f).iter_messages(topics=["/prsm/diagnosis"])
+        ]
+    assert len(messages) == 3 and "clearance" in messages[0]
