@@ -102,11 +102,10 @@ GROUPS = {
 
 
 @lru_cache(maxsize=256)
-def axial_baseline_frequency(design_name: str, load: float) -> float:
+def axial_baseline_frequency(design: PRSMDesign, load: float) -> float:
     """Healthy nut axial frequency √(k_axial/m_N)/2π [Hz] at an axial load [N] (paper 04 stiffness)."""
     from .stiffness.thread import roller_side_stiffness
 
-    design = preset(design_name)
     per_roller = max(abs(load), 20.0) / design.n_rollers
     k_s = float(roller_side_stiffness(design, per_roller, "screw"))
     k_n = float(roller_side_stiffness(design, per_roller, "nut"))
@@ -253,9 +252,7 @@ def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[s
         )
         mean_load = abs(out["load_mean"]) if np.isfinite(out["load_mean"]) else 100.0
         if design.gear is not None:
-            f0 = axial_baseline_frequency(
-                design.name if design.name in _preset_names() else "paper01", round(mean_load, 1)
-            )
+            f0 = axial_baseline_frequency(design, round(mean_load, 1))
             out["axial_baseline_frequency"] = f0
             out["axial_frequency_shift"] = f_dom - f0
             out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
@@ -283,13 +280,6 @@ def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[s
             residual = residual - np.mean(residual)
             out["lost_motion"] = float(np.percentile(residual, 99) - np.percentile(residual, 1))
     return out
-
-
-@lru_cache(maxsize=1)
-def _preset_names() -> frozenset:
-    from .design import PRESETS
-
-    return frozenset(PRESETS)
 
 
 def windows(run: Run, length: float, hop: float | None = None):
