@@ -120,8 +120,17 @@ def _matrix(rows: list[dict], names: list[str]):
 
 def diagnose_indicators(rows: list[dict], bundle: ModelBundle) -> list[dict]:
     """Diagnosis contract dicts for rows of indicators (one per window)."""
+    from threadpoolctl import threadpool_limits
+
     x = _matrix(rows, bundle.feature_names)
     n = len(rows)
+    # A few rows per call: OpenMP threads in the boosted trees only add spin-wait latency, and
+    # under load (the service, parallel replays) oversubscribe the cores.
+    with threadpool_limits(limits=1, user_api="openmp"):
+        return _predict(rows, x, n, bundle)
+
+
+def _predict(rows: list[dict], x, n: int, bundle: ModelBundle) -> list[dict]:
     estimate = lower = upper = np.full(n, np.nan)
     if bundle.clearance is not None:
         estimate = np.asarray(bundle.clearance.predict(x), float)
