@@ -31,7 +31,16 @@ def clearance_target(table) -> np.ndarray:
 
 def operating_point(table) -> np.ndarray:
     """Group id of runs that share every swept value (repeats differ only by seed)."""
-    keys = ["clearance_screw", "clearance_nut", "clearance_gear", "screw_speed", "axial_load", "friction_scale", "wear_spread", "load_amplitude"]
+    keys = [
+        "clearance_screw",
+        "clearance_nut",
+        "clearance_gear",
+        "screw_speed",
+        "axial_load",
+        "friction_scale",
+        "wear_spread",
+        "load_amplitude",
+    ]
     keys = [k for k in keys if k in table]
     return table[keys].astype(str).agg("|".join, axis=1).to_numpy()
 
@@ -86,8 +95,31 @@ def train(
     cv : int
         Cross-validation folds on the train split.
     """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="openmp"):
+        return _train(
+            dataset_dir,
+            out,
+            target=target,
+            name=name,
+            cv=cv,
+            progress=progress,
+            random_state=random_state,
+        )
+
+
+def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dict:
+    # One OpenMP thread: a few hundred samples gain nothing from threads, and spin-waiting
+    # threads of two busy processes on 2 cores made training 50× slower (docs/performance.md).
     from .dataset import Dataset
-    from .estimators import ClearanceEstimator, FaultClassifier, cross_validated_metrics, permutation_importance_table, save_model
+    from .estimators import (
+        ClearanceEstimator,
+        FaultClassifier,
+        cross_validated_metrics,
+        permutation_importance_table,
+        save_model,
+    )
 
     require(target in TARGETS, "target", target, f"must be one of {', '.join(TARGETS)}")
     out = Path(out)
@@ -99,10 +131,16 @@ def train(
     train_rows = table[table["split"] == "train"]
     test_rows = table[table["split"] == "test"]
     if len(train_rows) < 10:
-        raise PRSMHealthError(f"{dataset_dir}: only {len(train_rows)} training runs; need at least 10")
+        raise PRSMHealthError(
+            f"{dataset_dir}: only {len(train_rows)} training runs; need at least 10"
+        )
     x_train, x_test = train_rows[features], test_rows[features]
     groups = operating_point(train_rows)
-    metrics: dict = {"dataset": str(dataset_dir), "recipe": ds.manifest["name"], "runs": {"train": len(train_rows), "test": len(test_rows)}}
+    metrics: dict = {
+        "dataset": str(dataset_dir),
+        "recipe": ds.manifest["name"],
+        "runs": {"train": len(train_rows), "test": len(test_rows)},
+    }
     bundle: dict = {"feature_names": features, "clearance": None, "fault": None}
 
     if target in ("clearance", "both"):
@@ -127,7 +165,9 @@ def train(
         if len(test_rows):
             y_test = clearance_target(test_rows)
             metrics["clearance_test"] = _interval_metrics(estimator, x_test, y_test)
-            importance = permutation_importance_table(estimator, x_test, y_test, n_repeats=5, random_state=random_state, groups=GROUPS)
+            importance = permutation_importance_table(
+                estimator, x_test, y_test, n_repeats=5, random_state=random_state, groups=GROUPS
+            )
             metrics["clearance_importance"] = _importance_records(importance)
         metrics["clearance_range"] = [float(y.min()), float(y.max())]
 
@@ -137,16 +177,24 @@ def train(
         def make_classifier():
             # 3 calibration folds × 100 iterations keep the shipped bundle under 5 MB
             return FaultClassifier(
-                min_samples_leaf=5, max_iter=100, learning_rate=0.1, calibration_cv=3, random_state=random_state
+                min_samples_leaf=5,
+                max_iter=100,
+                learning_rate=0.1,
+                calibration_cv=3,
+                random_state=random_state,
             )
 
-        metrics["fault_cv"] = cross_validated_metrics(make_classifier, x_train, labels, groups=groups, cv=cv)
+        metrics["fault_cv"] = cross_validated_metrics(
+            make_classifier, x_train, labels, groups=groups, cv=cv
+        )
         classifier = make_classifier().fit(x_train, labels)
         bundle["fault"] = classifier
         if len(test_rows):
             y_test = test_rows["fault_class"].astype(str).to_numpy()
             metrics["fault_test"] = _class_metrics(classifier, x_test, y_test)
-            importance = permutation_importance_table(classifier, x_test, y_test, n_repeats=5, random_state=random_state, groups=GROUPS)
+            importance = permutation_importance_table(
+                classifier, x_test, y_test, n_repeats=5, random_state=random_state, groups=GROUPS
+            )
             metrics["fault_importance"] = _importance_records(importance)
 
     metadata = {
@@ -155,13 +203,20 @@ def train(
         "design": ds.manifest["recipe"]["design"],
         "window": float(ds.manifest["duration"]),
         "sample_rate": float(ds.manifest["sample_rate"]),
-        "trained_on": {"dataset": str(dataset_dir), "recipe": ds.manifest["recipe"], "runs": metrics["runs"]},
+        "trained_on": {
+            "dataset": str(dataset_dir),
+            "recipe": ds.manifest["recipe"],
+            "runs": metrics["runs"],
+        },
         "clearance_range": metrics.get("clearance_range"),
         "observability_feature": OBSERVABILITY_FEATURE,
         "target": target,
     }
     save_model(out, bundle, metadata=metadata)
-    metrics["model"] = {"path": str(out), **{k: metadata[k] for k in ("name", "model_version", "window", "design")}}
+    metrics["model"] = {
+        "path": str(out),
+        **{k: metadata[k] for k in ("name", "model_version", "window", "design")},
+    }
     metrics_path = out.with_name(out.stem + ".metrics.json")
     metrics_path.write_text(json.dumps(metrics, indent=2, default=_plain))
     metrics["metrics_path"] = str(metrics_path)
