@@ -350,6 +350,14 @@ def _um(value) -> str:
     return "  –" if value is None else f"{1e6 * value:5.1f}"
 
 
+# ----------------------------------------------------------------------------- serve
+def _cmd_serve(args) -> int:
+    from .service import serve
+
+    serve(args.host, args.port, args.model, args.db, args.token)
+    return 0
+
+
 # ----------------------------------------------------------------------------- diagnose / train
 def _cmd_diagnose(args) -> int:
     from .diagnosis import diagnose, load_bundle, plot_diagnosis, read_recording
@@ -566,6 +574,14 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--plot", default=None, help="PNG of the per-window estimates")
     d.add_argument("--json", action="store_true")
     d.set_defaults(func=_cmd_diagnose)
+
+    v = sub.add_parser("serve", help="HTTP diagnostics service with asset health history")
+    v.add_argument("--host", default="127.0.0.1", help="bind address (non-loopback needs a token)")
+    v.add_argument("--port", type=int, default=8000)
+    v.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
+    v.add_argument("--db", default=None, help="SQLite history database (default: see docs/service.md)")
+    v.add_argument("--token", default=None, help="bearer token (or PRSM_HEALTH_TOKEN)")
+    v.set_defaults(func=_cmd_serve)
 
     t = sub.add_parser("train", help="train the clearance estimator and fault classifier on a dataset")
     t.add_argument("dataset", help="dataset directory (prsm-health generate)")

@@ -11,7 +11,6 @@ from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOp
 from prsm_health.cli import main
 from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle, read_recording
-from prsm_health.errors import PRSMHealthError
 from prsm_health.estimators import ModelVersionError
 from prsm_health.mcap_io import write_mcap
 from prsm_health.training import train
