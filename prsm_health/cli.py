@@ -352,9 +352,10 @@ def _um(value) -> str:
 
 # ----------------------------------------------------------------------------- serve
 def _cmd_serve(args) -> int:
-    from .service import serve
+    from .service import ServiceLimits, serve
 
-    serve(args.host, args.port, args.model, args.db, args.token)
+    limits = ServiceLimits(max_window_seconds=args.max_window, **({"workers": args.workers} if args.workers else {}))
+    serve(args.host, args.port, args.model, args.db, args.token, limits=limits, log_level=args.log_level)
     return 0
 
 
@@ -581,6 +582,9 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
     v.add_argument("--db", default=None, help="SQLite history database (default: see docs/service.md)")
     v.add_argument("--token", default=None, help="bearer token (or PRSM_HEALTH_TOKEN)")
+    v.add_argument("--workers", type=int, default=None, help="diagnoses computed at once")
+    v.add_argument("--max-window", type=_finite_float, default=2.0, help="longest JSON recording [s]")
+    v.add_argument("--log-level", default="info", choices=("critical", "error", "warning", "info", "debug"))
     v.set_defaults(func=_cmd_serve)
 
     t = sub.add_parser("train", help="train the clearance estimator and fault classifier on a dataset")
