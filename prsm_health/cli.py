@@ -354,8 +354,10 @@ def _um(value) -> str:
 def _cmd_serve(args) -> int:
     from .service import ServiceLimits, serve
 
-    limits = ServiceLimits(max_window_seconds=args.max_window, **({"workers": args.workers} if args.workers else {}))
-    serve(args.host, args.port, args.model, args.db, args.token, limits=limits, log_level=args.log_level)
+    overrides = {"max_window_seconds": args.max_window}
+    if args.workers is not None:  # 0 or negative: ServiceLimits refuses it by name
+        overrides["workers"] = args.workers
+    serve(args.host, args.port, args.model, args.db, args.token, limits=ServiceLimits(**overrides), log_level=args.log_level)
     return 0
 
 
