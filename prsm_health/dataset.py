@@ -36,7 +36,7 @@ import numpy as np
 from .design import PRESETS
 from .dynamics.layout import CHANNELS
 from .errors import ParameterError, PRSMHealthError, require
-from .run import UNITS, Run
+from .run import UNITS, Run, json_default
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -199,7 +199,12 @@ class Recipe:
             value = sweep[key]
             if mode == "grid" and isinstance(value, dict):
                 ok = set(value) == {"uniform"} and _is_range(value["uniform"])
-                check(ok, f"sweep.{key}", value, f"a drawn value must be {{uniform = [min, max]}} [{SWEPT[key]}]")
+                check(
+                    ok,
+                    f"sweep.{key}",
+                    value,
+                    f"a drawn value must be {{uniform = [min, max]}} [{SWEPT[key]}]",
+                )
             elif mode == "grid":
                 ok = (
                     isinstance(value, list)
@@ -349,7 +354,10 @@ class RunSpec:
                 duration=r.duration,
                 speed=p.get("speed", 100.0),
                 load=p.get("load", 100.0),
-                **{**r.profile, **({"load_amplitude": p["load_amplitude"]} if "load_amplitude" in p else {})},
+                **{
+                    **r.profile,
+                    **({"load_amplitude": p["load_amplitude"]} if "load_amplitude" in p else {}),
+                },
             )
             sensors = SensorModel(sample_rate=r.sample_rate, **r.sensors)
             options = dict(r.options)
@@ -678,16 +686,9 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
             },
         },
     }
-    _atomic_write(out / "manifest.json", json.dumps(manifest, indent=2, default=_plain))
+    _atomic_write(out / "manifest.json", json.dumps(manifest, indent=2, default=json_default))
 
 
-def _plain(value):
-    if isinstance(value, (np.integer, np.floating)):
-        return value.item()
-    raise TypeError(type(value).__name__)
-
-
-# ---------------------------------------------------------------------- reading
 class Dataset:
     """A generated dataset directory: labels table and per-run signals."""
 

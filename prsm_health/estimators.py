@@ -68,6 +68,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from .errors import ParameterError, PRSMHealthError, require, require_range
+from .run import json_default
 
 __all__ = [
     "ClearanceEstimator",
@@ -1002,16 +1003,6 @@ def _refused_types(payload: bytes) -> tuple[list[str], list[str]]:
     return untrusted, [t for t in untrusted if not _is_trusted(t)]
 
 
-def _json_default(value):
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, Path):
-        return str(value)
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
-
-
 def _bundle_bytes(model, header: dict) -> bytes:
     """skops payload of ``model`` with the JSON header as an extra zip member."""
     import skops.io as sio
@@ -1020,7 +1011,7 @@ def _bundle_bytes(model, header: dict) -> bytes:
     # skops ignores members it does not know, so the file stays loadable by skops itself;
     # the header is plain JSON, readable before anything is instantiated.
     with zipfile.ZipFile(buffer, "a", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(_HEADER_NAME, json.dumps(header, indent=1, default=_json_default))
+        zf.writestr(_HEADER_NAME, json.dumps(header, indent=1, default=json_default))
     return buffer.getvalue()
 
 
@@ -1079,7 +1070,7 @@ def save_model(path, model, *, metadata: dict) -> Path:
     reserved = [k for k in _RESERVED_METADATA if k in metadata]
     require(not reserved, "metadata", reserved, "keys 'versions' and 'saved_at' are reserved")
     try:
-        json.dumps(metadata, default=_json_default)
+        json.dumps(metadata, default=json_default)
     except (TypeError, ValueError) as err:
         raise ParameterError("metadata", "…", f"must be JSON-serialisable ({err})") from err
     header = {

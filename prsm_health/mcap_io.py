@@ -59,7 +59,7 @@ import numpy as np
 
 from .dynamics.layout import CHANNELS
 from .errors import PRSMHealthError
-from .run import UNITS, Run, json_default
+from .run import UNITS, Run, json_default, lookup_channel
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -1339,14 +1339,7 @@ class Window:
         return len(self.time)
 
     def __getitem__(self, name: str) -> np.ndarray:
-        if name == "time":
-            return self.time
-        try:
-            return self.channels[name]
-        except KeyError:
-            raise PRSMHealthError(
-                f"unknown channel {name!r}; available: time, {', '.join(self.channels)}"
-            ) from None
+        return lookup_channel(self.time, self.channels, name)
 
 
 class _TopicBuffer:

@@ -60,14 +60,7 @@ class Run:
     energy: dict = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
-        if name == "time":
-            return self.time
-        try:
-            return self.channels[name]
-        except KeyError:
-            raise PRSMHealthError(
-                f"unknown channel {name!r}; available: time, {', '.join(self.channels)}"
-            ) from None
+        return lookup_channel(self.time, self.channels, name)
 
     def __len__(self) -> int:
         return len(self.time)
@@ -133,10 +126,24 @@ class Run:
         return cls(time, channels, rate, labels, scenario)
 
 
+def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str) -> np.ndarray:
+    """``time`` or a named channel; an unknown name is a user error listing the available ones."""
+    if name == "time":
+        return time
+    try:
+        return channels[name]
+    except KeyError:
+        raise PRSMHealthError(
+            f"unknown channel {name!r}; available: time, {', '.join(channels)}"
+        ) from None
+
+
 def json_default(value):
-    """``json.dumps`` fallback for numpy arrays and scalars."""
+    """``json.dumps`` fallback for numpy arrays and scalars, and paths."""
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
         return value.item()
+    if isinstance(value, Path):
+        return str(value)
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")

@@ -17,6 +17,7 @@ import numpy as np
 
 from .errors import PRSMHealthError, require
 from .features import FEATURES, GROUPS, dataset_features
+from .run import json_default
 
 TARGETS = ("clearance", "fault", "both")
 #: Indicator whose absence means the window has no load/motion reversal, i.e. the clearance is
@@ -218,18 +219,10 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         **{k: metadata[k] for k in ("name", "model_version", "window", "design")},
     }
     metrics_path = out.with_name(out.stem + ".metrics.json")
-    metrics_path.write_text(json.dumps(metrics, indent=2, default=_plain))
+    metrics_path.write_text(json.dumps(metrics, indent=2, default=json_default))
     metrics["metrics_path"] = str(metrics_path)
     return metrics
 
 
 def _importance_records(frame) -> list[dict]:
     return json.loads(frame.to_json(orient="records"))
-
-
-def _plain(value):
-    if isinstance(value, (np.integer, np.floating)):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(type(value).__name__)
