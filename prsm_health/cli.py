@@ -8,7 +8,6 @@ one line ``error: …`` to stderr and exits with status 2.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
@@ -28,9 +27,9 @@ class _UsageError(Exception):
 
 
 def _print_json(obj) -> None:
-    from .run import json_default
+    from .jsonable import dumps
 
-    print(json.dumps(obj, indent=2, default=json_default))
+    print(dumps(obj, indent=2))
 
 
 def _print_table(rows: list[tuple[str, object, str]]) -> None:
@@ -319,7 +318,15 @@ def _cmd_replay(args) -> int:
     for message in caught:
         print(f"warning: {message}", file=sys.stderr)
     if args.json:
-        _print_json({"file": args.file, "window": window_length, "windows": results, "warnings": caught, "out": args.out})
+        _print_json(
+            {
+                "file": args.file,
+                "window": window_length,
+                "windows": results,
+                "warnings": caught,
+                "out": args.out,
+            }
+        )
     elif not results:
         print("no complete window in the recording")
     elif args.out and writer is not None:
@@ -341,9 +348,15 @@ def _replay_line(entry) -> str:
     if "diagnosis" in entry:
         d = entry["diagnosis"]
         c = d["clearance"]
-        return head + f"{d['fault_class']:<12} clearance {_um(c['estimate'])} µm [{_um(c['lower'])}, {_um(c['upper'])}]"
+        return (
+            head
+            + f"{d['fault_class']:<12} clearance {_um(c['estimate'])} µm [{_um(c['lower'])}, {_um(c['upper'])}]"
+        )
     ax = entry["statistics"].get("nut_axial_accel", {})
-    return head + f"axial rms {ax.get('rms', float('nan')):.4g} m/s²  peak {ax.get('peak', float('nan')):.4g} m/s²"
+    return (
+        head
+        + f"axial rms {ax.get('rms', float('nan')):.4g} m/s²  peak {ax.get('peak', float('nan')):.4g} m/s²"
+    )
 
 
 def _um(value) -> str:
@@ -357,7 +370,15 @@ def _cmd_serve(args) -> int:
     overrides = {"max_window_seconds": args.max_window}
     if args.workers is not None:  # 0 or negative: ServiceLimits refuses it by name
         overrides["workers"] = args.workers
-    serve(args.host, args.port, args.model, args.db, args.token, limits=ServiceLimits(**overrides), log_level=args.log_level)
+    serve(
+        args.host,
+        args.port,
+        args.model,
+        args.db,
+        args.token,
+        limits=ServiceLimits(**overrides),
+        log_level=args.log_level,
+    )
     return 0
 
 
@@ -377,10 +398,17 @@ def _cmd_diagnose(args) -> int:
     rows = [
         ("file", args.file, ""),
         ("fault class", result["fault_class"], ""),
-        ("clearance", f"{_um(c['estimate'])} [{_um(c['lower'])}, {_um(c['upper'])}]", "µm (90 % interval)"),
+        (
+            "clearance",
+            f"{_um(c['estimate'])} [{_um(c['lower'])}, {_um(c['upper'])}]",
+            "µm (90 % interval)",
+        ),
     ]
     rows += [(f"P({k})", v, "") for k, v in result["class_probabilities"].items()]
-    rows += [("windows", len(result["windows"]), ""), ("model", f"{result['model']['name']} v{result['model']['version']}", "")]
+    rows += [
+        ("windows", len(result["windows"]), ""),
+        ("model", f"{result['model']['name']} v{result['model']['version']}", ""),
+    ]
     _print_table(rows)
     return 0
 
@@ -419,7 +447,9 @@ def _cmd_simulate(args) -> int:
 
     out = Path(args.out)
     if out.suffix not in (".parquet", ".mcap"):
-        raise PRSMHealthError(f"--out {out}: unsupported extension {out.suffix!r} (use .parquet or .mcap)")
+        raise PRSMHealthError(
+            f"--out {out}: unsupported extension {out.suffix!r} (use .parquet or .mcap)"
+        )
     if not out.parent.exists():
         raise PRSMHealthError(f"--out {out}: directory {out.parent} does not exist")
     design = preset(args.design)
@@ -562,10 +592,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("replay", help="stream an MCAP recording as windows through the diagnosis")
     r.add_argument("file", help="MCAP recording")
-    r.add_argument("--window", type=_finite_float, default=None, help="window length [s] (default: the model's)")
+    r.add_argument(
+        "--window",
+        type=_finite_float,
+        default=None,
+        help="window length [s] (default: the model's)",
+    )
     r.add_argument("--rate", type=_rate, default=None, help="real-time factor, or 'max' (default)")
     r.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
-    r.add_argument("--out", default=None, help="copy of the recording with /prsm/diagnosis messages")
+    r.add_argument(
+        "--out", default=None, help="copy of the recording with /prsm/diagnosis messages"
+    )
     r.add_argument("--statistics-only", action="store_true", help="window statistics, no model")
     r.add_argument("--json", action="store_true")
     r.set_defaults(func=_cmd_replay)
@@ -573,7 +610,12 @@ def build_parser() -> argparse.ArgumentParser:
     d = sub.add_parser("diagnose", help="diagnose a recording (.mcap, .parquet or .csv)")
     d.add_argument("file")
     d.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
-    d.add_argument("--window", type=_finite_float, default=None, help="window length [s] (default: the model's)")
+    d.add_argument(
+        "--window",
+        type=_finite_float,
+        default=None,
+        help="window length [s] (default: the model's)",
+    )
     d.add_argument("--plot", default=None, help="PNG of the per-window estimates")
     d.add_argument("--json", action="store_true")
     d.set_defaults(func=_cmd_diagnose)
@@ -582,14 +624,22 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--host", default="127.0.0.1", help="bind address (non-loopback needs a token)")
     v.add_argument("--port", type=int, default=8000)
     v.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
-    v.add_argument("--db", default=None, help="SQLite history database (default: see docs/service.md)")
+    v.add_argument(
+        "--db", default=None, help="SQLite history database (default: see docs/service.md)"
+    )
     v.add_argument("--token", default=None, help="bearer token (or PRSM_HEALTH_TOKEN)")
     v.add_argument("--workers", type=int, default=None, help="diagnoses computed at once")
-    v.add_argument("--max-window", type=_finite_float, default=2.0, help="longest JSON recording [s]")
-    v.add_argument("--log-level", default="info", choices=("critical", "error", "warning", "info", "debug"))
+    v.add_argument(
+        "--max-window", type=_finite_float, default=2.0, help="longest JSON recording [s]"
+    )
+    v.add_argument(
+        "--log-level", default="info", choices=("critical", "error", "warning", "info", "debug")
+    )
     v.set_defaults(func=_cmd_serve)
 
-    t = sub.add_parser("train", help="train the clearance estimator and fault classifier on a dataset")
+    t = sub.add_parser(
+        "train", help="train the clearance estimator and fault classifier on a dataset"
+    )
     t.add_argument("dataset", help="dataset directory (prsm-health generate)")
     t.add_argument("--out", required=True, help="model file (.skops); metrics JSON beside it")
     t.add_argument("--target", choices=("clearance", "fault", "both"), default="both")

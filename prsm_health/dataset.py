@@ -33,10 +33,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .channels import CHANNEL_NAMES, UNITS
 from .design import PRESETS
-from .dynamics.layout import CHANNELS
-from .errors import ParameterError, PRSMHealthError, require
-from .run import UNITS, Run, json_default
+from .errors import ParameterError, PRSMHealthError, RecipeError, require
+from .jsonable import dumps
+from .run import Run
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -59,10 +60,6 @@ SWEPT = {
 }
 FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
 DEFAULT_BATCH = 8
-
-
-class RecipeError(PRSMHealthError):
-    """A recipe that cannot be used (names the key)."""
 
 
 @dataclass(frozen=True)
@@ -447,7 +444,7 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
             "run_id": pa.array(np.full(len(run), run_id, np.int32)),
             "time": pa.array(run.time),
         }
-        for name in CHANNELS:
+        for name in CHANNEL_NAMES:
             columns[name] = pa.array(run.channels[name].astype(dtype))
         tables.append(pa.table(columns))
         labels.append(label)
@@ -471,7 +468,7 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
 
 def _schema_metadata(recipe: Recipe) -> dict:
     return {
-        b"prsm_health.units": json.dumps({k: UNITS[k] for k in ("time", *CHANNELS)}).encode(),
+        b"prsm_health.units": json.dumps({k: UNITS[k] for k in ("time", *CHANNEL_NAMES)}).encode(),
         b"prsm_health.sample_rate": repr(float(recipe.sample_rate)).encode(),
         b"prsm_health.recipe": recipe.name.encode(),
     }
@@ -665,7 +662,7 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
         "package": {"name": "prsm_health", "version": __version__},
         "sample_rate": recipe.sample_rate,
         "duration": recipe.duration,
-        "channels": {k: UNITS[k] for k in ("time", *CHANNELS)},
+        "channels": {k: UNITS[k] for k in ("time", *CHANNEL_NAMES)},
         "dtype": recipe.dtype,
         "formats": formats,
         "fault_taxonomy": {
@@ -686,7 +683,7 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
             },
         },
     }
-    _atomic_write(out / "manifest.json", json.dumps(manifest, indent=2, default=json_default))
+    _atomic_write(out / "manifest.json", dumps(manifest, indent=2))
 
 
 class Dataset:
@@ -721,7 +718,7 @@ class Dataset:
             raise PRSMHealthError(f"run_id {run_id} is not in {self.path}")
         row = rows.iloc[0]
         table = pq.ParquetFile(self.path / row["shard"]).read_row_group(int(row["row_group"]))
-        channels = {name: table.column(name).to_numpy().astype(float) for name in CHANNELS}
+        channels = {name: table.column(name).to_numpy().astype(float) for name in CHANNEL_NAMES}
         labels = {
             k: (v.item() if hasattr(v, "item") else v)
             for k, v in row.items()

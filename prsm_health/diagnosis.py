@@ -44,7 +44,9 @@ class ModelBundle:
 
     @property
     def version(self) -> str:
-        return str(self.metadata.get("model_version", self.metadata.get("prsm_health_version", "?")))
+        return str(
+            self.metadata.get("model_version", self.metadata.get("prsm_health_version", "?"))
+        )
 
     @property
     def window(self) -> float:
@@ -56,7 +58,9 @@ class ModelBundle:
         return self.metadata.get("design", "paper01")
 
 
-def load_bundle(path: str | Path | None = None, *, allow_version_mismatch: bool = False) -> ModelBundle:
+def load_bundle(
+    path: str | Path | None = None, *, allow_version_mismatch: bool = False
+) -> ModelBundle:
     """Load a model bundle (default: the shipped model); version checks in estimators.load_model."""
     from .estimators import load_model
 
@@ -67,7 +71,9 @@ def load_bundle(path: str | Path | None = None, *, allow_version_mismatch: bool 
     model, metadata = load_model(path, allow_version_mismatch=allow_version_mismatch)
     if not isinstance(model, dict) or "feature_names" not in model:
         raise PRSMHealthError(f"{path}: not a prsm_health diagnosis bundle")
-    return ModelBundle(model.get("clearance"), model.get("fault"), list(model["feature_names"]), metadata)
+    return ModelBundle(
+        model.get("clearance"), model.get("fault"), list(model["feature_names"]), metadata
+    )
 
 
 def read_recording(path: str | Path) -> Run:
@@ -90,7 +96,7 @@ def read_recording(path: str | Path) -> Run:
 def _read_csv(path: Path) -> Run:
     import pandas as pd
 
-    from .dynamics.layout import CHANNELS
+    from .channels import CHANNEL_NAMES
 
     try:
         frame = pd.read_csv(path)
@@ -98,9 +104,11 @@ def _read_csv(path: Path) -> Run:
         raise PRSMHealthError(f"{path}: not a readable CSV ({exc})") from None
     if "time" not in frame.columns:
         raise PRSMHealthError(f"{path}: no 'time' column")
-    channels = {c: frame[c].to_numpy(float) for c in CHANNELS if c in frame.columns}
+    channels = {c: frame[c].to_numpy(float) for c in CHANNEL_NAMES if c in frame.columns}
     if not channels:
-        raise PRSMHealthError(f"{path}: no usable channels (expected contract names such as nut_axial_accel)")
+        raise PRSMHealthError(
+            f"{path}: no usable channels (expected contract names such as nut_axial_accel)"
+        )
     time = frame["time"].to_numpy(float)
     if len(time) < 2 or not np.all(np.diff(time) > 0):
         raise PRSMHealthError(f"{path}: 'time' must increase strictly")
@@ -109,13 +117,17 @@ def _read_csv(path: Path) -> Run:
 
 
 def _clean(value):
-    return None if value is None or (isinstance(value, float) and not math.isfinite(value)) else value
+    return (
+        None if value is None or (isinstance(value, float) and not math.isfinite(value)) else value
+    )
 
 
 def _matrix(rows: list[dict], names: list[str]):
     import pandas as pd
 
-    return pd.DataFrame([[r.get(n, np.nan) for n in names] for r in rows], columns=names, dtype=float)
+    return pd.DataFrame(
+        [[r.get(n, np.nan) for n in names] for r in rows], columns=names, dtype=float
+    )
 
 
 def diagnose_indicators(rows: list[dict], bundle: ModelBundle) -> list[dict]:
@@ -153,7 +165,11 @@ def _predict(rows: list[dict], x, n: int, bundle: ModelBundle) -> list[dict]:
         probabilities = {c: float(p) for c, p in zip(classes, proba[i])} if classes else {}
         out.append(
             {
-                "clearance": {"estimate": _clean(float(estimate[i])), "lower": _clean(float(lower[i])), "upper": _clean(float(upper[i]))},
+                "clearance": {
+                    "estimate": _clean(float(estimate[i])),
+                    "lower": _clean(float(lower[i])),
+                    "upper": _clean(float(upper[i])),
+                },
                 "fault_class": max(probabilities, key=probabilities.get) if probabilities else None,
                 "class_probabilities": probabilities,
                 "indicators": {k: _clean(float(v)) for k, v in row.items()},
@@ -177,7 +193,10 @@ def aggregate(diagnoses: list[dict], bundle: ModelBundle) -> dict:
             probs[c] = probs.get(c, 0.0) + p / len(diagnoses)
     names = diagnoses[0]["indicators"].keys()
     return {
-        "clearance": {k: median([d["clearance"][k] for d in diagnoses]) for k in ("estimate", "lower", "upper")},
+        "clearance": {
+            k: median([d["clearance"][k] for d in diagnoses])
+            for k in ("estimate", "lower", "upper")
+        },
         "fault_class": max(probs, key=probs.get) if probs else None,
         "class_probabilities": probs,
         "indicators": {n: median([d["indicators"][n] for d in diagnoses]) for n in names},
@@ -222,9 +241,27 @@ def plot_diagnosis(result: dict, path: str | Path) -> Path:
 
     w = result["windows"]
     t = [d["window"]["start"] for d in w]
-    est = np.array([np.nan if d["clearance"]["estimate"] is None else d["clearance"]["estimate"] for d in w]) * 1e6
-    lo = np.array([np.nan if d["clearance"]["lower"] is None else d["clearance"]["lower"] for d in w]) * 1e6
-    hi = np.array([np.nan if d["clearance"]["upper"] is None else d["clearance"]["upper"] for d in w]) * 1e6
+    est = (
+        np.array(
+            [
+                np.nan if d["clearance"]["estimate"] is None else d["clearance"]["estimate"]
+                for d in w
+            ]
+        )
+        * 1e6
+    )
+    lo = (
+        np.array(
+            [np.nan if d["clearance"]["lower"] is None else d["clearance"]["lower"] for d in w]
+        )
+        * 1e6
+    )
+    hi = (
+        np.array(
+            [np.nan if d["clearance"]["upper"] is None else d["clearance"]["upper"] for d in w]
+        )
+        * 1e6
+    )
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     a1.fill_between(t, lo, hi, step="post", alpha=0.3, label="90 % interval")
     a1.step(t, est, where="post", label="estimate")

@@ -24,6 +24,34 @@ class ParameterError(PRSMHealthError, ValueError):
         super().__init__(f"{field} = {_fmt(value)} is invalid: {allowed}")
 
 
+class RecipeError(PRSMHealthError):
+    """A dataset recipe that cannot be used (the message names the key)."""
+
+
+class SimulationError(PRSMHealthError):
+    """The integration cannot proceed (unstable step, non-finite state)."""
+
+
+class ConvergenceError(PRSMHealthError):
+    """An iterative solver (Newton, ODE integration) did not converge for these inputs."""
+
+
+class RecordingError(PRSMHealthError):
+    """A recording that cannot be processed: too short, non-finite samples, bad time axis."""
+
+
+class RecordingTooLongError(RecordingError):
+    """A recording longer than the caller accepts (the service's size limits)."""
+
+
+class ModelVersionError(PRSMHealthError):
+    """A saved model from another, incompatible package or library version."""
+
+
+class TruncatedRecordingWarning(UserWarning):
+    """A recording ended early or was damaged; what preceded the damage was read."""
+
+
 def _fmt(value) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"

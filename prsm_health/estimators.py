@@ -67,8 +67,8 @@ from sklearn.utils.class_weight import compute_sample_weight
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from .errors import ParameterError, PRSMHealthError, require, require_range
-from .run import json_default
+from .errors import ModelVersionError, ParameterError, PRSMHealthError, require, require_range
+from .jsonable import json_ready
 
 __all__ = [
     "ClearanceEstimator",
@@ -930,10 +930,6 @@ def cross_validated_metrics(
 # --------------------------------------------------------------------------------------------
 
 
-class ModelVersionError(PRSMHealthError):
-    """A model file was saved by another prsm_health or scikit-learn major.minor version."""
-
-
 _HEADER_NAME = "prsm_health.json"
 _FORMAT = "prsm_health-model"
 _FORMAT_VERSION = 1
@@ -1011,7 +1007,7 @@ def _bundle_bytes(model, header: dict) -> bytes:
     # skops ignores members it does not know, so the file stays loadable by skops itself;
     # the header is plain JSON, readable before anything is instantiated.
     with zipfile.ZipFile(buffer, "a", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(_HEADER_NAME, json.dumps(header, indent=1, default=json_default))
+        zf.writestr(_HEADER_NAME, json.dumps(json_ready(header), indent=1))
     return buffer.getvalue()
 
 
@@ -1070,7 +1066,7 @@ def save_model(path, model, *, metadata: dict) -> Path:
     reserved = [k for k in _RESERVED_METADATA if k in metadata]
     require(not reserved, "metadata", reserved, "keys 'versions' and 'saved_at' are reserved")
     try:
-        json.dumps(metadata, default=json_default)
+        json.dumps(json_ready(metadata))
     except (TypeError, ValueError) as err:
         raise ParameterError("metadata", "…", f"must be JSON-serialisable ({err})") from err
     header = {

@@ -31,13 +31,13 @@ from functools import lru_cache
 import numpy as np
 from scipy import signal, stats
 
+from .channels import VIBRATION
 from .design import PRSMDesign, preset
 from .errors import PRSMHealthError
 from .kinematics import speed_ratios
 from .run import Run
 from .spectra import amplitude_spectrum, dominant_frequency
 
-VIBRATION = ("nut_axial_accel", "nut_tangential_accel", "nut_radial_x_accel", "nut_radial_y_accel")
 SHORT = {
     "nut_axial_accel": "ax",
     "nut_tangential_accel": "tan",

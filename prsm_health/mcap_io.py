@@ -57,9 +57,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .dynamics.layout import CHANNELS
-from .errors import PRSMHealthError
-from .run import UNITS, Run, json_default, lookup_channel
+from .channels import CHANNEL_NAMES, UNITS
+from .errors import PRSMHealthError, TruncatedRecordingWarning
+from .jsonable import json_ready
+from .run import Run, lookup_channel
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -125,10 +126,6 @@ _MEANINGS = {
     "friction_torque": "friction part of the drive torque",
     "axial_load": "external axial load on the nut",
 }
-
-
-class TruncatedRecordingWarning(UserWarning):
-    """A recording is truncated or damaged; the samples before the damage were read."""
 
 
 # ============================================================================ low-level writer
@@ -581,7 +578,7 @@ def _metadata_value(value) -> str:
             json.loads(value)
         except ValueError:
             return value
-    return json.dumps(value, default=json_default)
+    return json.dumps(json_ready(value))
 
 
 def _decode_metadata_value(text: str):
@@ -650,7 +647,7 @@ def write_mcap(
     if float(time[-1]) * 1e9 + start_time_ns >= 2**63 or float(time[0]) * 1e9 + start_time_ns < 0:
         raise PRSMHealthError("start_time_ns + time does not fit the MCAP 64-bit ns clock")
     for name, values in run.channels.items():
-        if name in CHANNELS and np.shape(values) != (n,):
+        if name in CHANNEL_NAMES and np.shape(values) != (n,):
             raise PRSMHealthError(
                 f"channel {name!r} has shape {np.shape(values)}; expected ({n},) like time"
             )
@@ -661,7 +658,7 @@ def write_mcap(
             topics[topic] = present
     if not topics:
         raise PRSMHealthError(
-            f"run has none of the contract channels ({', '.join(CHANNELS)}); nothing to write"
+            f"run has none of the contract channels ({', '.join(CHANNEL_NAMES)}); nothing to write"
         )
 
     log_time = start_time_ns + _to_ns(time)
@@ -676,10 +673,10 @@ def write_mcap(
             "sample_rate": repr(float(rate)),
             "start_time_ns": str(int(start_time_ns)),
             "scenario_attachment": scenario_name,
-            "units": json.dumps({k: UNITS[k] for k in ("time", *CHANNELS) if k in UNITS}),
-            "energy": json.dumps(run.energy, default=json_default),
+            "units": json.dumps({k: UNITS[k] for k in ("time", *CHANNEL_NAMES) if k in UNITS}),
+            "energy": json.dumps(json_ready(run.energy)),
         }
-        scenario = json.dumps(run.scenario, default=json_default, indent=1).encode()
+        scenario = json.dumps(json_ready(run.scenario), indent=1).encode()
         labels = {str(k): _metadata_value(v) for k, v in run.labels.items()}
     except (TypeError, ValueError) as exc:
         raise PRSMHealthError(
@@ -1199,7 +1196,7 @@ def _align(batches: dict[str, _Batch], *, trim: bool) -> tuple[np.ndarray, dict[
             placed[:, np.searchsorted(grid, batch.log_time[keep])] = batch.values[:, keep]
         for row, name in enumerate(batch.fields):
             channels[names[name]] = np.ascontiguousarray(placed[row])
-    ordered = {name: channels[name] for name in CHANNELS if name in channels}
+    ordered = {name: channels[name] for name in CHANNEL_NAMES if name in channels}
     return grid, ordered
 
 

@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .run import UNITS, Run
+from .channels import UNITS
+from .run import Run
 from .spectra import amplitude_spectrum
 
 

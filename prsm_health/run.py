@@ -1,8 +1,9 @@
 """A simulated or recorded run: time, contract channels, labels, and its single-file Parquet form.
 
-Channel names and units follow the signal-channel contract of ../shared/DESIGN.md. A single run
-written to ``.parquet`` has the columns ``time`` and every channel, with the units, sample rate,
-labels and scenario in the Parquet schema metadata, so pandas/pyarrow/duckdb read it as is.
+Channel names and units follow the signal-channel contract (:mod:`prsm_health.channels`). A
+single run written to ``.parquet`` has the columns ``time`` and every channel, with the units,
+sample rate, labels and scenario in the Parquet schema metadata, so pandas/pyarrow/duckdb read it
+as is. :meth:`Run.validate` is the one place that decides whether a recording can be processed.
 """
 
 from __future__ import annotations
@@ -13,24 +14,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .dynamics.layout import CHANNELS
-from .errors import PRSMHealthError
+from .channels import CHANNEL_NAMES, UNITS
+from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
+from .jsonable import dumps
 
-#: SI unit of every channel (contract).
-UNITS = {
-    "time": "s",
-    "screw_angle": "rad",
-    "screw_speed": "rad/s",
-    "carrier_speed": "rad/s",
-    "nut_position": "m",
-    "nut_axial_accel": "m/s^2",
-    "nut_tangential_accel": "m/s^2",
-    "nut_radial_x_accel": "m/s^2",
-    "nut_radial_y_accel": "m/s^2",
-    "drive_torque": "N*m",
-    "friction_torque": "N*m",
-    "axial_load": "N",
-}
+#: Fewest samples a recording or window needs: below it the spectra have too few bins for the
+#: indicators (a 256-point Welch segment).
+MIN_SAMPLES = 256
 
 
 @dataclass
@@ -65,12 +55,82 @@ class Run:
     def __len__(self) -> int:
         return len(self.time)
 
+    @property
+    def duration(self) -> float:
+        """Time from the first to the last sample [s]."""
+        return float(self.time[-1] - self.time[0]) if len(self.time) else 0.0
+
+    def validate(
+        self,
+        *,
+        min_samples: int = MIN_SAMPLES,
+        max_samples: int | None = None,
+        max_abs: float | None = None,
+        what: str = "recording",
+    ) -> Run:
+        """Check that the recording can be processed; returns self.
+
+        Parameters
+        ----------
+        min_samples, max_samples : int
+            Accepted length [samples].
+        max_abs : float or None
+            Largest accepted magnitude of a sample (SI) and of the time axis [s]; beyond it the
+            indicators overflow. None: no bound.
+        what : str
+            How the messages name the recording.
+
+        Raises
+        ------
+        RecordingError
+            Too short, no channel, non-finite or non-increasing time, a channel of another
+            length, non-finite or out-of-range samples.
+        RecordingTooLongError
+            More than ``max_samples`` samples.
+        """
+        n, rate = len(self), float(self.sample_rate)
+        if not (np.isfinite(rate) and rate > 0):
+            raise RecordingError(f"{what}: sample rate {rate:g} Hz must be finite and > 0")
+        if not self.channels:
+            raise RecordingError(f"{what}: no contract channel ({', '.join(CHANNEL_NAMES)})")
+        if n < min_samples:
+            raise RecordingError(
+                f"{what} too short: {n} samples, need at least {min_samples} "
+                f"({min_samples / rate:.3g} s at {rate:g} Hz){ms_hint(rate)}"
+            )
+        if max_samples is not None and n > max_samples:
+            raise RecordingTooLongError(
+                f"{what} too long: {n} samples ({n / rate:.6g} s at {rate:g} Hz); "
+                f"at most {max_samples} samples accepted here"
+            )
+        time = np.asarray(self.time, dtype=float)
+        if not (np.all(np.isfinite(time)) and np.all(np.diff(time) > 0)):
+            raise RecordingError(f"{what}: time must be finite and strictly increasing")
+        if max_abs is not None and float(np.max(np.abs(time))) > max_abs:
+            raise RecordingError(
+                f"{what}: time beyond ±{max_abs:g} s (use time from the recording start)"
+            )
+        for name, values in self.channels.items():
+            values = np.asarray(values, dtype=float)
+            if len(values) != n:
+                raise RecordingError(
+                    f"{what}: channel {name} has {len(values)} samples, time has {n}"
+                )
+            if not np.all(np.isfinite(values)):
+                raise RecordingError(f"{what}: channel {name} contains NaN or infinite values")
+            if max_abs is not None and values.size and float(np.max(np.abs(values))) > max_abs:
+                raise RecordingError(
+                    f"{what}: channel {name} has samples beyond ±{max_abs:g} "
+                    "(SI units expected: m, rad, N, N·m, m/s²)"
+                )
+        return self
+
     def to_frame(self):
         """pandas DataFrame with ``time`` and the channels in contract order."""
         import pandas as pd
 
         data = {"time": self.time}
-        data.update({name: self.channels[name] for name in CHANNELS if name in self.channels})
+        data.update({name: self.channels[name] for name in CHANNEL_NAMES if name in self.channels})
         return pd.DataFrame(data)
 
     def to_parquet(self, path: str | Path) -> Path:
@@ -83,8 +143,8 @@ class Run:
         meta = {
             b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
             b"prsm_health.sample_rate": repr(float(self.sample_rate)).encode(),
-            b"prsm_health.labels": json.dumps(self.labels, default=json_default).encode(),
-            b"prsm_health.scenario": json.dumps(self.scenario, default=json_default).encode(),
+            b"prsm_health.labels": dumps(self.labels).encode(),
+            b"prsm_health.scenario": dumps(self.scenario).encode(),
         }
         table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
         tmp = path.with_name(path.name + ".partial")
@@ -109,7 +169,7 @@ class Run:
             raise PRSMHealthError(f"{path}: no 'time' column")
         channels = {
             name: table.column(name).to_numpy().astype(float)
-            for name in CHANNELS
+            for name in CHANNEL_NAMES
             if name in table.column_names
         }
         if not channels:
@@ -138,12 +198,12 @@ def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str)
         ) from None
 
 
-def json_default(value):
-    """``json.dumps`` fallback for numpy arrays and scalars, and paths."""
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return str(value)
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+def ms_hint(rate: float) -> str:
+    """'; is time in ms?' when a sample rate is implausibly low for a vibration recording but
+    plausible × 1000 (20 kHz sampled, time written in ms, reads as 20 Hz)."""
+    if 1.0 <= rate < 100.0:
+        return (
+            f" — the time axis gives {rate:g} Hz; if time is in milliseconds, convert it to "
+            f"seconds ({1000 * rate:g} Hz)"
+        )
+    return ""

@@ -20,14 +20,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import signal
 
+from .channels import VIBRATION as ACCEL_CHANNELS
 from .errors import require, require_positive, require_range
 
-ACCEL_CHANNELS = (
-    "nut_axial_accel",
-    "nut_tangential_accel",
-    "nut_radial_x_accel",
-    "nut_radial_y_accel",
-)
 TORQUE_CHANNELS = ("drive_torque", "friction_torque")
 
 

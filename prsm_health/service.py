@@ -44,8 +44,8 @@ from typing import Annotated, Literal
 
 import numpy as np
 
+from .channels import CHANNEL_NAMES
 from .design import PRESETS
-from .dynamics.layout import CHANNELS
 from .errors import PRSMHealthError
 from .features import MIN_SAMPLES
 
@@ -377,7 +377,7 @@ def _models(limits: "ServiceLimits"):
         "Channels",
         __config__=ConfigDict(strict=True, extra="forbid"),
         __doc__="Contract channels (docs/formats.md): equal-length arrays, SI units.",
-        **{name: (samples, Field(None)) for name in CHANNELS},
+        **{name: (samples, Field(None)) for name in CHANNEL_NAMES},
     )
 
     class DiagnoseRequest(BaseModel):
@@ -519,7 +519,7 @@ def _format_errors(errors: list[dict], prefix: str = "") -> str:
     parts = []
     if unknown_channels:
         names = ", ".join(repr(n) for n in unknown_channels)
-        parts.append(f"unknown channel(s) {names}; contract channels: {', '.join(CHANNELS)}")
+        parts.append(f"unknown channel(s) {names}; contract channels: {', '.join(CHANNEL_NAMES)}")
     others = [
         e for e in errors if not (e["type"] == "extra_forbidden" and e["loc"][:1] == ("channels",))
     ]
@@ -636,7 +636,7 @@ def _precheck_upload(path: Path, suffix: str, limits: ServiceLimits) -> None:
         except Exception:
             return  # not readable: the library's reader reports it with its own message
         decoded = sum(meta.row_group(i).total_byte_size for i in range(meta.num_row_groups))
-        if meta.num_columns > 4 * len(CHANNELS):
+        if meta.num_columns > 4 * len(CHANNEL_NAMES):
             raise _HTTPError(
                 422, f"Parquet file has {meta.num_columns} columns; a recording has time + channels"
             )
@@ -988,7 +988,7 @@ def create_app(
         try:
             rate = float(bundle.metadata.get("sample_rate") or 20000.0)
             n = max(MIN_SAMPLES, int(round(bundle.window * rate)))
-            blank = {name: np.zeros(n) for name in CHANNELS}
+            blank = {name: np.zeros(n) for name in CHANNEL_NAMES}
             diagnose(Run(np.arange(n) / rate, blank, rate), bundle)
         except Exception:  # warm-up is an optimisation; a failure shows on the first request
             log.warning("warm-up diagnosis failed", exc_info=True)
@@ -1088,7 +1088,7 @@ def create_app(
             )
 
     def run_from_request(req) -> Run:
-        given = {name: getattr(req.channels, name) for name in CHANNELS}
+        given = {name: getattr(req.channels, name) for name in CHANNEL_NAMES}
         channels = {
             name: np.asarray(values, dtype=float)
             for name, values in given.items()
@@ -1096,7 +1096,7 @@ def create_app(
         }
         if not channels:
             raise _HTTPError(
-                422, f"channels: give at least one contract channel ({', '.join(CHANNELS)})"
+                422, f"channels: give at least one contract channel ({', '.join(CHANNEL_NAMES)})"
             )
         lengths = {name: len(v) for name, v in channels.items()}
         if len(set(lengths.values())) > 1:
@@ -1181,7 +1181,7 @@ def create_app(
             "samples": len(run),
             "sample_rate": float(run.sample_rate),
             "duration": float(len(run) / run.sample_rate),
-            "channels": [c for c in CHANNELS if c in run.channels],
+            "channels": [c for c in CHANNEL_NAMES if c in run.channels],
         }
         answer = {
             "diagnosis": result,

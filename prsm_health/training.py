@@ -17,7 +17,7 @@ import numpy as np
 
 from .errors import PRSMHealthError, require
 from .features import FEATURES, GROUPS, dataset_features
-from .run import json_default
+from .jsonable import dumps
 
 TARGETS = ("clearance", "fault", "both")
 #: Indicator whose absence means the window has no load/motion reversal, i.e. the clearance is
@@ -219,7 +219,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         **{k: metadata[k] for k in ("name", "model_version", "window", "design")},
     }
     metrics_path = out.with_name(out.stem + ".metrics.json")
-    metrics_path.write_text(json.dumps(metrics, indent=2, default=json_default))
+    metrics_path.write_text(dumps(metrics, indent=2))
     metrics["metrics_path"] = str(metrics_path)
     return metrics
 

@@ -13,8 +13,8 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
+from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.dataset import Dataset, Recipe, RecipeError, generate, load_recipe
-from prsm_health.dynamics.layout import CHANNELS
 from prsm_health.dynamics.simulate import simulate
 
 TINY = textwrap.dedent(
@@ -100,7 +100,7 @@ def test_workers_1_and_2_identical_and_readers(recipe_path, tmp_path):
     runs_pl = pl.read_parquet(tmp_path / "a" / "runs.parquet")
     assert runs_pl.height == 6
     signals_pl = pl.read_parquet(str(tmp_path / "a" / "signals" / "*.parquet"))
-    assert set(CHANNELS) <= set(signals_pl.columns)
+    assert set(CHANNEL_NAMES) <= set(signals_pl.columns)
     counts = duckdb.sql(
         f"select run_id, count(*) n from read_parquet('{tmp_path / 'a' / 'signals' / '*.parquet'}') group by run_id order by run_id"
     ).fetchall()
@@ -115,7 +115,7 @@ def test_dataset_run_equals_simulation(recipe_path, tmp_path):
     direct = simulate(design, health, profile, sensors, spec.seed, options=options)
     stored = ds.run(4)
     assert np.array_equal(stored.time, direct.time)
-    for name in CHANNELS:  # float32 storage: equal to float32 precision
+    for name in CHANNEL_NAMES:  # float32 storage: equal to float32 precision
         assert np.array_equal(stored[name], direct[name].astype(np.float32).astype(float)), name
     assert stored.labels["clearance_screw"] == health.clearance_screw
 

@@ -14,7 +14,7 @@ from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, IndexType, Writer
 
 from prsm_health import mcap_io
-from prsm_health.dynamics.layout import CHANNELS
+from prsm_health.channels import CHANNEL_NAMES, UNITS
 from prsm_health.errors import PRSMHealthError
 from prsm_health.mcap_io import (
     TOPIC_DIAGNOSIS,
@@ -29,7 +29,7 @@ from prsm_health.mcap_io import (
     write_diagnosis_mcap,
     write_mcap,
 )
-from prsm_health.run import UNITS, Run
+from prsm_health.run import Run
 
 FS = 20_000.0
 
@@ -48,7 +48,7 @@ LABELS = {
 }
 
 
-def make_run(n=2000, channels=CHANNELS, seed=0):
+def make_run(n=2000, channels=CHANNEL_NAMES, seed=0):
     """Known signals on every requested channel, plus values that stress float printing."""
     t = np.arange(n) / FS
     rng = np.random.default_rng(seed)
@@ -102,8 +102,8 @@ def test_round_trip_exact(mcap_file, run):
         back = read_mcap(mcap_file)
     assert back.sample_rate == run.sample_rate
     assert_same_bits(back.time, run.time)
-    assert list(back.channels) == list(CHANNELS)
-    for name in CHANNELS:
+    assert list(back.channels) == list(CHANNEL_NAMES)
+    for name in CHANNEL_NAMES:
         assert_same_bits(back[name], run[name])
     assert back.labels == LABELS
     assert back.scenario == run.scenario
@@ -115,7 +115,7 @@ def test_round_trip_missing_channels(tmp_path):
     run = make_run(channels=present)
     path = write_mcap(run, tmp_path / "partial.mcap")
     back = read_mcap(path)
-    assert list(back.channels) == [c for c in CHANNELS if c in present]
+    assert list(back.channels) == [c for c in CHANNEL_NAMES if c in present]
     for name in present:
         assert_same_bits(back[name], run[name])
     with open(path, "rb") as f:
@@ -548,8 +548,8 @@ def test_windows_stream_in_order(long_file, long_run):
         assert w.end_ns - w.start_ns == 50_000_000
         assert np.all(np.diff(w.time) > 0) and w.start <= w.time[0] and w.time[-1] < w.end
         assert w.labels == LABELS
-        assert list(w.channels) == list(CHANNELS)
-    for name in CHANNELS:
+        assert list(w.channels) == list(CHANNEL_NAMES)
+    for name in CHANNEL_NAMES:
         assert_same_bits(np.concatenate([w[name] for w in windows]), long_run[name])
     # Streaming: at most the unfinished window plus one decoded chunk (~160 samples) is held.
     assert stream.peak_buffered <= 2 * 1000
@@ -682,7 +682,7 @@ def test_write_diagnosis_mcap(tmp_path, mcap_file, run):
         assert count == 2 * len(run)
     # The signals are untouched and still replay in order next to the diagnosis.
     back = read_mcap(dst)
-    for name in CHANNELS:
+    for name in CHANNEL_NAMES:
         assert_same_bits(back[name], run[name])
     again = list(iter_windows(dst, 0.025))
     assert [len(w) for w in again] == [len(w) for w in windows]

@@ -8,9 +8,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from prsm_health import HealthState, OperatingProfile, SensorModel, simulate
-from prsm_health.dynamics.layout import CHANNELS
+from prsm_health.channels import CHANNEL_NAMES, UNITS
 from prsm_health.errors import PRSMHealthError
-from prsm_health.run import UNITS, Run
+from prsm_health.run import Run
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +23,7 @@ def test_round_trip_exact(tmp_path, run):
     back = Run.from_parquet(path)
     assert back.sample_rate == run.sample_rate
     assert np.array_equal(back.time, run.time)
-    for name in CHANNELS:
+    for name in CHANNEL_NAMES:
         assert np.array_equal(back[name], run[name]), name
     assert back.labels == json.loads(json.dumps(run.labels))
 
@@ -31,7 +31,7 @@ def test_round_trip_exact(tmp_path, run):
 def test_independent_readers(tmp_path, run):
     path = run.to_parquet(tmp_path / "run.parquet")
     frame = pd.read_parquet(path)
-    assert list(frame.columns) == ["time", *CHANNELS]
+    assert list(frame.columns) == ["time", *CHANNEL_NAMES]
     meta = pq.read_schema(path).metadata
     assert json.loads(meta[b"prsm_health.units"])["nut_axial_accel"] == UNITS["nut_axial_accel"]
     assert float(meta[b"prsm_health.sample_rate"]) == run.sample_rate

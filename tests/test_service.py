@@ -33,8 +33,8 @@ from prsm_health import (
     SimulationOptions,
     simulate,
 )
+from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.diagnosis import DEFAULT_MODEL, diagnose, load_bundle
-from prsm_health.dynamics.layout import CHANNELS
 from prsm_health.features import MIN_SAMPLES
 from prsm_health.mcap_io import write_mcap
 from prsm_health.run import Run
@@ -188,7 +188,7 @@ def test_openapi_document(client):
     ):
         assert path in paths
     channels = doc["components"]["schemas"]["Channels"]
-    assert set(channels["properties"]) == set(CHANNELS)
+    assert set(channels["properties"]) == set(CHANNEL_NAMES)
     assert channels["additionalProperties"] is False
 
 

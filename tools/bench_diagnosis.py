@@ -33,7 +33,9 @@ def main() -> None:
     )
     parts = list(windows(run, 1.0))
     bundle = load_bundle()
-    diagnose_indicators([extract_features(parts[0], bundle.design)], bundle)  # warm-up (thread pools)
+    diagnose_indicators(
+        [extract_features(parts[0], bundle.design)], bundle
+    )  # warm-up (thread pools)
     t0 = time.perf_counter()
     rows = [extract_features(p, bundle.design) for p in parts]
     t_features = time.perf_counter() - t0

@@ -30,7 +30,7 @@ import numpy as np
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
-from prsm_health.dynamics.layout import CHANNELS
+from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.mcap_io import TOPIC_FIELDS, iter_windows, read_mcap, write_mcap
 from prsm_health.run import Run
 
@@ -40,7 +40,7 @@ def synthetic_run(duration: float, rate: float) -> Run:
     t = np.arange(n) / rate
     rng = np.random.default_rng(0)
     channels = {}
-    for k, name in enumerate(CHANNELS):
+    for k, name in enumerate(CHANNEL_NAMES):
         f = 37.0 * (k + 1)
         channels[name] = (k + 1) * np.sin(2 * np.pi * f * t) + 0.1 * rng.standard_normal(n)
     return Run(t, channels, rate, {"design": "paper01", "seed": 0}, {"design": "paper01"})
@@ -126,7 +126,7 @@ def main() -> None:
         write_mcap(run, ours)
         baseline_write(run, theirs)
         mine, other = read_mcap(theirs), baseline_read(ours)
-        for name in CHANNELS:
+        for name in CHANNEL_NAMES:
             assert np.array_equal(mine[name], run[name]), name
             assert np.array_equal(other[name], run[name]), name
 
@@ -150,7 +150,7 @@ def main() -> None:
         sizes = ours.stat().st_size, theirs.stat().st_size
 
     print(
-        f"{args.duration:g} s at {args.rate:g} Hz, {len(CHANNELS)} channels: "
+        f"{args.duration:g} s at {args.rate:g} Hz, {len(CHANNEL_NAMES)} channels: "
         f"{messages} messages on {len(TOPIC_FIELDS)} topics; best of {args.repeat}\n"
     )
     print("| operation | prsm_health [msg/s] | baseline mcap + json [msg/s] | speed-up |")

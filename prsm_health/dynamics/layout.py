@@ -93,23 +93,8 @@ N_ROLLER_PARAMS = 12
     C_AXIAL_LOAD,
 ) = range(11)
 N_CHANNELS = 11
+# Names, units and meanings of these channels: prsm_health.channels.CHANNELS (same order).
 
-#: Channel names in record order (the signal-channel contract of ../shared/DESIGN.md).
-CHANNELS = (
-    "screw_angle",
-    "screw_speed",
-    "carrier_speed",
-    "nut_position",
-    "nut_axial_accel",
-    "nut_tangential_accel",
-    "nut_radial_x_accel",
-    "nut_radial_y_accel",
-    "drive_torque",
-    "friction_torque",
-    "axial_load",
-)
-
-# Auxiliary outputs of one right-hand-side evaluation.
 # Auxiliary outputs of one right-hand-side evaluation; after them, per roller, the Coulomb
 # limit μ·N of its screw–roller traction [N].
 A_DRIVE_TORQUE, A_FRICTION_TORQUE, A_AXIAL_LOAD, A_P_DRIVE, A_P_LOAD, A_P_DISS, A_P_FRIC = range(7)

@@ -10,8 +10,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..channels import CHANNEL_NAMES
 from ..design import PRSMDesign, preset
-from ..errors import PRSMHealthError, require
+from ..errors import SimulationError, require
 from ..run import Run
 from ..sensors import SensorModel, measure
 from ..states import HealthState, OperatingProfile
@@ -21,10 +22,6 @@ from .model import Model, SimulationOptions, build_model, initial_state
 
 #: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
 STABILITY_MARGIN = 0.9
-
-
-class SimulationError(PRSMHealthError):
-    """The integration cannot proceed (unstable step, non-finite state)."""
 
 
 def _rk4_amplification(z: np.ndarray) -> np.ndarray:
@@ -185,7 +182,7 @@ def simulate(
         )
     raw = _integrate(model, y, h, n_steps, progress)
     channels = measure(
-        {name: raw[:, k] for k, name in enumerate(L.CHANNELS)},
+        {name: raw[:, k] for k, name in enumerate(CHANNEL_NAMES)},
         1.0 / h,
         sensors,
         np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
