@@ -438,12 +438,8 @@ def _cmd_train(args) -> int:
 def _cmd_simulate(args) -> int:
     from pathlib import Path
 
-    from .design import preset
-    from .dynamics.model import SimulationOptions
-    from .dynamics.simulate import simulate
     from .kinematics import characteristic_frequencies
-    from .sensors import SensorModel
-    from .states import HealthState, ManufacturingVariation, OperatingProfile
+    from .scenario import Scenario
 
     out = Path(args.out)
     if out.suffix not in (".parquet", ".mcap"):
@@ -452,34 +448,39 @@ def _cmd_simulate(args) -> int:
         )
     if not out.parent.exists():
         raise PRSMHealthError(f"--out {out}: directory {out.parent} does not exist")
-    design = preset(args.design)
-    health = HealthState(
-        clearance_screw=args.clearance,
-        clearance_nut=args.clearance,
-        clearance_gear=args.clearance if args.gear_clearance is None else args.gear_clearance,
-        wear_spread=args.wear_spread,
-        friction_scale=args.friction_scale,
+    health = {
+        "clearance": args.clearance,
+        "wear_spread": args.wear_spread,
+        "friction_scale": args.friction_scale,
+    }
+    if args.gear_clearance is not None:
+        health["clearance_gear"] = args.gear_clearance
+    scenario = Scenario.from_dict(
+        {
+            "design": args.design,
+            "health": health,
+            "profile": {
+                "duration": args.duration,
+                "motion": args.profile,
+                "speed": args.speed,
+                "accel_time": args.accel_time,
+                "motion_period": args.period,
+                "load_profile": args.load_profile,
+                "load": args.load,
+                "load_amplitude": args.load_amplitude,
+                "load_frequency": args.load_frequency,
+            },
+            "sensors": {"sample_rate": args.sample_rate, "accel_noise": args.accel_noise},
+            "options": {
+                "max_step": args.max_step,
+                "contact_law": args.contact_law,
+                "ideal": args.ideal,
+            },
+            "seed": args.seed,
+        }
     )
-    profile = OperatingProfile(
-        duration=args.duration,
-        motion=args.profile,
-        speed=args.speed,
-        accel_time=args.accel_time,
-        motion_period=args.period,
-        load_profile=args.load_profile,
-        load=args.load,
-        load_amplitude=args.load_amplitude,
-        load_frequency=args.load_frequency,
-    )
-    sensors = SensorModel(sample_rate=args.sample_rate, accel_noise=args.accel_noise)
-    options = SimulationOptions(
-        max_step=args.max_step,
-        contact_law=args.contact_law,
-        variation=ManufacturingVariation.ideal() if args.ideal else ManufacturingVariation(),
-    )
-    run = simulate(
-        design, health, profile, sensors, args.seed, options=options, progress=not args.json
-    )
+    run = scenario.simulate(progress=not args.json)
+    design, profile = scenario.design, scenario.profile
     if out.suffix == ".mcap":
         from .mcap_io import write_mcap
 

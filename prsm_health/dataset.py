@@ -38,6 +38,8 @@ from .design import PRESETS
 from .errors import ParameterError, PRSMHealthError, RecipeError, require
 from .jsonable import dumps
 from .run import Run
+from .scenario import Scenario
+from .states import FAULT_CLASSES, FaultThresholds
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -58,33 +60,7 @@ SWEPT = {
     "friction_scale": "-",
     "wear_spread": "-",
 }
-FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
 DEFAULT_BATCH = 8
-
-
-@dataclass(frozen=True)
-class FaultThresholds:
-    """Fault taxonomy thresholds (recipe ``[faults]``).
-
-    A run's class, in this order of precedence: ``severe_wear`` when its largest thread
-    clearance ≥ ``severe_wear`` [m]; ``wear`` when ≥ ``wear`` [m]; ``lubrication`` when its
-    friction scale ≥ ``lubrication`` [-]; else ``healthy``. Wear comes first because it is
-    irreversible and what maintenance acts on; a degraded lubricant on a worn actuator is
-    labelled by its wear.
-    """
-
-    wear: float = 15e-6
-    severe_wear: float = 30e-6
-    lubrication: float = 1.8
-
-    def classify(self, clearance: float, friction_scale: float) -> str:
-        if clearance >= self.severe_wear:
-            return "severe_wear"
-        if clearance >= self.wear:
-            return "wear"
-        if friction_scale >= self.lubrication:
-            return "lubrication"
-        return "healthy"
 
 
 @dataclass(frozen=True)
@@ -238,10 +214,7 @@ class Recipe:
         # Build every run's objects once, so a bad value fails now, not in a worker.
         specs = self.runs()
         for spec in (specs[0], specs[-1]) if specs else ():
-            try:
-                spec.build()
-            except ParameterError as exc:
-                raise RecipeError(f"recipe (run {spec.run_id}): {exc}") from None
+            spec.scenario()
 
     @property
     def fingerprint(self) -> str:
@@ -330,63 +303,44 @@ class RunSpec:
     seed: int
     split: str
 
-    def build(self):
-        """(design, health, profile, sensors, options) objects of this run (validates)."""
-        from .design import preset
-        from .dynamics.model import SimulationOptions
-        from .sensors import SensorModel
-        from .states import HealthState, ManufacturingVariation, OperatingProfile
-
+    def scenario(self) -> Scenario:
+        """The :class:`~prsm_health.scenario.Scenario` of this run (validates)."""
         r, p = self.recipe, self.point
-        base = p.get("clearance", 10e-6)
+        health = {"clearance": p.get("clearance", 10e-6)}
+        health.update({k: p[k] for k in SWEPT if k.startswith("clearance_") and k in p})
+        health.update({k: p[k] for k in ("wear_spread", "friction_scale") if k in p})
+        profile = {
+            "duration": r.duration,
+            "speed": p.get("speed", 100.0),
+            "load": p.get("load", 100.0),
+        }
+        profile.update(r.profile)
+        if "load_amplitude" in p:
+            profile["load_amplitude"] = p["load_amplitude"]
         try:
-            health = HealthState(
-                clearance_screw=p.get("clearance_screw", base),
-                clearance_nut=p.get("clearance_nut", base),
-                clearance_gear=p.get("clearance_gear", base),
-                wear_spread=p.get("wear_spread", 0.0),
-                friction_scale=p.get("friction_scale", 1.0),
+            return Scenario.from_dict(
+                {
+                    "design": r.design,
+                    "health": health,
+                    "profile": profile,
+                    "sensors": {"sample_rate": r.sample_rate, **r.sensors},
+                    "options": r.options,
+                    "seed": self.seed,
+                }
             )
-            profile = OperatingProfile(
-                duration=r.duration,
-                speed=p.get("speed", 100.0),
-                load=p.get("load", 100.0),
-                **{
-                    **r.profile,
-                    **({"load_amplitude": p["load_amplitude"]} if "load_amplitude" in p else {}),
-                },
-            )
-            sensors = SensorModel(sample_rate=r.sample_rate, **r.sensors)
-            options = dict(r.options)
-            ideal = options.pop("ideal", False)
-            if ideal:
-                options["variation"] = ManufacturingVariation.ideal()
-            sim_options = SimulationOptions(**options)
-        except TypeError as exc:
-            raise RecipeError(f"recipe: {exc}") from None
-        return preset(r.design), health, profile, sensors, sim_options
+        except ParameterError as exc:
+            raise RecipeError(f"recipe (run {self.run_id}): {exc}") from None
 
     def labels(self, run: Run | None = None) -> dict:
-        """The run's labels (contract names; nominal values)."""
-        _, health, profile, _, _ = self.build()
+        """The run's labels: id, split, fault class and the scenario's labels (nominal values)."""
+        scenario = self.scenario()
+        health = scenario.health
         clearance = max(health.clearance_screw, health.clearance_nut)
         out = {
             "run_id": self.run_id,
             "split": self.split,
             "fault_class": self.recipe.faults.classify(clearance, health.friction_scale),
-            "design": self.recipe.design,
-            "clearance_screw": health.clearance_screw,
-            "clearance_nut": health.clearance_nut,
-            "clearance_gear": health.clearance_gear,
-            "wear_spread": health.wear_spread,
-            "friction_scale": health.friction_scale,
-            "screw_speed": profile.speed,
-            "axial_load": profile.load,
-            "load_amplitude": profile.load_amplitude,
-            "motion": profile.motion,
-            "load_profile": profile.load_profile,
-            "duration": profile.duration,
-            "seed": self.seed,
+            **scenario.labels(),
         }
         if run is not None:
             out["n_samples"] = len(run)
@@ -423,8 +377,6 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from .dynamics.simulate import simulate
-
     recipe = Recipe.from_dict(recipe_source)
     out = Path(out_dir)
     specs = recipe.runs()
@@ -432,8 +384,7 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
     tables, labels = [], []
     for run_id in recipe.batches()[batch]:
         spec = specs[run_id]
-        design, health, profile, sensors, options = spec.build()
-        run = simulate(design, health, profile, sensors, spec.seed, options=options)
+        run = spec.scenario().simulate()
         label = spec.labels(run)
         run.labels = dict(run.labels, **label)
         if formats in ("mcap", "both"):

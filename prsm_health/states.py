@@ -21,6 +21,8 @@ from .errors import require, require_positive, require_range
 MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
 LOADS = ("constant", "sinusoidal", "reversing")
 DRIVES = ("prescribed", "speed_loop")
+#: Fault classes of the taxonomy (run label ``fault_class``).
+FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
 
 
 @dataclass(frozen=True)
@@ -261,3 +263,28 @@ class ManufacturingVariation:
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+@dataclass(frozen=True)
+class FaultThresholds:
+    """Fault taxonomy thresholds (recipe ``[faults]``).
+
+    A run's class, in this order of precedence: ``severe_wear`` when its largest thread
+    clearance ≥ ``severe_wear`` [m]; ``wear`` when ≥ ``wear`` [m]; ``lubrication`` when its
+    friction scale ≥ ``lubrication`` [-]; else ``healthy``. Wear comes first because it is
+    irreversible and what maintenance acts on; a degraded lubricant on a worn actuator is
+    labelled by its wear.
+    """
+
+    wear: float = 15e-6
+    severe_wear: float = 30e-6
+    lubrication: float = 1.8
+
+    def classify(self, clearance: float, friction_scale: float) -> str:
+        if clearance >= self.severe_wear:
+            return "severe_wear"
+        if clearance >= self.wear:
+            return "wear"
+        if friction_scale >= self.lubrication:
+            return "lubrication"
+        return "healthy"

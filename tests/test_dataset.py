@@ -111,13 +111,20 @@ def test_dataset_run_equals_simulation(recipe_path, tmp_path):
     generate(recipe_path, tmp_path / "d", workers=1, progress=False)
     ds = Dataset(tmp_path / "d")
     spec = load_recipe(recipe_path).runs()[4]
-    design, health, profile, sensors, options = spec.build()
-    direct = simulate(design, health, profile, sensors, spec.seed, options=options)
+    scenario = spec.scenario()
+    direct = simulate(
+        scenario.design,
+        scenario.health,
+        scenario.profile,
+        scenario.sensors,
+        spec.seed,
+        options=scenario.options,
+    )
     stored = ds.run(4)
     assert np.array_equal(stored.time, direct.time)
     for name in CHANNEL_NAMES:  # float32 storage: equal to float32 precision
         assert np.array_equal(stored[name], direct[name].astype(np.float32).astype(float)), name
-    assert stored.labels["clearance_screw"] == health.clearance_screw
+    assert stored.labels["clearance_screw"] == scenario.health.clearance_screw
 
 
 def test_interrupt_and_resume_in_process(recipe_path, tmp_path):

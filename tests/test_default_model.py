@@ -36,10 +36,9 @@ def test_held_out_runs_of_the_reference_recipe(bundle):
     specs = [s for s in recipe.runs() if s.split == "test"][::10][:8]
     errors, inside, correct = [], 0, 0
     for spec in specs:
-        design, health, profile, sensors, options = spec.build()
-        run = simulate(design, health, profile, sensors, spec.seed, options=options)
-        result = diagnose(run, bundle)
-        truth = 0.5 * (health.clearance_screw + health.clearance_nut)
+        scenario = spec.scenario()
+        result = diagnose(scenario.simulate(), bundle)
+        truth = 0.5 * (scenario.health.clearance_screw + scenario.health.clearance_nut)
         c = result["clearance"]
         errors.append(abs(c["estimate"] - truth))
         inside += c["lower"] <= truth <= c["upper"]

@@ -11,7 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..channels import CHANNEL_NAMES
-from ..design import PRSMDesign, preset
+from ..design import DEFAULT_PRESET, PRSMDesign
 from ..errors import SimulationError, require
 from ..run import Run
 from ..sensors import SensorModel, measure
@@ -153,16 +153,26 @@ def simulate(
     ParameterError
         For any invalid input.
     """
-    design = preset(design) if isinstance(design, str) or design is None else design
-    health = health or HealthState()
-    profile = profile or OperatingProfile()
-    sensors = sensors or SensorModel()
-    options = options or SimulationOptions()
+    from ..scenario import Scenario
+
     require(
         isinstance(seed, (int, np.integer)) and seed >= 0, "seed", seed, "must be an integer ≥ 0"
     )
-    seed = int(seed)
+    scenario = Scenario(
+        design=design or DEFAULT_PRESET,
+        health=health or HealthState(),
+        profile=profile or OperatingProfile(),
+        sensors=sensors or SensorModel(),
+        options=options or SimulationOptions(),
+        seed=int(seed),
+    )
+    return simulate_scenario(scenario, progress=progress)
 
+
+def simulate_scenario(scenario, *, progress: bool = False) -> Run:
+    """Simulate a :class:`~prsm_health.scenario.Scenario`; see :func:`simulate`."""
+    design, health, profile = scenario.design, scenario.health, scenario.profile
+    sensors, options, seed = scenario.sensors, scenario.options, scenario.seed
     model = build_model(design, health, profile, options, seed)
     h, factor = choose_step(options.max_step, sensors.sample_rate)
     h_stable, f_max = max_stable_step(model)
@@ -200,40 +210,15 @@ def simulate(
         time=time,
         channels=channels,
         sample_rate=sensors.sample_rate,
-        labels=run_labels(design, health, profile, seed),
+        labels=scenario.labels(),
         scenario={
-            "design": design.name,
-            "health": health.as_dict(),
-            "profile": profile.as_dict(),
-            "sensors": sensors.as_dict(),
-            "options": options.as_dict(),
-            "seed": seed,
+            **scenario.to_dict(),
             "integration_step": h,
             "stable_step": h_stable,
             "highest_natural_frequency": f_max,
         },
         energy=energy,
     )
-
-
-def run_labels(
-    design: PRSMDesign, health: HealthState, profile: OperatingProfile, seed: int
-) -> dict:
-    """Run labels of the contract (nominal values, SI)."""
-    return {
-        "design": design.name,
-        "clearance_screw": health.clearance_screw,
-        "clearance_nut": health.clearance_nut,
-        "clearance_gear": health.clearance_gear,
-        "wear_spread": health.wear_spread,
-        "friction_scale": health.friction_scale,
-        "screw_speed": profile.speed,
-        "axial_load": profile.load,
-        "motion": profile.motion,
-        "load_profile": profile.load_profile,
-        "load_amplitude": profile.load_amplitude,
-        "seed": seed,
-    }
 
 
 def _integrate(

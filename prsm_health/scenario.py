@@ -1,0 +1,191 @@
+"""Scenario: the one object a simulated run is built from, and its labels.
+
+A :class:`Scenario` gathers the parameter groups by lifetime — design, health state, operating
+profile, sensors, simulation options — and the seed. The CLI (``prsm-health simulate``), dataset
+recipes (one scenario per run) and the Python API all build it here, from keyword objects or from
+a nested dict / TOML table, so defaults and validation live in one place; its :meth:`labels`
+are the run labels of the contract (docs/formats.md).
+
+The dict form (and the TOML form, the same tables)::
+
+    design = "paper01"                       # preset name
+    seed = 3
+    [health]   clearance = 20e-6             # shorthand for screw, nut and gear; or each field
+    [profile]  duration = 0.5, speed = 100.0, load = 100.0, …   (OperatingProfile fields)
+    [sensors]  sample_rate = 20000, accel_noise = 0.05, …       (SensorModel fields)
+    [options]  contact_law = "hertz", ideal = true, …           (SimulationOptions fields)
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+from .design import DEFAULT_PRESET, PRSMDesign, preset
+from .dynamics.model import SimulationOptions
+from .errors import ParameterError, PRSMHealthError, require
+from .sensors import SensorModel
+from .states import HealthState, ManufacturingVariation, OperatingProfile
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+_GROUPS = {
+    "health": HealthState,
+    "profile": OperatingProfile,
+    "sensors": SensorModel,
+    "options": SimulationOptions,
+}
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Everything that determines a simulated run.
+
+    Parameters
+    ----------
+    design : PRSMDesign or preset name, default "paper01"
+    health : HealthState
+    profile : OperatingProfile
+    sensors : SensorModel
+    options : SimulationOptions
+    seed : int
+        Seeds manufacturing variation, uneven wear and sensor noise (same seed, same run).
+    """
+
+    design: PRSMDesign = field(default_factory=preset)
+    health: HealthState = field(default_factory=HealthState)
+    profile: OperatingProfile = field(default_factory=OperatingProfile)
+    sensors: SensorModel = field(default_factory=SensorModel)
+    options: SimulationOptions = field(default_factory=SimulationOptions)
+    seed: int = 0
+
+    def __post_init__(self):
+        if isinstance(self.design, str):
+            object.__setattr__(self, "design", preset(self.design))
+        require(
+            isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0,
+            "seed",
+            self.seed,
+            "must be an integer ≥ 0",
+        )
+
+    # ------------------------------------------------------------------ dict / TOML
+    @classmethod
+    def from_dict(cls, data: dict) -> Scenario:
+        """Build from the nested dict form (module docstring); errors name the table and key."""
+        data = dict(data)
+        unknown = sorted(set(data) - {"design", "seed", *_GROUPS})
+        if unknown:
+            raise ParameterError(
+                "scenario",
+                ", ".join(unknown),
+                f"unknown key(s); allowed: design, seed, {', '.join(_GROUPS)}",
+            )
+        groups = {name: _group(name, kind, data.get(name, {})) for name, kind in _GROUPS.items()}
+        return cls(design=data.get("design", DEFAULT_PRESET), seed=data.get("seed", 0), **groups)
+
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Scenario:
+        """Read a scenario file (the dict form as TOML tables)."""
+        path = Path(path)
+        try:
+            return cls.from_dict(tomllib.loads(path.read_text()))
+        except FileNotFoundError:
+            raise PRSMHealthError(f"{path}: no such scenario file") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise PRSMHealthError(f"{path}: not valid TOML ({exc})") from None
+
+    def to_dict(self) -> dict:
+        """The nested dict form, as stored with every run (``Run.scenario``)."""
+        return {
+            "design": self.design.name,
+            "health": self.health.as_dict(),
+            "profile": self.profile.as_dict(),
+            "sensors": self.sensors.as_dict(),
+            "options": self.options.as_dict(),
+            "seed": self.seed,
+        }
+
+    def to_toml(self) -> str:
+        """TOML text that :meth:`from_toml` reads back to an equal scenario."""
+        data = self.to_dict()
+        lines = [f'design = "{data.pop("design")}"', f"seed = {data.pop('seed')}"]
+        options = data["options"]
+        variation = options.pop("variation")
+        for table, values in data.items():
+            lines.append(f"\n[{table}]")
+            lines += [f"{k} = {_toml_value(v)}" for k, v in values.items() if v is not None]
+        lines.append("\n[options.variation]")
+        lines += [f"{k} = {_toml_value(v)}" for k, v in variation.items()]
+        return "\n".join(lines) + "\n"
+
+    # ------------------------------------------------------------------ labels
+    def labels(self) -> dict:
+        """Run labels of the contract: nominal health and operating point (SI)."""
+        h, p = self.health, self.profile
+        return {
+            "design": self.design.name,
+            "clearance_screw": h.clearance_screw,
+            "clearance_nut": h.clearance_nut,
+            "clearance_gear": h.clearance_gear,
+            "wear_spread": h.wear_spread,
+            "friction_scale": h.friction_scale,
+            "screw_speed": p.speed,
+            "axial_load": p.load,
+            "load_amplitude": p.load_amplitude,
+            "motion": p.motion,
+            "load_profile": p.load_profile,
+            "duration": p.duration,
+            "seed": self.seed,
+        }
+
+    def simulate(self, *, progress: bool = False):
+        """Simulate this scenario (:func:`prsm_health.simulate`) → :class:`~prsm_health.run.Run`."""
+        from .dynamics.simulate import simulate_scenario
+
+        return simulate_scenario(self, progress=progress)
+
+
+def _group(name: str, kind: type, values) -> object:
+    """One parameter group from its table; unknown keys name the table and list the allowed."""
+    if isinstance(values, kind):
+        return values
+    if not isinstance(values, dict):
+        raise ParameterError(name, values, "must be a table of parameters")
+    values = dict(values)
+    if kind is HealthState and "clearance" in values:
+        clearance = values.pop("clearance")
+        for key in ("clearance_screw", "clearance_nut", "clearance_gear"):
+            values.setdefault(key, clearance)
+    if kind is SimulationOptions:
+        if values.pop("ideal", False):
+            values["variation"] = ManufacturingVariation.ideal()
+        elif isinstance(values.get("variation"), dict):
+            values["variation"] = _group(
+                "options.variation", ManufacturingVariation, values["variation"]
+            )
+    allowed = [f.name for f in fields(kind)]
+    if kind is HealthState:
+        allowed.append("clearance")
+    if kind is SimulationOptions:
+        allowed.append("ideal")
+    unknown = sorted(set(values) - set(allowed))
+    if unknown:
+        raise ParameterError(
+            f"{name}.{unknown[0]}",
+            values[unknown[0]],
+            f"unknown key; allowed: {', '.join(allowed)}",
+        )
+    return kind(**values)
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    return repr(value)
