@@ -57,18 +57,25 @@ def _cmd_validate(args) -> int:
     return 1 if failed else 0
 
 
-def _print_validation_text(rows) -> None:
+def _print_validation_text(rows, width: int = 100) -> None:
+    """Each row in at most a few lines of ``width`` columns: where and what, the numbers and the
+    verdict, then the note wrapped."""
+    import textwrap
+
     from .validation import _fmt
 
-    header = f"{'paper':<5} {'where':<26} {'quantity':<44} {'paper':>11} {'model':>11} {'error':>9}  verdict"
-    print(header)
-    print("-" * len(header))
+    indent = " " * 4
     for r in rows:
-        err = "" if r.error is None else f"{100 * r.error:+.2f}%"
+        err = "–" if r.error is None else f"{100 * r.error:+.2f} %"
+        head = f"{r.paper} {r.where}: {r.quantity} [{r.unit}]"
+        print(textwrap.fill(head, width, subsequent_indent=indent))
         print(
-            f"{r.paper:<5} {r.where[:26]:<26} {(r.quantity + ' [' + r.unit + ']')[:44]:<44} "
-            f"{_fmt(r.paper_value):>11} {_fmt(r.model_value):>11} {err:>9}  {r.verdict}"
+            f"{indent}paper {_fmt(r.paper_value)}  model {_fmt(r.model_value)}  "
+            f"error {err}  → {r.verdict}"
         )
+        if r.note:
+            print(textwrap.fill(r.note, width, initial_indent=indent, subsequent_indent=indent))
+        print()
 
 
 # ----------------------------------------------------------------------------- kinematics
@@ -274,73 +281,22 @@ def _rate(text: str) -> float | None:
 
 
 def _cmd_replay(args) -> int:
-    import warnings
+    from .diagnosis import load_bundle, replay
 
-    from .mcap_io import DiagnosisWriter, TruncatedRecordingWarning, iter_windows, window_statistics
-
-    bundle = None
-    if not args.statistics_only:
-        from .diagnosis import load_bundle
-
-        bundle = load_bundle(args.model)
-    window_length = args.window or (bundle.window if bundle else 1.0)
-    caught: list[str] = []
-
-    def note(message, category, *rest):
-        caught.append(str(message))
-
-    writer = DiagnosisWriter(args.file, args.out) if (args.out and bundle) else None
-    results = []
-    with warnings.catch_warnings():
-        warnings.simplefilter("always", TruncatedRecordingWarning)
-        warnings.showwarning = note
-        stream = iter_windows(args.file, window_length, rate=args.rate)
-        try:
-            for window in stream:
-                entry = {"index": window.index, "start": window.start, "end": window.end}
-                if bundle is not None:
-                    entry["diagnosis"] = _diagnose_window(window, bundle)
-                    if writer is not None:
-                        writer.add(window.end_ns, entry["diagnosis"])
-                else:
-                    entry["statistics"] = window_statistics(window)
-                results.append(entry)
-                if not args.json:
-                    print(_replay_line(entry))
-        except BaseException:
-            if writer is not None:
-                writer.abort()
-            raise
-        finally:
-            stream.close()
-    if writer is not None:
-        writer.close()
-    for message in caught:
-        print(f"warning: {message}", file=sys.stderr)
+    bundle = None if args.statistics_only else load_bundle(args.model)
+    window = args.window or (bundle.window if bundle else 1.0)
+    steps = []
+    for step in replay(args.file, bundle, window=window, rate=args.rate, out=args.out):
+        steps.append(step.to_json())
+        if not args.json:
+            print(_replay_line(steps[-1]))
     if args.json:
-        _print_json(
-            {
-                "file": args.file,
-                "window": window_length,
-                "windows": results,
-                "warnings": caught,
-                "out": args.out,
-            }
-        )
-    elif not results:
+        _print_json({"file": args.file, "window": window, "windows": steps, "out": args.out})
+    elif not steps:
         print("no complete window in the recording")
-    elif args.out and writer is not None:
-        print(f"wrote {args.out} with {len(results)} /prsm/diagnosis messages")
+    elif args.out and bundle is not None:
+        print(f"wrote {args.out} with {len(steps)} /prsm/diagnosis messages")
     return 0
-
-
-def _diagnose_window(window, bundle) -> dict:
-    from .diagnosis import diagnose_indicators
-    from .features import extract_features
-    from .run import Run
-
-    run = Run(window.time, window.channels, window.sample_rate, window.labels)
-    return diagnose_indicators([extract_features(run, bundle.design)], bundle)[0]
 
 
 def _replay_line(entry) -> str:
@@ -384,31 +340,34 @@ def _cmd_serve(args) -> int:
 
 # ----------------------------------------------------------------------------- diagnose / train
 def _cmd_diagnose(args) -> int:
-    from .diagnosis import diagnose, load_bundle, plot_diagnosis, read_recording
+    from .diagnosis import diagnose, load_bundle
+    from .io import read_recording
 
     bundle = load_bundle(args.model)
-    run = read_recording(args.file)
-    result = diagnose(run, bundle, window=args.window)
+    result = diagnose(read_recording(args.file), bundle, window=args.window)
     if args.plot:
+        from .plots import plot_diagnosis
+
         plot_diagnosis(result, args.plot)
     if args.json:
-        _print_json(result)
+        _print_json(result.to_json())
         return 0
-    c = result["clearance"]
+    c = result.clearance
     rows = [
         ("file", args.file, ""),
-        ("fault class", result["fault_class"], ""),
+        ("fault class", result.fault_class, ""),
         (
             "clearance",
             f"{_um(c['estimate'])} [{_um(c['lower'])}, {_um(c['upper'])}]",
             "µm (90 % interval)",
         ),
     ]
-    rows += [(f"P({k})", v, "") for k, v in result["class_probabilities"].items()]
+    rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
     rows += [
-        ("windows", len(result["windows"]), ""),
-        ("model", f"{result['model']['name']} v{result['model']['version']}", ""),
+        ("windows", len(result.windows), ""),
+        ("model", f"{result.model['name']} v{result.model['version']}", ""),
     ]
+    rows += [("warning", text, "") for text in result.warnings]
     _print_table(rows)
     return 0
 
@@ -527,191 +486,255 @@ def _finite_float(text: str) -> float:
     return value
 
 
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Help with every option's default; an option without one says in its help what applies."""
+
+    def _get_help_string(self, action):
+        if action.default is None or action.default is False or action.required:
+            return action.help
+        return super()._get_help_string(action)
+
+
+def _add_json(p, what: str = "the result") -> None:
+    p.add_argument("--json", action="store_true", help=f"print {what} as JSON instead of a table")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from .design import DEFAULT_PRESET, PRESETS
 
     parser = _Parser(
         prog="prsm-health",
-        description="Planetary roller screw physics, signal generation and diagnostics.",
+        description="Planetary roller screw physics, signal generation and diagnostics. "
+        "SI units on the command line unless an option says otherwise.",
+        formatter_class=_HelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"prsm-health {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
-    p = sub.add_parser("validate", help="compare the models with every number the papers print")
+    def command(name: str, text: str):
+        return sub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+
+    designs = sorted(PRESETS)
+    p = command("validate", "compare the models with every number the papers print")
     fmt = p.add_mutually_exclusive_group()
-    fmt.add_argument("--json", action="store_true", help="machine-readable output")
-    fmt.add_argument("--markdown", action="store_true", help="Markdown table")
+    fmt.add_argument("--json", action="store_true", help="print the rows as JSON")
+    fmt.add_argument("--markdown", action="store_true", help="print a Markdown table")
     p.set_defaults(func=_cmd_validate)
 
-    p = sub.add_parser("kinematics", help="speed ratios and characteristic frequencies")
-    p.add_argument("--design", default=DEFAULT_PRESET, choices=sorted(PRESETS))
+    p = command("kinematics", "speed ratios and characteristic frequencies of a design")
+    p.add_argument("--design", default=DEFAULT_PRESET, choices=designs, help="design preset")
     p.add_argument("--speed", type=_finite_float, required=True, help="screw speed [rad/s]")
-    p.add_argument("--json", action="store_true")
+    _add_json(p)
     p.set_defaults(func=_cmd_kinematics)
 
-    p = sub.add_parser("stiffness", help="static stiffness models")
+    p = command("stiffness", "static stiffness models: gear mesh, axial, electric cylinder")
     ssub = p.add_subparsers(dest="model", required=True, parser_class=_Parser)
 
-    g = ssub.add_parser("gear", help="time-varying gear mesh stiffness (potential energy method)")
+    def stiffness(name: str, text: str):
+        return ssub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+
+    g = stiffness("gear", "time-varying gear mesh stiffness (potential energy method, paper 01)")
     g.add_argument("--z1", type=int, required=True, help="pinion (roller gear) teeth")
     g.add_argument("--z2", type=int, required=True, help="gear (ring gear) teeth")
     g.add_argument("--module", type=_finite_float, required=True, help="module [m]")
-    g.add_argument("--pressure-angle", type=_finite_float, default=20.0, metavar="DEG")
-    g.add_argument("--face-width", type=_finite_float, required=True, help="[m]")
+    g.add_argument(
+        "--pressure-angle", type=_finite_float, default=20.0, metavar="DEG", help="[deg]"
+    )
+    g.add_argument("--face-width", type=_finite_float, required=True, help="face width [m]")
     g.add_argument("--bore-diameter", type=_finite_float, default=0.0, help="pinion bore [m]")
     g.add_argument("--internal", action="store_true", help="z2 is an internal ring gear")
-    g.add_argument("--youngs-modulus", type=_finite_float, default=2.1e11, metavar="PA")
-    g.add_argument("--poisson", type=_finite_float, default=0.3, metavar="V")
+    g.add_argument(
+        "--youngs-modulus", type=_finite_float, default=2.1e11, metavar="PA", help="[Pa]"
+    )
+    g.add_argument("--poisson", type=_finite_float, default=0.3, metavar="V", help="[-]")
     g.add_argument("--threaded-tooth", action="store_true", help="PRSM threaded roller tooth")
-    g.add_argument("--json", action="store_true")
+    _add_json(g)
     g.set_defaults(func=_cmd_stiffness_gear)
 
-    a = ssub.add_parser("axial", help="axial stiffness of the whole PRSM (papers 01, 04)")
-    a.add_argument("--design", default=DEFAULT_PRESET, choices=sorted(PRESETS))
+    a = stiffness("axial", "axial stiffness of the whole PRSM (papers 01, 04)")
+    a.add_argument("--design", default=DEFAULT_PRESET, choices=designs, help="design preset")
     a.add_argument("--load", type=_finite_float, required=True, help="axial load [N]")
-    a.add_argument("--json", action="store_true")
+    _add_json(a)
     a.set_defaults(func=_cmd_stiffness_axial)
 
-    c = ssub.add_parser("cylinder", help="electric-cylinder deformation and stiffness (paper 05)")
+    c = stiffness("cylinder", "electric-cylinder deformation and stiffness (paper 05)")
     c.add_argument("--load", type=_finite_float, required=True, help="axial load [N]")
     c.add_argument("--extension", type=_finite_float, required=True, help="rod extension [m]")
-    c.add_argument("--json", action="store_true")
+    _add_json(c)
     c.set_defaults(func=_cmd_stiffness_cylinder)
 
-    _add_simulate_parser(sub, DEFAULT_PRESET, PRESETS)
+    _add_simulate_parser(command, DEFAULT_PRESET, designs)
 
-    g = sub.add_parser("generate", help="generate a labelled dataset from a recipe (resumable)")
-    g.add_argument("recipe", help="TOML recipe (see datasets/)")
-    g.add_argument("--out", required=True, help="dataset directory")
-    g.add_argument("--workers", type=int, default=None, help="local processes (default: all cores)")
+    g = command("generate", "generate a labelled dataset from a recipe (resumable after Ctrl-C)")
+    g.add_argument("recipe", help="TOML recipe (see datasets/ and docs/formats.md)")
+    g.add_argument("--out", required=True, help="dataset directory (created; rerun to resume)")
     g.add_argument(
-        "--scheduler", default=None, help="Dask scheduler address (or DASK_SCHEDULER_ADDRESS)"
+        "--workers", type=int, default=None, help="local worker processes (None: all cores)"
     )
-    g.add_argument("--format", choices=("parquet", "mcap", "both"), default="parquet")
-    g.add_argument("--json", action="store_true")
+    g.add_argument(
+        "--scheduler",
+        default=None,
+        help="Dask scheduler address, e.g. tcp://host:8786 (None: $DASK_SCHEDULER_ADDRESS, "
+        "else local processes)",
+    )
+    g.add_argument(
+        "--format", choices=("parquet", "mcap", "both"), default="parquet", help="signal files"
+    )
+    _add_json(g, "the generation report")
     g.set_defaults(func=_cmd_generate)
 
-    r = sub.add_parser("replay", help="stream an MCAP recording as windows through the diagnosis")
-    r.add_argument("file", help="MCAP recording")
-    r.add_argument(
-        "--window",
-        type=_finite_float,
-        default=None,
-        help="window length [s] (default: the model's)",
+    t = command("train", "train the clearance estimator and fault classifier on a dataset")
+    t.add_argument("dataset", help="dataset directory (prsm-health generate)")
+    t.add_argument(
+        "--out", required=True, help="model file, must end in .skops; metrics JSON beside it"
     )
-    r.add_argument("--rate", type=_rate, default=None, help="real-time factor, or 'max' (default)")
-    r.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
-    r.add_argument(
-        "--out", default=None, help="copy of the recording with /prsm/diagnosis messages"
+    t.add_argument(
+        "--target",
+        choices=("clearance", "fault", "both"),
+        default="both",
+        help="what to train: the clearance estimator, the fault classifier or both",
     )
-    r.add_argument("--statistics-only", action="store_true", help="window statistics, no model")
-    r.add_argument("--json", action="store_true")
-    r.set_defaults(func=_cmd_replay)
+    t.add_argument("--cv", type=int, default=5, help="cross-validation folds on the train split")
+    _add_json(t, "the metrics")
+    t.set_defaults(func=_cmd_train)
 
-    d = sub.add_parser("diagnose", help="diagnose a recording (.mcap, .parquet or .csv)")
-    d.add_argument("file")
-    d.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
+    d = command("diagnose", "diagnose a recording: clearance with interval, fault class")
+    d.add_argument("file", help="recording: .mcap, .parquet (one run) or .csv (docs/formats.md)")
+    d.add_argument("--model", default=None, help="model bundle (None: the shipped model)")
     d.add_argument(
-        "--window",
-        type=_finite_float,
-        default=None,
-        help="window length [s] (default: the model's)",
+        "--window", type=_finite_float, default=None, help="window length [s] (None: the model's)"
     )
-    d.add_argument("--plot", default=None, help="PNG of the per-window estimates")
-    d.add_argument("--json", action="store_true")
+    d.add_argument("--plot", default=None, help="write a PNG of the per-window estimates")
+    _add_json(d, "the Diagnosis contract")
     d.set_defaults(func=_cmd_diagnose)
 
-    v = sub.add_parser("serve", help="HTTP diagnostics service with asset health history")
-    v.add_argument("--host", default="127.0.0.1", help="bind address (non-loopback needs a token)")
-    v.add_argument("--port", type=int, default=8000)
-    v.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
-    v.add_argument(
-        "--db", default=None, help="SQLite history database (default: see docs/service.md)"
+    r = command("replay", "stream an MCAP recording window by window through the diagnosis")
+    r.add_argument("file", help="MCAP recording")
+    r.add_argument(
+        "--window", type=_finite_float, default=None, help="window length [s] (None: the model's)"
     )
-    v.add_argument("--token", default=None, help="bearer token (or PRSM_HEALTH_TOKEN)")
-    v.add_argument("--workers", type=int, default=None, help="diagnoses computed at once")
+    r.add_argument(
+        "--rate",
+        type=_rate,
+        default=None,
+        help="real-time factor, or 'max' (None: as fast as possible)",
+    )
+    r.add_argument("--model", default=None, help="model bundle (None: the shipped model)")
+    r.add_argument(
+        "--out", default=None, help="write a copy of the recording with /prsm/diagnosis messages"
+    )
+    r.add_argument(
+        "--statistics-only", action="store_true", help="window statistics only, no model"
+    )
+    _add_json(r, "every window")
+    r.set_defaults(func=_cmd_replay)
+
+    v = command("serve", "HTTP diagnostics service with asset health history (docs/service.md)")
+    v.add_argument("--host", default="127.0.0.1", help="bind address (non-loopback needs a token)")
+    v.add_argument("--port", type=int, default=8000, help="TCP port")
+    v.add_argument("--model", default=None, help="model bundle (None: the shipped model)")
+    v.add_argument("--db", default=None, help="SQLite history database (None: see docs/service.md)")
+    v.add_argument("--token", default=None, help="bearer token (None: $PRSM_HEALTH_TOKEN)")
+    v.add_argument(
+        "--workers", type=int, default=None, help="diagnoses computed at once (None: cores)"
+    )
     v.add_argument(
         "--max-window", type=_finite_float, default=2.0, help="longest JSON recording [s]"
     )
     v.add_argument(
-        "--log-level", default="info", choices=("critical", "error", "warning", "info", "debug")
+        "--log-level",
+        default="info",
+        choices=("critical", "error", "warning", "info", "debug"),
+        help="server log level",
     )
     v.set_defaults(func=_cmd_serve)
 
-    t = sub.add_parser(
-        "train", help="train the clearance estimator and fault classifier on a dataset"
-    )
-    t.add_argument("dataset", help="dataset directory (prsm-health generate)")
-    t.add_argument("--out", required=True, help="model file (.skops); metrics JSON beside it")
-    t.add_argument("--target", choices=("clearance", "fault", "both"), default="both")
-    t.add_argument("--cv", type=int, default=5, help="cross-validation folds")
-    t.add_argument("--json", action="store_true")
-    t.set_defaults(func=_cmd_train)
-
-    f = sub.add_parser("friction", help="friction torque and efficiency at start-up (paper 02)")
+    f = command("friction", "friction torque and efficiency at start-up (paper 02)")
     f.add_argument("--load", type=_finite_float, required=True, help="output axial force [N]")
     f.add_argument("--speed", type=_finite_float, default=1.0, help="final screw speed [rad/s]")
     f.add_argument("--accel-time", type=_finite_float, default=0.02, help="ramp time [s]")
     f.add_argument(
-        "--duration", type=_finite_float, default=None, help="[s], default accel-time + 0.1"
+        "--duration", type=_finite_float, default=None, help="[s] (None: accel-time + 0.1 s)"
     )
     f.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
     f.add_argument(
-        "--design", default=None, choices=sorted(PRESETS), help="default: paper 02's table"
+        "--design", default=None, choices=designs, help="design preset (None: paper 02's table)"
     )
-    f.add_argument("--json", action="store_true")
+    _add_json(f)
     f.set_defaults(func=_cmd_friction)
     return parser
 
 
-def _add_simulate_parser(sub, default_preset, presets) -> None:
+def _add_simulate_parser(command, default_preset, designs) -> None:
     from .states import LOADS, MOTIONS
 
-    s = sub.add_parser("simulate", help="simulate a PRSM run (paper 01 dynamics) and write it")
-    s.add_argument("--design", default=default_preset, choices=sorted(presets))
+    s = command("simulate", "simulate a PRSM run (paper 01 dynamics) and write it")
+    s.add_argument("--design", default=default_preset, choices=designs, help="design preset")
     s.add_argument(
         "--clearance", type=_finite_float, default=10e-6, help="thread half-clearance b [m]"
     )
     s.add_argument(
-        "--gear-clearance", type=_finite_float, default=None, help="gear backlash b_g [m]"
+        "--gear-clearance",
+        type=_finite_float,
+        default=None,
+        help="gear backlash b_g [m] (None: --clearance)",
     )
     s.add_argument("--wear-spread", type=_finite_float, default=0.0, help="uneven roller wear [-]")
     s.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
     s.add_argument("--speed", type=_finite_float, default=100.0, help="screw speed [rad/s]")
     s.add_argument("--load", type=_finite_float, default=100.0, help="resisting axial load [N]")
     s.add_argument("--profile", choices=MOTIONS, default="constant", help="screw motion profile")
-    s.add_argument("--accel-time", type=_finite_float, default=0.02, help="[s]")
+    s.add_argument(
+        "--accel-time", type=_finite_float, default=0.02, help="speed ramp and load edge [s]"
+    )
     s.add_argument("--period", type=_finite_float, default=0.1, help="reversing motion period [s]")
-    s.add_argument("--load-profile", choices=LOADS, default="constant")
-    s.add_argument("--load-amplitude", type=_finite_float, default=0.0, help="[N]")
-    s.add_argument("--load-frequency", type=_finite_float, default=20.0, help="[Hz]")
-    s.add_argument("--duration", type=_finite_float, default=0.2, help="[s]")
-    s.add_argument("--sample-rate", type=_finite_float, default=20000.0, help="[Hz]")
+    s.add_argument("--load-profile", choices=LOADS, default="constant", help="axial load profile")
+    s.add_argument(
+        "--load-amplitude", type=_finite_float, default=0.0, help="load swing around --load [N]"
+    )
+    s.add_argument(
+        "--load-frequency", type=_finite_float, default=20.0, help="load swing frequency [Hz]"
+    )
+    s.add_argument("--duration", type=_finite_float, default=0.2, help="simulated time [s]")
+    s.add_argument("--sample-rate", type=_finite_float, default=20000.0, help="output rate [Hz]")
     s.add_argument(
         "--accel-noise", type=_finite_float, default=0.0, help="RMS accelerometer noise [m/s²]"
     )
-    s.add_argument("--contact-law", choices=("linear", "hertz"), default="linear")
+    s.add_argument(
+        "--contact-law", choices=("linear", "hertz"), default="linear", help="thread flank law"
+    )
     s.add_argument("--max-step", type=_finite_float, default=5e-6, help="largest RK4 step [s]")
     s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=int, default=0, help="seed of variation, wear and noise")
     s.add_argument("--out", required=True, help="output file (.parquet or .mcap)")
-    s.add_argument("--plot", default=None, help="PNG with time traces and spectra")
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--plot", default=None, help="write a PNG with time traces and spectra")
+    _add_json(s, "a summary")
     s.set_defaults(func=_cmd_simulate)
+
+
+def _warning_line(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"warning: {message}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``prsm-health`` console script."""
+    import warnings
+
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
-        return args.func(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _warning_line  # one line per warning, no source excerpt
+            args = parser.parse_args(argv)
+            return args.func(args)
     except _UsageError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except PRSMHealthError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # output piped into head & co.: stop quietly
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

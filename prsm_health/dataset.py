@@ -527,13 +527,39 @@ def _prepare(out: Path, recipe: Recipe, formats: str) -> None:
         previous = json.loads(stamp.read_text())
         if previous.get("fingerprint") != recipe.fingerprint:
             raise PRSMHealthError(
-                f"{out} holds a dataset of another recipe ({previous.get('name')!r}); "
-                "use a new --out directory"
+                f"{out} holds a dataset of recipe {previous.get('name')!r} with other content "
+                f"({_recipe_changes(previous.get('source'), recipe.source)}); runs made with "
+                "different settings cannot be mixed: use a new --out directory or undo the edit"
             )
     else:
-        _atomic_write(stamp, json.dumps({"name": recipe.name, "fingerprint": recipe.fingerprint}))
+        _atomic_write(
+            stamp,
+            dumps(
+                {"name": recipe.name, "fingerprint": recipe.fingerprint, "source": recipe.source}
+            ),
+        )
     for stale in (out / "signals").glob("*.partial-*"):
         stale.unlink(missing_ok=True)  # a killed worker's unfinished shard
+
+
+def _recipe_changes(before: dict | None, after: dict) -> str:
+    """Which recipe keys differ, as 'key: old → new' (dotted keys for tables)."""
+    if before is None:
+        return "the directory predates change tracking"
+
+    def flat(d, prefix=""):
+        out = {}
+        for k, v in d.items():
+            out.update(flat(v, f"{prefix}{k}.") if isinstance(v, dict) else {prefix + k: v})
+        return out
+
+    a, b = flat(before), flat(after)
+    changed = [
+        f"{k}: {a.get(k, '(unset)')!r} → {b.get(k, '(unset)')!r}"
+        for k in sorted(set(a) | set(b))
+        if a.get(k) != b.get(k)
+    ]
+    return "changed " + "; ".join(changed[:5]) + (" …" if len(changed) > 5 else "")
 
 
 def _run_local(workers, recipe, out, formats, pending, finished) -> None:
@@ -546,7 +572,10 @@ def _run_local(workers, recipe, out, formats, pending, finished) -> None:
         return
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-    pool = ProcessPoolExecutor(max_workers=workers)
+    # Workers ignore SIGINT: on Ctrl-C the parent stops them at once (shards are written
+    # atomically, so a killed batch leaves no file and is redone on resume); otherwise each
+    # worker would finish its batch and start queued ones before the pool noticed.
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_ignore_sigint)
     try:
         futures = {pool.submit(run_batch, recipe.source, b, str(out), formats): b for b in pending}
         remaining = set(futures)
@@ -556,9 +585,20 @@ def _run_local(workers, recipe, out, formats, pending, finished) -> None:
                 fut.result()
                 finished(futures[fut])
     except BaseException:
+        processes = list((pool._processes or {}).values())  # no public API to stop a worker
         pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            process.terminate()
+        for process in processes:
+            process.join(timeout=2.0)
         raise
     pool.shutdown()
+
+
+def _ignore_sigint() -> None:
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _run_dask(scheduler, recipe, out, formats, pending, finished) -> None:

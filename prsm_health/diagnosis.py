@@ -1,42 +1,52 @@
-"""Diagnosis: recording → windows → indicators → estimators → Diagnosis (contract JSON).
+"""Diagnosis: recording → windows → indicators → estimators → :class:`Diagnosis`.
 
 A **model bundle** (saved by :func:`prsm_health.training.train`) holds the clearance estimator,
 the fault classifier, the indicator names they were trained on, the window length of the
 training runs and the design. :func:`diagnose` cuts a recording into windows of that length,
-computes the indicators (:mod:`prsm_health.features`) of each, and returns per window and for
-the whole recording the Diagnosis contract of ../shared/DESIGN.md::
+computes the indicators (:mod:`prsm_health.features`) of each, and returns a :class:`Diagnosis`
+for the whole recording with one per window; :func:`replay` does the same window by window
+while an MCAP recording streams. ``Diagnosis.to_json()`` is the Diagnosis contract
+(docs/formats.md)::
 
     {"clearance": {"estimate": m, "lower": m, "upper": m}, "fault_class": str,
-     "class_probabilities": {class: p}, "indicators": {name: value}, "model": {name, version}}
-
-Sources: MCAP (contract topics), a Parquet run (``simulate --out``), or a CSV with contract
-channel names and a ``time`` column [s].
+     "class_probabilities": {class: p}, "indicators": {name: value},
+     "model": {name, version, design}, "warnings": [str], "window"|"windows": …}
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from collections.abc import Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .design import PRSMDesign, preset
 from .errors import PRSMHealthError
-from .features import MIN_SAMPLES, extract_features, windows
-from .run import Run
+from .features import extract_features, windows
+from .jsonable import finite_or_none
+from .run import MIN_SAMPLES, Run
 
 #: Where the shipped default model lives (repository layout: models/ next to the package).
 DEFAULT_MODEL = Path(__file__).resolve().parents[1] / "models" / "default.skops"
+#: A recording's tail shorter than a window is diagnosed as its own window when it holds at
+#: least this fraction of a window (indicators over less are biased: fewer reversals, wider
+#: spectral bins), and reported as dropped otherwise.
+MIN_TAIL_FRACTION = 0.5
 
 
 @dataclass
 class ModelBundle:
-    """A loaded diagnosis model."""
+    """A loaded diagnosis model; ``design`` is resolved once, at load."""
 
     clearance: object | None
     fault: object | None
     feature_names: list[str]
     metadata: dict
+    design: PRSMDesign = field(init=False)
+
+    def __post_init__(self):
+        self.design = preset(self.metadata.get("design", "paper01"))
 
     @property
     def name(self) -> str:
@@ -53,9 +63,9 @@ class ModelBundle:
         """Window length the model was trained on [s]."""
         return float(self.metadata.get("window", 0.4))
 
-    @property
-    def design(self) -> str:
-        return self.metadata.get("design", "paper01")
+    def reference(self) -> dict:
+        """The ``model`` entry of a diagnosis."""
+        return {"name": self.name, "version": self.version, "design": self.design.name}
 
 
 def load_bundle(
@@ -76,50 +86,52 @@ def load_bundle(
     )
 
 
-def read_recording(path: str | Path) -> Run:
-    """A recording as a Run: ``.mcap``, ``.parquet`` (single run) or ``.csv`` (contract names)."""
-    path = Path(path)
-    if not path.exists():
-        raise PRSMHealthError(f"{path}: no such file")
-    suffix = path.suffix.lower()
-    if suffix == ".mcap":
-        from .mcap_io import read_mcap
+@dataclass
+class Diagnosis:
+    """One diagnosis, of a window or of a whole recording (then with ``windows``).
 
-        return read_mcap(path)
-    if suffix == ".parquet":
-        return Run.from_parquet(path)
-    if suffix == ".csv":
-        return _read_csv(path)
-    raise PRSMHealthError(f"{path}: unsupported file type {suffix!r} (use .mcap, .parquet or .csv)")
+    Attributes
+    ----------
+    clearance : dict
+        ``estimate``, ``lower``, ``upper`` [m] (90 % interval); None where not computable.
+    fault_class : str or None
+        The most probable class.
+    class_probabilities : dict of class → probability
+    indicators : dict of name → value (None where not computable)
+    model : dict
+        ``name``, ``version``, ``design`` of the model bundle.
+    window : dict or None
+        ``index``, ``start``, ``end`` [s] of a window diagnosis.
+    windows : list of Diagnosis
+        Per-window diagnoses of a recording diagnosis.
+    warnings : list of str
+        Sentences a person can act on (e.g. a dropped tail).
+    """
 
+    clearance: dict
+    fault_class: str | None
+    class_probabilities: dict
+    indicators: dict
+    model: dict
+    window: dict | None = None
+    windows: list[Diagnosis] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
-def _read_csv(path: Path) -> Run:
-    import pandas as pd
-
-    from .channels import CHANNEL_NAMES
-
-    try:
-        frame = pd.read_csv(path)
-    except Exception as exc:  # pandas raises many types for bad CSVs
-        raise PRSMHealthError(f"{path}: not a readable CSV ({exc})") from None
-    if "time" not in frame.columns:
-        raise PRSMHealthError(f"{path}: no 'time' column")
-    channels = {c: frame[c].to_numpy(float) for c in CHANNEL_NAMES if c in frame.columns}
-    if not channels:
-        raise PRSMHealthError(
-            f"{path}: no usable channels (expected contract names such as nut_axial_accel)"
-        )
-    time = frame["time"].to_numpy(float)
-    if len(time) < 2 or not np.all(np.diff(time) > 0):
-        raise PRSMHealthError(f"{path}: 'time' must increase strictly")
-    rate = 1.0 / float(np.median(np.diff(time)))
-    return Run(time, channels, rate)
-
-
-def _clean(value):
-    return (
-        None if value is None or (isinstance(value, float) and not math.isfinite(value)) else value
-    )
+    def to_json(self) -> dict:
+        """The Diagnosis contract as plain JSON values."""
+        out = {
+            "clearance": dict(self.clearance),
+            "fault_class": self.fault_class,
+            "class_probabilities": dict(self.class_probabilities),
+            "indicators": dict(self.indicators),
+            "model": dict(self.model),
+            "warnings": list(self.warnings),
+        }
+        if self.window is not None:
+            out["window"] = dict(self.window)
+        if self.windows:
+            out["windows"] = [w.to_json() for w in self.windows]
+        return out
 
 
 def _matrix(rows: list[dict], names: list[str]):
@@ -130,19 +142,19 @@ def _matrix(rows: list[dict], names: list[str]):
     )
 
 
-def diagnose_indicators(rows: list[dict], bundle: ModelBundle) -> list[dict]:
-    """Diagnosis contract dicts for rows of indicators (one per window)."""
+def diagnose_indicators(rows: list[dict], bundle: ModelBundle) -> list[Diagnosis]:
+    """One :class:`Diagnosis` per row of indicators (one row per window)."""
     from threadpoolctl import threadpool_limits
 
     x = _matrix(rows, bundle.feature_names)
-    n = len(rows)
     # A few rows per call: OpenMP threads in the boosted trees only add spin-wait latency, and
     # under load (the service, parallel replays) oversubscribe the cores.
     with threadpool_limits(limits=1, user_api="openmp"):
-        return _predict(rows, x, n, bundle)
+        return _predict(rows, x, bundle)
 
 
-def _predict(rows: list[dict], x, n: int, bundle: ModelBundle) -> list[dict]:
+def _predict(rows: list[dict], x, bundle: ModelBundle) -> list[Diagnosis]:
+    n = len(rows)
     estimate = lower = upper = np.full(n, np.nan)
     if bundle.clearance is not None:
         estimate = np.asarray(bundle.clearance.predict(x), float)
@@ -162,26 +174,26 @@ def _predict(rows: list[dict], x, n: int, bundle: ModelBundle) -> list[dict]:
         proba = np.asarray(bundle.fault.predict_proba(x), float)
     out = []
     for i, row in enumerate(rows):
-        probabilities = {c: float(p) for c, p in zip(classes, proba[i])} if classes else {}
+        probabilities = {c: float(p) for c, p in zip(classes, proba[i])}
         out.append(
-            {
-                "clearance": {
-                    "estimate": _clean(float(estimate[i])),
-                    "lower": _clean(float(lower[i])),
-                    "upper": _clean(float(upper[i])),
+            Diagnosis(
+                clearance={
+                    "estimate": finite_or_none(estimate[i]),
+                    "lower": finite_or_none(lower[i]),
+                    "upper": finite_or_none(upper[i]),
                 },
-                "fault_class": max(probabilities, key=probabilities.get) if probabilities else None,
-                "class_probabilities": probabilities,
-                "indicators": {k: _clean(float(v)) for k, v in row.items()},
-                "model": {"name": bundle.name, "version": bundle.version},
-            }
+                fault_class=max(probabilities, key=probabilities.get) if probabilities else None,
+                class_probabilities=probabilities,
+                indicators={k: finite_or_none(v) for k, v in row.items()},
+                model=bundle.reference(),
+            )
         )
     return out
 
 
-def aggregate(diagnoses: list[dict], bundle: ModelBundle) -> dict:
-    """One diagnosis for a recording: medians of the window estimates and bounds, mean
-    class probabilities, median indicators."""
+def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
+    """One diagnosis for a recording: medians of the window estimates and bounds, mean class
+    probabilities, median indicators; the windows attached."""
 
     def median(values):
         values = [v for v in values if v is not None]
@@ -189,98 +201,147 @@ def aggregate(diagnoses: list[dict], bundle: ModelBundle) -> dict:
 
     probs: dict[str, float] = {}
     for d in diagnoses:
-        for c, p in d["class_probabilities"].items():
+        for c, p in d.class_probabilities.items():
             probs[c] = probs.get(c, 0.0) + p / len(diagnoses)
-    names = diagnoses[0]["indicators"].keys()
-    return {
-        "clearance": {
-            k: median([d["clearance"][k] for d in diagnoses])
-            for k in ("estimate", "lower", "upper")
+    names = diagnoses[0].indicators.keys()
+    return Diagnosis(
+        clearance={
+            k: median([d.clearance[k] for d in diagnoses]) for k in ("estimate", "lower", "upper")
         },
-        "fault_class": max(probs, key=probs.get) if probs else None,
-        "class_probabilities": probs,
-        "indicators": {n: median([d["indicators"][n] for d in diagnoses]) for n in names},
-        "model": {"name": bundle.name, "version": bundle.version},
-    }
+        fault_class=max(probs, key=probs.get) if probs else None,
+        class_probabilities=probs,
+        indicators={n: median([d.indicators[n] for d in diagnoses]) for n in names},
+        model=bundle.reference(),
+        windows=list(diagnoses),
+    )
 
 
-def diagnose(run: Run, bundle: ModelBundle | None = None, *, window: float | None = None) -> dict:
-    """Diagnose a recording: the contract dict for the whole recording, plus ``windows``.
+def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:
+    """Diagnosis of one window (a :class:`Run` of about the model's window length)."""
+    return diagnose_indicators([extract_features(run, bundle.design)], bundle)[0]
+
+
+def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
+    """Windows of ``length`` seconds covering the recording, and warnings about what is not.
+
+    A recording shorter than one window (but ≥ the indicators' minimum) is one window; a tail
+    of at least :data:`MIN_TAIL_FRACTION` of a window is a last, shorter window; a shorter tail
+    is dropped with a warning.
+    """
+    n = int(round(length * run.sample_rate))
+    if len(run) < n:
+        return [run], [
+            f"recording ({run.duration:.3g} s) is shorter than the model's window ({length:g} s): "
+            "diagnosed as one short window"
+        ]
+    parts = list(windows(run, length))
+    tail = len(run) - n * len(parts)
+    notes = []
+    if tail >= max(MIN_SAMPLES, MIN_TAIL_FRACTION * n):
+        parts.append(_slice(run, len(run) - tail, len(run)))
+        notes.append(f"last window is {tail / run.sample_rate:.3g} s, shorter than {length:g} s")
+    elif tail > 0:
+        notes.append(
+            f"last {tail / run.sample_rate:.3g} s not diagnosed: shorter than half a window "
+            f"({length:g} s)"
+        )
+    return parts, notes
+
+
+def _slice(run: Run, a: int, b: int) -> Run:
+    return Run(
+        run.time[a:b], {k: v[a:b] for k, v in run.channels.items()}, run.sample_rate, run.labels
+    )
+
+
+def diagnose(
+    run: Run, bundle: ModelBundle | None = None, *, window: float | None = None
+) -> Diagnosis:
+    """Diagnose a recording: a :class:`Diagnosis` of the whole, with one per window.
 
     Parameters
     ----------
     run : Run
     bundle : ModelBundle, default the shipped model
     window : float or None [s]
-        Window length; default the model's training window. A recording shorter than one
-        window but longer than the indicators' minimum is diagnosed as one window.
+        Window length; default the model's training window (see :func:`split_windows`).
     """
     bundle = bundle or load_bundle()
-    window = window or bundle.window
-    if len(run) < MIN_SAMPLES:
-        raise PRSMHealthError(
-            f"recording too short: {len(run)} samples, need at least {MIN_SAMPLES} "
-            f"({MIN_SAMPLES / run.sample_rate:.3g} s at {run.sample_rate:g} Hz)"
-        )
-    parts = list(windows(run, window)) if len(run) >= window * run.sample_rate else [run]
+    run.validate()
+    parts, notes = split_windows(run, window or bundle.window)
     rows = [extract_features(part, bundle.design) for part in parts]
     per_window = diagnose_indicators(rows, bundle)
     for k, (part, d) in enumerate(zip(parts, per_window)):
-        d["window"] = {"index": k, "start": float(part.time[0]), "end": float(part.time[-1])}
+        d.window = {"index": k, "start": float(part.time[0]), "end": float(part.time[-1])}
     result = aggregate(per_window, bundle)
-    result["windows"] = per_window
+    result.warnings.extend(notes)
     return result
 
 
-def plot_diagnosis(result: dict, path: str | Path) -> Path:
-    """Clearance estimate with its interval per window, and class probabilities, as PNG."""
-    import matplotlib
+@dataclass
+class ReplayStep:
+    """One window of a replay: its span and its diagnosis (or plain statistics without a model)."""
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    index: int
+    start: float
+    end: float
+    diagnosis: Diagnosis | None = None
+    statistics: dict | None = None
 
-    w = result["windows"]
-    t = [d["window"]["start"] for d in w]
-    est = (
-        np.array(
-            [
-                np.nan if d["clearance"]["estimate"] is None else d["clearance"]["estimate"]
-                for d in w
-            ]
-        )
-        * 1e6
-    )
-    lo = (
-        np.array(
-            [np.nan if d["clearance"]["lower"] is None else d["clearance"]["lower"] for d in w]
-        )
-        * 1e6
-    )
-    hi = (
-        np.array(
-            [np.nan if d["clearance"]["upper"] is None else d["clearance"]["upper"] for d in w]
-        )
-        * 1e6
-    )
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
-    a1.fill_between(t, lo, hi, step="post", alpha=0.3, label="90 % interval")
-    a1.step(t, est, where="post", label="estimate")
-    a1.set_ylabel("clearance [µm]")
-    a1.legend()
-    classes = list(result["class_probabilities"])
-    for c in classes:
-        a2.step(t, [d["class_probabilities"].get(c, 0) for d in w], where="post", label=c)
-    a2.set_ylabel("class probability")
-    a2.set_xlabel("window start [s]")
-    a2.set_ylim(-0.02, 1.02)
-    a2.legend(fontsize=8)
-    c = result["clearance"]
-    fig.suptitle(
-        f"{result['fault_class']}  clearance {1e6 * (c['estimate'] or np.nan):.1f} µm "
-        f"[{1e6 * (c['lower'] or np.nan):.1f}, {1e6 * (c['upper'] or np.nan):.1f}]  model {result['model']['name']}"
-    )
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    def to_json(self) -> dict:
+        out = {"index": self.index, "start": self.start, "end": self.end}
+        if self.diagnosis is not None:
+            out["diagnosis"] = self.diagnosis.to_json()
+        if self.statistics is not None:
+            out["statistics"] = self.statistics
+        return out
+
+
+def replay(
+    path: str | Path,
+    bundle: ModelBundle | None,
+    *,
+    window: float | None = None,
+    rate: float | None = None,
+    out: str | Path | None = None,
+) -> Iterator[ReplayStep]:
+    """Stream an MCAP recording window by window through the diagnosis.
+
+    Parameters
+    ----------
+    path : MCAP recording
+    bundle : ModelBundle or None
+        None: window statistics only (no model).
+    window : float or None [s]
+        Default: the model's window, 1 s without a model.
+    rate : float or None
+        Real-time factor of the replay; None as fast as possible.
+    out : path or None
+        Write a copy of the recording with a ``/prsm/diagnosis`` message per window (needs a
+        model); written atomically when the replay completes, discarded if it fails.
+    """
+    from .mcap_io import DiagnosisWriter, iter_windows, window_statistics
+
+    length = window or (bundle.window if bundle else 1.0)
+    writer = DiagnosisWriter(path, out) if (out and bundle) else None
+    stream = iter_windows(path, length, rate=rate)
+    try:
+        for w in stream:
+            step = ReplayStep(w.index, w.start, w.end)
+            if bundle is not None:
+                step.diagnosis = diagnose_window(
+                    Run(w.time, w.channels, w.sample_rate, w.labels), bundle
+                )
+                if writer is not None:
+                    writer.add(w.end_ns, step.diagnosis.to_json())
+            else:
+                step.statistics = window_statistics(w)
+            yield step
+    except BaseException:
+        if writer is not None:
+            writer.abort()
+        raise
+    finally:
+        stream.close()
+    if writer is not None:
+        writer.close()

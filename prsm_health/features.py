@@ -35,7 +35,7 @@ from .channels import VIBRATION
 from .design import PRSMDesign, preset
 from .errors import PRSMHealthError
 from .kinematics import speed_ratios
-from .run import Run
+from .run import MIN_SAMPLES, Run, ms_hint
 from .spectra import amplitude_spectrum, dominant_frequency
 
 SHORT = {
@@ -46,7 +46,6 @@ SHORT = {
 }
 BANDS = ((50.0, 300.0), (300.0, 1000.0), (1000.0, 3000.0), (3000.0, 10000.0))
 MESH_CHANNELS = ("nut_tangential_accel", "nut_radial_x_accel")
-MIN_SAMPLES = 256
 ORDER_TRACKING_SPREAD = 0.05
 
 
@@ -169,18 +168,11 @@ def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[s
     -------
     dict of name → float, in :data:`FEATURES` order and units.
     """
-    if len(run) < MIN_SAMPLES:
-        raise PRSMHealthError(
-            f"window too short: {len(run)} samples, need at least {MIN_SAMPLES} "
-            f"({MIN_SAMPLES / run.sample_rate:.3g} s at {run.sample_rate:g} Hz)"
-        )
+    run.validate(what="window")
     if not any(ch in run.channels for ch in VIBRATION) and "nut_position" not in run.channels:
         raise PRSMHealthError(
             "no usable channels: need nut accelerations or nut position (contract names)"
         )
-    for name, values in run.channels.items():
-        if not np.all(np.isfinite(values)):
-            raise PRSMHealthError(f"channel {name} contains NaN or infinite values")
     if design is None:
         design = run.labels.get("design", "paper01")
     design = preset(design) if isinstance(design, str) else design
@@ -289,6 +281,7 @@ def windows(run: Run, length: float, hop: float | None = None):
     if n < MIN_SAMPLES:
         raise PRSMHealthError(
             f"window length {length:g} s gives {n} samples, need at least {MIN_SAMPLES}"
+            f"{ms_hint(run.sample_rate)}"
         )
     for start in range(0, len(run) - n + 1, step):
         sl = slice(start, start + n)

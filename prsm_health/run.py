@@ -8,15 +8,13 @@ as is. :meth:`Run.validate` is the one place that decides whether a recording ca
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .channels import CHANNEL_NAMES, UNITS
+from .channels import CHANNEL_NAMES
 from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
-from .jsonable import dumps
 
 #: Fewest samples a recording or window needs: below it the spectra have too few bins for the
 #: indicators (a 256-point Welch segment).
@@ -134,56 +132,17 @@ class Run:
         return pd.DataFrame(data)
 
     def to_parquet(self, path: str | Path) -> Path:
-        """Write the run as one Parquet file (atomic: temp file, then rename)."""
-        import pyarrow as pa
-        import pyarrow.parquet as pq
+        """Write the run as one Parquet file (:func:`prsm_health.io.parquet.write_run_parquet`)."""
+        from .io.parquet import write_run_parquet
 
-        path = Path(path)
-        table = pa.Table.from_pandas(self.to_frame(), preserve_index=False)
-        meta = {
-            b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
-            b"prsm_health.sample_rate": repr(float(self.sample_rate)).encode(),
-            b"prsm_health.labels": dumps(self.labels).encode(),
-            b"prsm_health.scenario": dumps(self.scenario).encode(),
-        }
-        table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
-        tmp = path.with_name(path.name + ".partial")
-        pq.write_table(table, tmp, compression="zstd")
-        tmp.replace(path)
-        return path
+        return write_run_parquet(self, path)
 
     @classmethod
     def from_parquet(cls, path: str | Path) -> Run:
-        """Read a run written by :meth:`to_parquet` (or any Parquet file with contract columns)."""
-        import pyarrow.parquet as pq
+        """Read a single-run Parquet file (:func:`prsm_health.io.parquet.read_run_parquet`)."""
+        from .io.parquet import read_run_parquet
 
-        path = Path(path)
-        try:
-            table = pq.read_table(path)
-        except FileNotFoundError:
-            raise PRSMHealthError(f"{path}: no such file") from None
-        except Exception as exc:  # pyarrow raises several types for damaged files
-            raise PRSMHealthError(f"{path}: not a readable Parquet file ({exc})") from None
-        meta = table.schema.metadata or {}
-        if "time" not in table.column_names:
-            raise PRSMHealthError(f"{path}: no 'time' column")
-        channels = {
-            name: table.column(name).to_numpy().astype(float)
-            for name in CHANNEL_NAMES
-            if name in table.column_names
-        }
-        if not channels:
-            raise PRSMHealthError(f"{path}: none of the contract channels is present")
-        time = table.column("time").to_numpy().astype(float)
-        if b"prsm_health.sample_rate" in meta:
-            rate = float(meta[b"prsm_health.sample_rate"])
-        elif len(time) > 1:
-            rate = 1.0 / float(np.median(np.diff(time)))
-        else:
-            raise PRSMHealthError(f"{path}: cannot tell the sample rate from one sample")
-        labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
-        scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
-        return cls(time, channels, rate, labels, scenario)
+        return read_run_parquet(path)
 
 
 def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str) -> np.ndarray:

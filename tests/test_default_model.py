@@ -37,7 +37,7 @@ def test_held_out_runs_of_the_reference_recipe(bundle):
     errors, inside, correct = [], 0, 0
     for spec in specs:
         scenario = spec.scenario()
-        result = diagnose(scenario.simulate(), bundle)
+        result = diagnose(scenario.simulate(), bundle).to_json()
         truth = 0.5 * (scenario.health.clearance_screw + scenario.health.clearance_nut)
         c = result["clearance"]
         errors.append(abs(c["estimate"] - truth))
@@ -79,7 +79,7 @@ def test_off_grid_speeds_and_loads_with_noise(bundle):
             1000 + k,
             options=SimulationOptions(contact_law="hertz"),
         )
-        errors.append(abs(diagnose(run, bundle)["clearance"]["estimate"] - clearance))
+        errors.append(abs(diagnose(run, bundle).clearance["estimate"] - clearance))
     assert np.mean(errors) <= 4e-6, errors
 
 
@@ -96,7 +96,7 @@ def test_interval_widens_where_the_regime_hides_clearance(bundle):
             3,
             options=SimulationOptions(contact_law="hertz"),
         )
-        c = diagnose(run, bundle)["clearance"]
+        c = diagnose(run, bundle).clearance
         return c["upper"] - c["lower"]
 
     hidden = width(OperatingProfile(duration=0.4, load=100.0))

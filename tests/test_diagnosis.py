@@ -10,8 +10,9 @@ import pytest
 from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOptions, simulate
 from prsm_health.cli import main
 from prsm_health.dataset import generate
-from prsm_health.diagnosis import diagnose, load_bundle, read_recording
+from prsm_health.diagnosis import diagnose, load_bundle
 from prsm_health.estimators import ModelVersionError
+from prsm_health.io import read_recording
 from prsm_health.mcap_io import write_mcap
 from prsm_health.training import train
 
@@ -77,7 +78,7 @@ def test_training_writes_model_and_metrics(model):
 
 def test_diagnosis_contract(model):
     bundle = load_bundle(model[0])
-    result = diagnose(recording(26e-6), bundle)
+    result = diagnose(recording(26e-6), bundle).to_json()
     assert set(result) >= {
         "clearance",
         "fault_class",
@@ -105,7 +106,7 @@ def test_small_model_orders_clearances(model):
 
     def mean_estimate(clearance):
         estimates = [
-            diagnose(recording(clearance, seed=seed), bundle)["clearance"]["estimate"]
+            diagnose(recording(clearance, seed=seed), bundle).clearance["estimate"]
             for seed in (9, 10)
         ]
         return float(np.mean(estimates))
@@ -115,7 +116,7 @@ def test_small_model_orders_clearances(model):
 
 def test_regime_gate_reports_the_trained_range_without_reversal(model):
     bundle = load_bundle(model[0])
-    steady = diagnose(recording(26e-6, load=100.0), bundle)
+    steady = diagnose(recording(26e-6, load=100.0), bundle).to_json()
     assert steady["indicators"]["lost_motion"] is None
     span = bundle.metadata["clearance_range"]
     assert [steady["clearance"]["lower"], steady["clearance"]["upper"]] == pytest.approx(span)
@@ -128,7 +129,7 @@ def test_sources_mcap_parquet_csv_agree(model, tmp_path):
     run.to_frame().to_csv(tmp_path / "r.csv", index=False)
     bundle = load_bundle(model[0])
     estimates = [
-        diagnose(read_recording(tmp_path / f"r.{ext}"), bundle)["clearance"]["estimate"]
+        diagnose(read_recording(tmp_path / f"r.{ext}"), bundle).clearance["estimate"]
         for ext in ("mcap", "parquet", "csv")
     ]
     assert estimates[0] == pytest.approx(estimates[1], rel=1e-9)

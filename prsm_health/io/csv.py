@@ -1,0 +1,50 @@
+"""CSV recordings: a header row of contract channel names, ``time`` in seconds (docs/formats.md).
+
+Every column named like a contract channel (:mod:`prsm_health.channels`) is read as that channel
+in its SI unit; other columns are ignored. Sampling must be uniform; the sample rate is
+1/median(Δt). A time column in milliseconds is the usual mistake: name it ``time_ms`` and it is
+converted, and a time axis that implies a sample rate below 100 Hz gets a hint.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..channels import CHANNEL_NAMES
+from ..errors import PRSMHealthError
+from ..run import Run, ms_hint
+
+
+def read_csv(path: str | Path) -> Run:
+    """Read a CSV recording as a :class:`~prsm_health.run.Run` (SI units)."""
+    import pandas as pd
+
+    path = Path(path)
+    try:
+        frame = pd.read_csv(path)
+    except FileNotFoundError:
+        raise PRSMHealthError(f"{path}: no such file") from None
+    except Exception as exc:  # pandas raises many types for bad CSVs
+        raise PRSMHealthError(f"{path}: not a readable CSV ({exc})") from None
+    if "time" in frame.columns:
+        time = frame["time"].to_numpy(float)
+    elif "time_ms" in frame.columns:
+        time = frame["time_ms"].to_numpy(float) / 1000.0
+    else:
+        raise PRSMHealthError(f"{path}: no 'time' column [s] (or 'time_ms' [ms])")
+    channels = {c: frame[c].to_numpy(float) for c in CHANNEL_NAMES if c in frame.columns}
+    if not channels:
+        raise PRSMHealthError(
+            f"{path}: no usable channels (expected contract names such as nut_axial_accel; "
+            f"found {', '.join(map(str, frame.columns[:8]))})"
+        )
+    if len(time) < 2 or not np.all(np.diff(time) > 0):
+        raise PRSMHealthError(f"{path}: 'time' must increase strictly")
+    rate = 1.0 / float(np.median(np.diff(time)))
+    hint = ms_hint(rate)
+    if hint:
+        warnings.warn(f"{path}: {hint.lstrip(' —')}", UserWarning, stacklevel=2)
+    return Run(time, channels, rate)

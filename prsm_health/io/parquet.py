@@ -1,0 +1,70 @@
+"""One run as a single Parquet file: ``time`` and the contract channels as columns, with the
+units, sample rate, labels and scenario in the schema metadata (docs/formats.md), so pandas,
+pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.dataset`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..channels import CHANNEL_NAMES, UNITS
+from ..errors import PRSMHealthError
+from ..jsonable import dumps
+from ..run import Run
+
+
+def write_run_parquet(run: Run, path: str | Path) -> Path:
+    """Write ``run`` to ``path`` atomically (temporary file, then rename)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    table = pa.Table.from_pandas(run.to_frame(), preserve_index=False)
+    meta = {
+        b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
+        b"prsm_health.sample_rate": repr(float(run.sample_rate)).encode(),
+        b"prsm_health.labels": dumps(run.labels).encode(),
+        b"prsm_health.scenario": dumps(run.scenario).encode(),
+    }
+    table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+    tmp = path.with_name(path.name + ".partial")
+    pq.write_table(table, tmp, compression="zstd")
+    tmp.replace(path)
+    return path
+
+
+def read_run_parquet(path: str | Path) -> Run:
+    """Read a run written by :func:`write_run_parquet`, or any Parquet file with a ``time``
+    column [s] and contract channel columns."""
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    try:
+        table = pq.read_table(path)
+    except FileNotFoundError:
+        raise PRSMHealthError(f"{path}: no such file") from None
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise PRSMHealthError(f"{path}: not a readable Parquet file ({exc})") from None
+    meta = table.schema.metadata or {}
+    if "time" not in table.column_names:
+        raise PRSMHealthError(f"{path}: no 'time' column")
+    channels = {
+        name: table.column(name).to_numpy().astype(float)
+        for name in CHANNEL_NAMES
+        if name in table.column_names
+    }
+    if not channels:
+        raise PRSMHealthError(f"{path}: none of the contract channels is present")
+    time = table.column("time").to_numpy().astype(float)
+    if b"prsm_health.sample_rate" in meta:
+        rate = float(meta[b"prsm_health.sample_rate"])
+    elif len(time) > 1:
+        rate = 1.0 / float(np.median(np.diff(time)))
+    else:
+        raise PRSMHealthError(f"{path}: cannot tell the sample rate from one sample")
+    labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
+    scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
+    return Run(time, channels, rate, labels, scenario)
