@@ -1,43 +1,69 @@
 """prsm_health — physics-based signals and health diagnostics for planetary roller screws.
 
-Public API (SI units throughout):
+Public API (SI units throughout), imported lazily so ``import prsm_health`` stays fast:
 
-- designs: :func:`preset`, :class:`PRSMDesign`
+- designs and states: :func:`preset`, :class:`PRSMDesign`, :class:`HealthState`,
+  :class:`OperatingProfile`, :class:`SensorModel`, :class:`SimulationOptions`, :class:`Scenario`
 - kinematics: :func:`speed_ratios`, :func:`characteristic_frequencies`
-- static stiffness: :mod:`prsm_health.stiffness` (gear mesh, thread/axial, electric cylinder)
-- dynamics: :func:`simulate` (design, health, profile, sensors, seed) → :class:`Run`
-- validation against the papers: :func:`prsm_health.validation.collect`
+- simulation: :func:`simulate` (design, health, profile, sensors, seed) → :class:`Run`
+- data: :class:`Dataset`, :func:`read_mcap`, :func:`write_mcap`, :func:`read_recording`
+- diagnostics: :func:`extract_features`, :func:`load_model` (a diagnosis model bundle),
+  :func:`diagnose` → :class:`Diagnosis`
+- static stiffness: :mod:`prsm_health.stiffness`; validation: :func:`prsm_health.validation.collect`
 """
 
-from .design import PRESETS, GearGeometry, MassProperties, Material, PRSMDesign, preset
-from .dynamics.model import SimulationOptions
-from .dynamics.simulate import SimulationError, simulate
-from .errors import ParameterError, PRSMHealthError
-from .kinematics import characteristic_frequencies, speed_ratios
-from .run import Run
-from .sensors import SensorModel
-from .states import HealthState, ManufacturingVariation, OperatingProfile
+from __future__ import annotations
+
+from importlib import import_module
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "PRESETS",
-    "GearGeometry",
-    "HealthState",
-    "ManufacturingVariation",
-    "OperatingProfile",
-    "Run",
-    "SensorModel",
-    "SimulationError",
-    "SimulationOptions",
-    "MassProperties",
-    "Material",
-    "PRSMDesign",
-    "ParameterError",
-    "PRSMHealthError",
-    "__version__",
-    "characteristic_frequencies",
-    "preset",
-    "simulate",
-    "speed_ratios",
-]
+#: Public name → module that defines it (relative to the package).
+_EXPORTS = {
+    "PRESETS": ".design",
+    "GearGeometry": ".design",
+    "MassProperties": ".design",
+    "Material": ".design",
+    "PRSMDesign": ".design",
+    "preset": ".design",
+    "HealthState": ".states",
+    "ManufacturingVariation": ".states",
+    "OperatingProfile": ".states",
+    "SensorModel": ".sensors",
+    "SimulationOptions": ".dynamics.model",
+    "Scenario": ".scenario",
+    "simulate": ".dynamics.simulate",
+    "Run": ".run",
+    "characteristic_frequencies": ".kinematics",
+    "speed_ratios": ".kinematics",
+    "ParameterError": ".errors",
+    "PRSMHealthError": ".errors",
+    "SimulationError": ".errors",
+    "Dataset": ".dataset",
+    "read_mcap": ".mcap_io",
+    "write_mcap": ".mcap_io",
+    "read_recording": ".io",
+    "extract_features": ".features",
+    "Diagnosis": ".diagnosis",
+    "diagnose": ".diagnosis",
+}
+#: Public names that differ from the defining module's name for them.
+_ALIASES = {"load_model": (".diagnosis", "load_bundle")}
+
+__all__ = sorted([*_EXPORTS, *_ALIASES, "__version__"])
+
+
+def __getattr__(name: str):
+    if name in _EXPORTS:
+        module, attr = _EXPORTS[name], name
+    elif name in _ALIASES:
+        module, attr = _ALIASES[name]
+    else:
+        raise AttributeError(f"module 'prsm_health' has no attribute {name!r}")
+    value = getattr(import_module(module, __name__), attr)
+    globals()[name] = value  # next access skips this hook
+    return value
+
+
+def __dir__():
+    return __all__
