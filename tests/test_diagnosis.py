@@ -7,7 +7,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOptions, simulate
 from prsm_health.cli import main
 from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle
@@ -40,10 +39,6 @@ RECIPE = textwrap.dedent(
     """
 )
 
-REVERSING = dict(
-    load=0.0, load_profile="reversing", load_amplitude=300.0, load_frequency=10.0, accel_time=0.002
-)
-
 
 @pytest.fixture(scope="module")
 def model(tmp_path_factory):
@@ -53,17 +48,6 @@ def model(tmp_path_factory):
     generate(recipe, root / "ds", workers=2, progress=False)
     metrics = train(root / "ds", root / "model.skops", cv=2, progress=False)
     return root / "model.skops", metrics
-
-
-def recording(clearance, duration=0.4, seed=9, **profile):
-    return simulate(
-        "paper01",
-        HealthState.uniform(clearance),
-        OperatingProfile(duration=duration, **(profile or REVERSING)),
-        SensorModel(),
-        seed,
-        options=SimulationOptions(contact_law="hertz"),
-    )
 
 
 def test_training_writes_model_and_metrics(model):
@@ -76,9 +60,9 @@ def test_training_writes_model_and_metrics(model):
     assert {"mesh", "axial_frequency", "lost_motion"} <= groups
 
 
-def test_diagnosis_contract(model):
+def test_diagnosis_contract(model, reversing_run):
     bundle = load_bundle(model[0])
-    result = diagnose(recording(26e-6), bundle).to_json()
+    result = diagnose(reversing_run(26e-6), bundle).to_json()
     assert set(result) >= {
         "clearance",
         "fault_class",
@@ -96,7 +80,7 @@ def test_diagnosis_contract(model):
     json.dumps(result, allow_nan=False)  # plain JSON (NaN indicators become null)
 
 
-def test_small_model_orders_clearances(model):
+def test_small_model_orders_clearances(model, reversing_run):
     # Accuracy belongs to the shipped model (tests/test_default_model.py, 400 training runs):
     # a 32-run model is biased by several µm, and an impact-dominated recording differs sample
     # by sample on another CPU, so one estimate is no test. What must hold on any machine: two
@@ -106,7 +90,7 @@ def test_small_model_orders_clearances(model):
 
     def mean_estimate(clearance):
         estimates = [
-            diagnose(recording(clearance, seed=seed), bundle).clearance["estimate"]
+            diagnose(reversing_run(clearance, seed=seed), bundle).clearance["estimate"]
             for seed in (9, 10)
         ]
         return float(np.mean(estimates))
@@ -114,16 +98,16 @@ def test_small_model_orders_clearances(model):
     assert mean_estimate(30e-6) - mean_estimate(6e-6) > 12e-6
 
 
-def test_regime_gate_reports_the_trained_range_without_reversal(model):
+def test_regime_gate_reports_the_trained_range_without_reversal(model, reversing_run):
     bundle = load_bundle(model[0])
-    steady = diagnose(recording(26e-6, load=100.0), bundle).to_json()
+    steady = diagnose(reversing_run(26e-6, load=100.0, load_profile="constant"), bundle).to_json()
     assert steady["indicators"]["lost_motion"] is None
     span = bundle.metadata["clearance_range"]
     assert [steady["clearance"]["lower"], steady["clearance"]["upper"]] == pytest.approx(span)
 
 
-def test_sources_mcap_parquet_csv_agree(model, tmp_path):
-    run = recording(10e-6)
+def test_sources_mcap_parquet_csv_agree(model, tmp_path, reversing_run):
+    run = reversing_run(10e-6)
     write_mcap(run, tmp_path / "r.mcap")
     run.to_parquet(tmp_path / "r.parquet")
     run.to_frame().to_csv(tmp_path / "r.csv", index=False)
@@ -136,14 +120,14 @@ def test_sources_mcap_parquet_csv_agree(model, tmp_path):
     assert estimates[2] == pytest.approx(estimates[1], rel=1e-6)  # CSV: 17-digit text
 
 
-def test_bad_inputs(model, tmp_path, capsys):
+def test_bad_inputs(model, tmp_path, capsys, reversing_run):
     path = str(model[0])
-    run = recording(10e-6, duration=0.01)
+    run = reversing_run(10e-6, duration=0.01)
     run.to_parquet(tmp_path / "short.parquet")
     pd.DataFrame({"time": np.arange(5000) / 2e4, "temperature": np.ones(5000)}).to_csv(
         tmp_path / "nochan.csv", index=False
     )
-    frame = recording(10e-6).to_frame()
+    frame = reversing_run(10e-6).to_frame()
     frame.loc[100, "nut_axial_accel"] = np.nan
     frame.to_csv(tmp_path / "nan.csv", index=False)
     cases = [
@@ -164,20 +148,20 @@ def test_bad_inputs(model, tmp_path, capsys):
         )
 
 
-def test_model_from_another_version(model, tmp_path, capsys, monkeypatch):
+def test_model_from_another_version(model, tmp_path, capsys, monkeypatch, reversing_run):
     import prsm_health.estimators as est
 
     monkeypatch.setattr(est, "_package_version", lambda: "9.9.0")
     with pytest.raises(ModelVersionError):
         load_bundle(model[0])
-    recording(10e-6).to_parquet(tmp_path / "r.parquet")
+    reversing_run(10e-6).to_parquet(tmp_path / "r.parquet")
     assert main(["diagnose", str(tmp_path / "r.parquet"), "--model", str(model[0])]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "9.9.0" in err and len(err.strip().splitlines()) == 1
 
 
-def test_cli_diagnose_plot_and_replay_with_diagnosis(model, tmp_path, capsys):
-    run = recording(18e-6, duration=0.6)
+def test_cli_diagnose_plot_and_replay_with_diagnosis(model, tmp_path, capsys, reversing_run):
+    run = reversing_run(18e-6, duration=0.6)
     write_mcap(run, tmp_path / "r.mcap")
     assert (
         main(
