@@ -26,7 +26,7 @@ Readings of ambiguous terms (stated in docs/validation.md):
 
 References
 ----------
-Paper 02: ../shared/papers/02-friction-torque-efficiency.txt — sliding velocity v_sr0, F_fs1,
+Paper 02 (docs/references.md) — sliding velocity v_sr0, F_fs1,
 F_fs2, M_fs3, Lagrangian L, generalised forces Q_s, Q_R, efficiencies η(t) and η_overall,
 parameter and results tables.
 """
@@ -40,7 +40,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .design import PRSMDesign
-from .errors import require, require_positive, require_range
+from .errors import ConvergenceError, require, require_positive, require_range
 
 
 @dataclass(frozen=True)
@@ -357,7 +357,11 @@ def simulate_friction(
             max_step=(t1 - t0) / 50,
         )
         if not sol.success:  # pragma: no cover - Radau on a 2-state system does not fail
-            raise RuntimeError(sol.message)
+            raise ConvergenceError(
+                f"friction: Radau integration of the roller revolution speed did not converge "
+                f"on t = [{t0:.6g}, {t1:.6g}] s for load = {load:.6g} N, speed = {speed:.6g} "
+                f"rad/s, accel_time = {accel_time:.6g} s: {sol.message}"
+            )
         # each sample belongs to one segment; the ramp corner starts the second one
         mask = (time >= t0) & ((time < t1) | (t1 == duration))
         w_r[mask] = sol.sol(time[mask])[1]

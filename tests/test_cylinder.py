@@ -1,7 +1,7 @@
 """Electric-cylinder deformation model (paper 05) against closed forms, limits and the paper.
 
 Paper numbers asserted here are only those the paper does not contradict (see
-../shared/notes/paper-consistency.md and prsm_health/validation/paper05.py).
+docs/validation.md and prsm_health/validation/paper05.py).
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from prsm_health.stiffness.cylinder import (
     total_deformation,
     yamamoto_thread_terms,
 )
+from prsm_health.stiffness.thread_compliance import yamamoto_terms
 from prsm_health.validation import NOT_REPRODUCED, REPRODUCED, paper05
 
 MM = 1e-3
@@ -256,6 +257,15 @@ def test_yamamoto_terms_properties():
     assert root_shear > 0 and radial > 0
     # Radial term = (1 − ν)(d/P) tan²β/(2E): thin closed form.
     assert radial == pytest.approx((1 - 0.27) * 36 / (2 * 200e9), rel=1e-12)
+
+
+def test_yamamoto_has_one_implementation():
+    # The cylinder's terms are the thread model's dimensionless terms for a sharp V tooth
+    # (a = P, b = a/2, c = (a/4)·cot β_Y) divided by E, bit for bit.
+    e, nu, flank, p, d = 200e9, 0.27, math.radians(40), 1.5e-3, 36e-3
+    a, c = p, 0.25 * p * (1.0 / math.tan(flank))
+    expected = tuple(t / e for t in yamamoto_terms(p, a, a / 2, c, flank, nu, 1 - nu, d))
+    assert yamamoto_thread_terms(e, nu, flank, p, d, 1 - nu) == expected
 
 
 def test_thread_radial_term_is_lame(cyl, coef):

@@ -1,12 +1,14 @@
 """Friction torque and efficiency (paper 02) under the stated reading, and physical invariants."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from prsm_health import friction
 from prsm_health.design import preset
-from prsm_health.errors import ParameterError
+from prsm_health.errors import ConvergenceError, ParameterError
 from prsm_health.friction import (
     FrictionParameters,
     simulate_friction,
@@ -18,7 +20,7 @@ P = FrictionParameters.paper02()
 
 
 def test_paper02_derived_quantities():
-    # ../shared/notes/paper-consistency.md: p_s = 0.79577 mm/rad, ψ = 4.550°, G = −2 with the
+    # docs/validation.md (paper 02): p_s = 0.79577 mm/rad, ψ = 4.550°, G = −2 with the
     # printed radii, F_n = 94.58 N at 1000 N (exact formulas, rounding of the printed digits).
     assert P.lead_per_radian == pytest.approx(0.79577e-3, rel=1e-5)
     assert math.degrees(P.lead_angle) == pytest.approx(4.550, abs=5e-4)
@@ -89,3 +91,11 @@ def test_from_design_and_errors():
         simulate_friction(P, 100.0, 1.0, 0.05, duration=0.01)
     with pytest.raises(ParameterError, match="friction.nut_radius"):
         FrictionParameters(nut_radius=1e-3)
+
+
+def test_integration_failure_is_a_convergence_error(monkeypatch):
+    monkeypatch.setattr(
+        friction, "solve_ivp", lambda *a, **k: SimpleNamespace(success=False, message="stiff")
+    )
+    with pytest.raises(ConvergenceError, match=r"friction: Radau.*load = 1000 N.*stiff"):
+        simulate_friction(P, 1000.0, 100.0, 0.05)

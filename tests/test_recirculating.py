@@ -1,19 +1,21 @@
 """Recirculating PRSM (paper 03): design rules, kinematics with resets, reset contact force.
 
-Reference values: ../shared/papers/03-recirculating-prsm-design-dynamics.txt and
-../shared/notes/paper-consistency.md ("03 recirculating PRSM"). The ``paper03`` preset is the
+Reference values: paper 03 (docs/references.md) and docs/validation.md ("Paper 03 —
+recirculating PRSM"). The ``paper03`` preset is the
 reconstructed geometry (orbit radius 19.75 mm, d_s = 32, d_r = 7.5, d_n = 47 mm, 12 rollers,
 1 mm single-start pitch, α = 90°); Table 1 is not printed.
 """
 
+import importlib
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from prsm_health import recirculating as rc
 from prsm_health.design import preset, printed_eq14_limit, recirculating_roller_limit
-from prsm_health.errors import ParameterError
+from prsm_health.errors import ConvergenceError, ParameterError
 
 W_S = 40 * math.pi  # §4.2: "a constant speed 40π rad/s"
 RUN = 0.1  # §4.2: simulation time 0.1 s
@@ -337,3 +339,25 @@ def test_force_series_has_one_pulse_per_reset(design, geometry, sample_rate):
 def test_zero_speed_gives_zero_signal(design):
     s = rc.reset_force_series(design, None, 0.0, 0.01, 10_000.0)
     assert not np.any(s.normal_force) and s.pulse is None and s.peak_force == 0.0
+
+
+# ------------------------------------------------------------------ package layout
+def test_package_reexports_every_public_name():
+    for sub in ("geometry", "motion", "impact"):
+        module = importlib.import_module(f"prsm_health.recirculating.{sub}")
+        for name in dir(module):
+            obj = getattr(module, name)
+            if not name.startswith("_") and getattr(obj, "__module__", None) == module.__name__:
+                assert getattr(rc, name) is obj, name
+                assert name in rc.__all__, name
+    # The function, not the submodule of the same name, as before the split.
+    assert callable(rc.motion) and rc.motion.__module__ == "prsm_health.recirculating.motion"
+
+
+def test_reset_pulse_failure_is_a_convergence_error(design, monkeypatch):
+    impact = importlib.import_module("prsm_health.recirculating.impact")
+    monkeypatch.setattr(
+        impact, "solve_ivp", lambda *a, **k: SimpleNamespace(success=False, message="stiff")
+    )
+    with pytest.raises(ConvergenceError, match=r"reset pulse.*screw_speed = 125\.664.*stiff"):
+        rc.reset_pulse(design, W_S)

@@ -1,11 +1,14 @@
-"""Thread contact geometry, load distribution and PRSM axial stiffness (stiffness/thread.py).
+"""Thread contact geometry, load distribution and PRSM axial stiffness (stiffness/thread.py
+and the modules it re-exports: thread_geometry, thread_compliance, thread_load, clearance,
+axial).
 
 Checks are against closed forms (paper 05's curvatures, Yamamoto's tooth terms), independent
 numerical methods (height-function fit, quadrature, finite differences), analytical limits
 (Hertz exponents, rigid bodies, equal gaps) and physical bounds. No paper-04 table value is
-asserted: the paper contradicts itself (../shared/notes/paper-consistency.md).
+asserted: the paper contradicts itself (docs/validation.md).
 """
 
+import importlib
 import math
 
 import numpy as np
@@ -13,7 +16,7 @@ import pytest
 from scipy.integrate import quad
 
 from prsm_health.design import preset
-from prsm_health.errors import ParameterError
+from prsm_health.errors import ConvergenceError, ParameterError
 from prsm_health.stiffness import thread as th
 from prsm_health.validation import NOT_REPRODUCED, REPRODUCED
 from prsm_health.validation import paper04 as v04
@@ -496,6 +499,34 @@ def test_errors_name_the_field(call, field):
     with pytest.raises(ParameterError) as info:
         call()
     assert info.value.field == field
+
+
+def test_newton_failure_is_a_convergence_error(monkeypatch):
+    thread_load = importlib.import_module("prsm_health.stiffness.thread_load")
+    monkeypatch.setattr(thread_load, "_NEWTON_MAXITER", 0)
+    with pytest.raises(
+        ConvergenceError,
+        match=r"thread load distribution: Newton .* roller load W = \[5, 2000\] N .*'paper01'",
+    ):
+        th.thread_load_distribution(P01, [5.0, 2000.0])
+
+
+def test_common_approach_failure_is_a_convergence_error(monkeypatch):
+    axial = importlib.import_module("prsm_health.stiffness.axial")
+    monkeypatch.setattr(axial, "_APPROACH_MAXITER", 0)
+    with pytest.raises(ConvergenceError, match=r"common approach .* F = 1000 N with roller gaps"):
+        th.axial_stiffness(P04, 1000.0, eccentricity=5e-6)
+
+
+# ============================================================================ layout
+def test_front_reexports_every_public_name():
+    for sub in ("thread_geometry", "thread_compliance", "thread_load", "clearance", "axial"):
+        module = importlib.import_module(f"prsm_health.stiffness.{sub}")
+        for name in dir(module):
+            obj = getattr(module, name)
+            if not name.startswith("_") and getattr(obj, "__module__", None) == module.__name__:
+                assert getattr(th, name) is obj, name
+                assert name in th.__all__, name
 
 
 # ============================================================================ validation

@@ -44,11 +44,15 @@ import numpy as np
 
 from ..design import PRSMDesign
 from ..errors import require, require_positive, require_range
+from ..friction import FrictionParameters
 from ..kinematics import speed_ratios
 from ..states import HealthState, ManufacturingVariation, OperatingProfile
 from . import layout as L
 
 CONTACT_LAWS = ("linear", "hertz")
+
+#: Paper 02's friction table, the one source of the simulator's Coulomb and rolling defaults.
+_PAPER02_FRICTION = FrictionParameters.paper02()
 
 
 @dataclass(frozen=True)
@@ -99,8 +103,8 @@ class SimulationOptions:
     variation: ManufacturingVariation = field(default_factory=ManufacturingVariation)
     contact_damping_ratio: float = 0.03
     support_damping_ratio: float = 0.05
-    friction_coefficient: float = 0.1
-    rolling_friction: float = 1.5e-6
+    friction_coefficient: float = _PAPER02_FRICTION.sliding
+    rolling_friction: float = _PAPER02_FRICTION.rolling
     viscous_friction: float = 25.0
     traction_stiffness_ratio: float = 0.82
     screw_support_stiffness: float = 1e8

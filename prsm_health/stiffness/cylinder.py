@@ -54,7 +54,7 @@ Belt (Δl8)
 
 References
 ----------
-- Paper 05: ../shared/papers/05-electric-cylinder-accuracy.txt — the Δl1…Δl8 formulas, the
+- Paper 05 (docs/references.md) — the Δl1…Δl8 formulas, the
   parameter table, the printed Δl(F, x), the stiffness table and the influence coefficients.
 - A. Palmgren, *Ball and Roller Bearing Engineering*, 1959 (via T. A. Harris, *Rolling
   Bearing Analysis*): line-contact approach δ = 3.84e-5·Q^0.9/l^0.8 [mm, N, mm].
@@ -73,6 +73,7 @@ import numpy as np
 from ..design import PRSMDesign, preset
 from ..errors import ParameterError, require, require_positive, require_range
 from .hertz import HertzContact, effective_modulus
+from .thread_compliance import yamamoto_terms
 
 #: Component names, in the paper's order Δl1 … Δl8.
 COMPONENTS = (
@@ -440,38 +441,19 @@ def yamamoto_thread_terms(
     slightly negative (the radial load component's moment outweighs the axial one), as it is
     in the paper's γ1 (4 ln 2 − 3 < 0).
 
+    The formulas are :func:`prsm_health.stiffness.thread_compliance.yamamoto_terms` (the one
+    implementation, shared with the PRSM thread model) evaluated for this tooth and divided
+    by E.
+
     References
     ----------
     Yamamoto (1980); paper 05, γ1S…γ5S and γ1N…γ5N.
     """
-    e, nu, beta = youngs_modulus, poisson_ratio, flank_angle
-    tan_b = math.tan(beta)
-    cot_b = 1.0 / tan_b
     a = THREAD_ROOT_WIDTH_OVER_PITCH * pitch
     b = THREAD_LOAD_WIDTH_OVER_ROOT * a
-    c = 0.25 * a * cot_b
-    bending = (
-        (1 - nu**2)
-        * 3.0
-        / (4.0 * e)
-        * (
-            (1.0 - (2.0 - b / a) ** 2 + 2.0 * math.log(a / b)) * cot_b**3
-            - 4.0 * (c / a) ** 2 * tan_b
-        )
-    )
-    shear = (1 + nu) * 6.0 / (5.0 * e) * cot_b * math.log(a / b)
-    root_moment = (1 - nu**2) * 12.0 / (math.pi * e) * (c / a) * (c / a - b / (2.0 * a) * tan_b)
-    root_shear = (
-        (1 - nu**2)
-        * 2.0
-        / (math.pi * e)
-        * (
-            (pitch / a) * math.log((pitch + a / 2) / (pitch - a / 2))
-            + 0.5 * math.log(4 * pitch**2 / a**2 - 1)
-        )
-    )
-    radial = radial_factor * (diameter / pitch) * tan_b**2 / (2.0 * e)
-    return bending, shear, root_moment, root_shear, radial
+    c = 0.25 * a * (1.0 / math.tan(flank_angle))
+    terms = yamamoto_terms(pitch, a, b, c, flank_angle, poisson_ratio, radial_factor, diameter)
+    return tuple(t / youngs_modulus for t in terms)
 
 
 def contact_pair(cyl: ElectricCylinder) -> tuple[HertzContact, HertzContact]:
