@@ -276,7 +276,7 @@ def _rate(text: str) -> float | None:
 def _cmd_replay(args) -> int:
     import warnings
 
-    from .mcap_io import DiagnosisWriter, TruncatedRecordingWarning, iter_windows, window_statistics
+    from .mcap import DiagnosisWriter, TruncatedRecordingWarning, iter_windows, window_statistics
 
     bundle = None
     if not args.statistics_only:
@@ -481,7 +481,7 @@ def _cmd_simulate(args) -> int:
         design, health, profile, sensors, args.seed, options=options, progress=not args.json
     )
     if out.suffix == ".mcap":
-        from .mcap_io import write_mcap
+        from .mcap import write_mcap
 
         write_mcap(run, out)
     else:
