@@ -441,7 +441,7 @@ def _cmd_simulate(args) -> int:
     run = scenario.simulate(progress=not args.json)
     design, profile = scenario.design, scenario.profile
     if out.suffix == ".mcap":
-        from .mcap_io import write_mcap
+        from .mcap import write_mcap
 
         write_mcap(run, out)
     else:

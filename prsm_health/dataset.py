@@ -388,7 +388,7 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
         label = spec.labels(run)
         run.labels = dict(run.labels, **label)
         if formats in ("mcap", "both"):
-            from .mcap_io import write_mcap
+            from .mcap import write_mcap
 
             write_mcap(run, _mcap_path(out, run_id))
         columns = {

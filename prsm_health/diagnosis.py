@@ -320,7 +320,7 @@ def replay(
         Write a copy of the recording with a ``/prsm/diagnosis`` message per window (needs a
         model); written atomically when the replay completes, discarded if it fails.
     """
-    from .mcap_io import DiagnosisWriter, iter_windows, window_statistics
+    from .mcap import DiagnosisWriter, iter_windows, window_statistics
 
     length = window or (bundle.window if bundle else 1.0)
     writer = DiagnosisWriter(path, out) if (out and bundle) else None

@@ -1149,7 +1149,7 @@ def create_app(
         if upload.path is None or upload.file_bytes == 0:
             raise _HTTPError(422, "no recording: send the file in the multipart field 'file'")
         _precheck_upload(upload.path, upload.suffix, limits)
-        from .mcap_io import TruncatedRecordingWarning
+        from .mcap import TruncatedRecordingWarning
 
         with warnings_lock, warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", TruncatedRecordingWarning)

@@ -201,7 +201,7 @@ def test_shipped_recipes_parse():
 
 
 def test_generate_both_formats(recipe_path, tmp_path):
-    from prsm_health.mcap_io import read_mcap
+    from prsm_health.mcap import read_mcap
 
     generate(recipe_path, tmp_path / "m", workers=1, formats="both", progress=False)
     files = sorted((tmp_path / "m" / "mcap").glob("run-*.mcap"))

@@ -12,7 +12,7 @@ from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle
 from prsm_health.estimators import ModelVersionError
 from prsm_health.io import read_recording
-from prsm_health.mcap_io import write_mcap
+from prsm_health.mcap import write_mcap
 from prsm_health.training import train
 
 RECIPE = textwrap.dedent(

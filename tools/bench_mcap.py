@@ -31,7 +31,7 @@ from mcap.reader import make_reader
 from mcap.writer import Writer
 
 from prsm_health.channels import CHANNEL_NAMES
-from prsm_health.mcap_io import TOPIC_FIELDS, iter_windows, read_mcap, write_mcap
+from prsm_health.mcap import TOPIC_FIELDS, iter_windows, read_mcap, write_mcap
 from prsm_health.run import Run
 
 

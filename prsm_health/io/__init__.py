@@ -24,7 +24,7 @@ def read_recording(path: str | Path):
         raise PRSMHealthError(f"{path}: no such file")
     suffix = path.suffix.lower()
     if suffix == ".mcap":
-        from ..mcap_io import read_mcap
+        from ..mcap import read_mcap
 
         return read_mcap(path)
     if suffix == ".parquet":

@@ -13,22 +13,24 @@ from mcap.records import Chunk, Footer, MessageIndex, SummaryOffset
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, IndexType, Writer
 
-from prsm_health import mcap_io
 from prsm_health.channels import CHANNEL_NAMES, UNITS
 from prsm_health.errors import PRSMHealthError
-from prsm_health.mcap_io import (
+from prsm_health.mcap import (
     TOPIC_DIAGNOSIS,
     TOPIC_DRIVE,
     TOPIC_FIELDS,
     TOPIC_NUT_ACCEL,
     DiagnosisWriter,
     TruncatedRecordingWarning,
+    Window,
+    _container,
     iter_windows,
     read_mcap,
     window_statistics,
     write_diagnosis_mcap,
     write_mcap,
 )
+from prsm_health.mcap import writer as mcap_writer
 from prsm_health.run import Run
 
 FS = 20_000.0
@@ -191,7 +193,7 @@ def test_write_errors(tmp_path, run):
 
 def test_blockwise_write_gives_the_same_file(tmp_path, run, monkeypatch):
     whole = write_mcap(run, tmp_path / "whole.mcap", chunk_size=10_000).read_bytes()
-    monkeypatch.setattr(mcap_io, "_WRITE_BLOCK", 333)  # long runs are formatted in blocks
+    monkeypatch.setattr(mcap_writer, "_WRITE_BLOCK", 333)  # long runs are formatted in blocks
     blocks = write_mcap(run, tmp_path / "blocks.mcap", chunk_size=10_000).read_bytes()
     assert blocks == whole
 
@@ -209,7 +211,7 @@ def test_write_is_atomic(tmp_path, run, monkeypatch):
     def interrupted(self):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(mcap_io._FileWriter, "finish", interrupted)
+    monkeypatch.setattr(_container._FileWriter, "finish", interrupted)
     with pytest.raises(KeyboardInterrupt):
         write_mcap(run, path)
     assert path.read_bytes() == b"previous content"
@@ -618,7 +620,7 @@ def test_window_parameters(mcap_file, tmp_path):
 
 def test_window_statistics(run):
     t = run.time
-    window = mcap_io.Window(
+    window = Window(
         index=0,
         start=0.0,
         end=0.1,
