@@ -169,6 +169,48 @@ def test_killed_process_resumes_without_duplicates_or_holes(recipe_path, tmp_pat
     pd.testing.assert_frame_equal(signals, _signals(reference))
 
 
+def test_ctrl_c_stops_the_workers(tmp_path):
+    # Ctrl-C reaches the whole process group; the workers ignore it and the parent stops them,
+    # so no shard is written after the command has returned (it used to finish the running and
+    # queued batches: 4 more shards). Behaviour only: the time to stop is measured in the docs.
+    recipe = tmp_path / "slow.toml"
+    recipe.write_text(
+        TINY.replace("duration = 0.02", "duration = 0.3").replace(
+            "batch_size = 2", "batch_size = 1"
+        )
+    )
+    out = tmp_path / "c"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "prsm_health.cli",
+            "generate",
+            str(recipe),
+            "--out",
+            str(out),
+            "--workers",
+            "2",
+        ],
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.time() + 300
+    while time.time() < deadline and not list((out / "signals").glob("part-*.parquet")):
+        time.sleep(0.05)
+    at_signal = len(list((out / "signals").glob("part-*.parquet")))
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130 and "run the same command to resume" in err
+    time.sleep(2.0)  # a surviving worker would finish a 0.3 s run and write its shard by now
+    written_after = len(list((out / "signals").glob("part-*.parquet"))) - at_signal
+    # ≤ 1: a shard being renamed at the instant of the signal is complete and kept; the old
+    # behaviour wrote one per worker plus the queued batches (3–4 here).
+    assert written_after <= 1, written_after
+
+
 def test_dask_local_cluster_same_dataset(recipe_path, tmp_path):
     from distributed import Client, LocalCluster
 
@@ -185,12 +227,18 @@ def test_dask_local_cluster_same_dataset(recipe_path, tmp_path):
 
 def test_other_recipe_in_same_directory_refused(recipe_path, tmp_path):
     generate(recipe_path, tmp_path / "x", workers=1, progress=False)
-    other = tmp_path / "other.toml"
-    other.write_text(TINY.replace('name = "tiny"', 'name = "other"'))
     from prsm_health.errors import PRSMHealthError
 
-    with pytest.raises(PRSMHealthError, match="another recipe"):
-        generate(other, tmp_path / "x", workers=1, progress=False)
+    # Another recipe, or the same recipe edited: the message names what differs.
+    for old, new, change in (
+        ('name = "tiny"', 'name = "other"', "name: 'tiny' → 'other'"),
+        ("speed = [80.0]", "speed = [90.0]", "sweep.speed: [80.0] → [90.0]"),
+    ):
+        edited = tmp_path / "edited.toml"
+        edited.write_text(TINY.replace(old, new))
+        with pytest.raises(PRSMHealthError) as err:
+            generate(edited, tmp_path / "x", workers=1, progress=False)
+        assert change in str(err.value) and "new --out directory" in str(err.value)
 
 
 def test_shipped_recipes_parse():
