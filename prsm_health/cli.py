@@ -445,7 +445,9 @@ def _cmd_simulate(args) -> int:
 
         write_mcap(run, out)
     else:
-        run.to_parquet(out)
+        from .io.parquet import write_run_parquet
+
+        write_run_parquet(run, out)
     mesh = characteristic_frequencies(design, args.speed).gear_mesh
     if args.plot:
         from .plots import plot_run

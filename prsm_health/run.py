@@ -9,7 +9,6 @@ as is. :meth:`Run.validate` is the one place that decides whether a recording ca
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -130,19 +129,6 @@ class Run:
         data = {"time": self.time}
         data.update({name: self.channels[name] for name in CHANNEL_NAMES if name in self.channels})
         return pd.DataFrame(data)
-
-    def to_parquet(self, path: str | Path) -> Path:
-        """Write the run as one Parquet file (:func:`prsm_health.io.parquet.write_run_parquet`)."""
-        from .io.parquet import write_run_parquet
-
-        return write_run_parquet(self, path)
-
-    @classmethod
-    def from_parquet(cls, path: str | Path) -> Run:
-        """Read a single-run Parquet file (:func:`prsm_health.io.parquet.read_run_parquet`)."""
-        from .io.parquet import read_run_parquet
-
-        return read_run_parquet(path)
 
 
 def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str) -> np.ndarray:

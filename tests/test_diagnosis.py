@@ -12,6 +12,7 @@ from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle
 from prsm_health.estimators import ModelVersionError
 from prsm_health.io import read_recording
+from prsm_health.io.parquet import write_run_parquet
 from prsm_health.mcap import write_mcap
 from prsm_health.training import train
 
@@ -109,7 +110,7 @@ def test_regime_gate_reports_the_trained_range_without_reversal(model, reversing
 def test_sources_mcap_parquet_csv_agree(model, tmp_path, reversing_run):
     run = reversing_run(10e-6)
     write_mcap(run, tmp_path / "r.mcap")
-    run.to_parquet(tmp_path / "r.parquet")
+    write_run_parquet(run, tmp_path / "r.parquet")
     run.to_frame().to_csv(tmp_path / "r.csv", index=False)
     bundle = load_bundle(model[0])
     estimates = [
@@ -123,7 +124,7 @@ def test_sources_mcap_parquet_csv_agree(model, tmp_path, reversing_run):
 def test_bad_inputs(model, tmp_path, capsys, reversing_run):
     path = str(model[0])
     run = reversing_run(10e-6, duration=0.01)
-    run.to_parquet(tmp_path / "short.parquet")
+    write_run_parquet(run, tmp_path / "short.parquet")
     pd.DataFrame({"time": np.arange(5000) / 2e4, "temperature": np.ones(5000)}).to_csv(
         tmp_path / "nochan.csv", index=False
     )
@@ -154,7 +155,7 @@ def test_model_from_another_version(model, tmp_path, capsys, monkeypatch, revers
     monkeypatch.setattr(est, "_package_version", lambda: "9.9.0")
     with pytest.raises(ModelVersionError):
         load_bundle(model[0])
-    reversing_run(10e-6).to_parquet(tmp_path / "r.parquet")
+    write_run_parquet(reversing_run(10e-6), tmp_path / "r.parquet")
     assert main(["diagnose", str(tmp_path / "r.parquet"), "--model", str(model[0])]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "9.9.0" in err and len(err.strip().splitlines()) == 1

@@ -10,7 +10,7 @@ import pytest
 from prsm_health import HealthState, OperatingProfile, SensorModel, simulate
 from prsm_health.channels import CHANNEL_NAMES, UNITS
 from prsm_health.errors import PRSMHealthError
-from prsm_health.run import Run
+from prsm_health.io.parquet import read_run_parquet, write_run_parquet
 
 
 @pytest.fixture(scope="module")
@@ -19,8 +19,8 @@ def run():
 
 
 def test_round_trip_exact(tmp_path, run):
-    path = run.to_parquet(tmp_path / "run.parquet")
-    back = Run.from_parquet(path)
+    path = write_run_parquet(run, tmp_path / "run.parquet")
+    back = read_run_parquet(path)
     assert back.sample_rate == run.sample_rate
     assert np.array_equal(back.time, run.time)
     for name in CHANNEL_NAMES:
@@ -29,7 +29,7 @@ def test_round_trip_exact(tmp_path, run):
 
 
 def test_independent_readers(tmp_path, run):
-    path = run.to_parquet(tmp_path / "run.parquet")
+    path = write_run_parquet(run, tmp_path / "run.parquet")
     frame = pd.read_parquet(path)
     assert list(frame.columns) == ["time", *CHANNEL_NAMES]
     meta = pq.read_schema(path).metadata
@@ -41,12 +41,12 @@ def test_damaged_files(tmp_path):
     bad = tmp_path / "bad.parquet"
     bad.write_bytes(b"PAR1 not really")
     with pytest.raises(PRSMHealthError, match="not a readable Parquet"):
-        Run.from_parquet(bad)
+        read_run_parquet(bad)
     with pytest.raises(PRSMHealthError, match="no such file"):
-        Run.from_parquet(tmp_path / "missing.parquet")
+        read_run_parquet(tmp_path / "missing.parquet")
     pd.DataFrame({"x": [1.0, 2.0]}).to_parquet(tmp_path / "other.parquet")
     with pytest.raises(PRSMHealthError, match="no 'time' column"):
-        Run.from_parquet(tmp_path / "other.parquet")
+        read_run_parquet(tmp_path / "other.parquet")
 
 
 def test_unknown_channel(run):
