@@ -35,9 +35,8 @@ from prsm_health import (
 )
 from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.diagnosis import DEFAULT_MODEL, diagnose, load_bundle
-from prsm_health.features import MIN_SAMPLES
 from prsm_health.mcap_io import write_mcap
-from prsm_health.run import Run
+from prsm_health.run import MIN_SAMPLES, Run
 from prsm_health.service import (
     HistoryStore,
     ServiceLimits,
