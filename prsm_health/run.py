@@ -63,6 +63,7 @@ class Run:
         min_samples: int = MIN_SAMPLES,
         max_samples: int | None = None,
         max_abs: float | None = None,
+        max_time: float | None = None,
         what: str = "recording",
     ) -> Run:
         """Check that the recording can be processed; returns self.
@@ -72,8 +73,10 @@ class Run:
         min_samples, max_samples : int
             Accepted length [samples].
         max_abs : float or None
-            Largest accepted magnitude of a sample (SI) and of the time axis [s]; beyond it the
-            indicators overflow. None: no bound.
+            Largest accepted magnitude of a sample (SI); beyond it the indicators overflow.
+            None: no bound.
+        max_time : float or None [s]
+            Largest accepted magnitude of the time axis. None: no bound.
         what : str
             How the messages name the recording.
 
@@ -103,9 +106,9 @@ class Run:
         time = np.asarray(self.time, dtype=float)
         if not (np.all(np.isfinite(time)) and np.all(np.diff(time) > 0)):
             raise RecordingError(f"{what}: time must be finite and strictly increasing")
-        if max_abs is not None and float(np.max(np.abs(time))) > max_abs:
+        if max_time is not None and float(np.max(np.abs(time))) > max_time:
             raise RecordingError(
-                f"{what}: time beyond ±{max_abs:g} s (use time from the recording start)"
+                f"{what}: time beyond ±{max_time:g} s (use time from the recording start)"
             )
         for name, values in self.channels.items():
             values = np.asarray(values, dtype=float)

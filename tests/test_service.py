@@ -26,20 +26,14 @@ import uvicorn
 from hypothesis import HealthCheck, settings
 
 from prsm_health import (
-    HealthState,
-    OperatingProfile,
     PRSMHealthError,
-    SensorModel,
-    SimulationOptions,
-    simulate,
 )
 from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.diagnosis import DEFAULT_MODEL, diagnose, load_bundle
-from prsm_health.features import MIN_SAMPLES
+from prsm_health.io.parquet import write_run_parquet
 from prsm_health.mcap import write_mcap
-from prsm_health.run import Run
+from prsm_health.run import MIN_SAMPLES, Run
 from prsm_health.service import (
-    HistoryStore,
     ServiceLimits,
     check_bind,
     create_app,
@@ -58,22 +52,8 @@ def bundle():
 
 
 @pytest.fixture(scope="module")
-def recording(bundle) -> Run:
-    run = simulate(
-        "paper01",
-        HealthState.uniform(20e-6),
-        OperatingProfile(
-            duration=0.4,
-            load=0.0,
-            load_profile="reversing",
-            load_amplitude=300.0,
-            load_frequency=10.0,
-            accel_time=0.002,
-        ),
-        SensorModel(),
-        3,
-        options=SimulationOptions(contact_law="hertz"),
-    )
+def recording(bundle, reversing_run) -> Run:
+    run = reversing_run(20e-6, seed=3)
     diagnose(run, bundle)  # compile / load the numba kernels once, before any server starts
     return run
 
@@ -150,7 +130,7 @@ def small_server(bundle, recording, tmp_path_factory):
 def files(recording, tmp_path_factory):
     d = tmp_path_factory.mktemp("uploads")
     mcap = write_mcap(recording, d / "run.mcap")
-    parquet = recording.to_parquet(d / "run.parquet")
+    parquet = write_run_parquet(recording, d / "run.parquet")
     return {"mcap": mcap, "parquet": parquet}
 
 
@@ -170,7 +150,7 @@ def test_health_and_model(client, bundle):
     model = client.get("/v1/model").json()
     assert model["name"] == bundle.name
     assert model["window"] == bundle.window
-    assert model["design"] == bundle.design
+    assert model["design"] == bundle.design.name
     assert model["feature_names"] == bundle.feature_names
     assert model["classes"]  # the shipped model has a fault classifier
 
@@ -199,13 +179,13 @@ def test_diagnose_returns_the_contract(client, recording, bundle):
     d = r.json()
     assert CONTRACT_KEYS <= set(d)
     assert "windows" not in d  # 0.4 s = one model window
-    assert d["model"] == {"name": bundle.name, "version": bundle.version}
+    assert d["model"] == bundle.reference()
     c = d["clearance"]
     assert c["lower"] <= c["estimate"] <= c["upper"]
     assert abs(sum(d["class_probabilities"].values()) - 1) < 1e-9
     assert d["fault_class"] in d["class_probabilities"]
     # The service adds nothing to the library's answer.
-    direct = diagnose(recording, bundle)
+    direct = diagnose(recording, bundle).to_json()
     assert d["fault_class"] == direct["fault_class"]
     assert d["clearance"]["estimate"] == pytest.approx(direct["clearance"]["estimate"], rel=1e-12)
 
@@ -465,7 +445,7 @@ def test_upload_sample_limit(small_server, recording, tmp_path):
         {"nut_axial_accel": recording["nut_axial_accel"][:6000]},
         recording.sample_rate,
     )
-    path = short.to_parquet(tmp_path / "long.parquet")
+    path = write_run_parquet(short, tmp_path / "long.parquet")
     with small_server.client() as c:
         r = c.post("/v1/diagnose/file", files={"file": ("long.parquet", path.read_bytes())})
     assert r.status_code == 413
@@ -630,43 +610,6 @@ def test_health_answers_while_diagnoses_run(client, recording):
         for w in workers:
             w.join()
     assert len(busy) >= 5  # /v1/health answered while diagnoses were in progress
-
-
-# ----------------------------------------------------------------------------- store
-def test_history_store(tmp_path):
-    path = tmp_path / "h.sqlite"
-    store = HistoryStore(path)
-    d = {
-        "clearance": {"estimate": 1e-5, "lower": 0.5e-5, "upper": 2e-5},
-        "fault_class": "wear",
-        "class_probabilities": {"wear": 1.0},
-        "indicators": {},
-        "model": {"name": "m", "version": "1"},
-    }
-    store.add("a", [d], received_at="2024-01-01T00:00:00.000000+00:00")
-    store.add("a", [d, d], received_at="2024-01-02T00:00:00.000000+00:00", source="file")
-    store.add("b", [d])
-    h = store.history("a")
-    assert h["count"] == 3 and [e["received_at"][:10] for e in h["diagnoses"]] == [
-        "2024-01-01",
-        "2024-01-02",
-        "2024-01-02",
-    ]
-    assert store.history("a", since="2024-01-01T12:00:00")["count"] == 2
-    assert store.history("a", since="2024-01-02T01:00:00+02:00")["count"] == 2  # 23:00 UTC
-    assert store.history("a", limit=1)["diagnoses"][0]["id"] == h["diagnoses"][-1]["id"]
-    with pytest.raises(PRSMHealthError, match="ISO-8601"):
-        store.history("a", since="not a time")
-    mode = store._conn.execute("PRAGMA journal_mode").fetchone()[0]
-    assert mode == "wal"
-    store.close()
-    assert HistoryStore(path).history("a")["count"] == 3  # reopened: still there
-
-    (tmp_path / "junk.sqlite").write_bytes(b"this is not a database" * 100)
-    with pytest.raises(PRSMHealthError, match="not a usable history database"):
-        HistoryStore(tmp_path / "junk.sqlite")
-    with pytest.raises(PRSMHealthError, match="does not exist"):
-        HistoryStore(tmp_path / "missing" / "h.sqlite")
 
 
 # ----------------------------------------------------------------------------- fuzzing

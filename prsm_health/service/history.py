@@ -1,0 +1,248 @@
+"""Diagnoses per asset over time: :class:`HistoryStore` (embedded SQLite, WAL journal), its
+default location (:func:`default_db_path`) and its time format (:func:`utc_now`,
+:func:`parse_time`)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import sqlite3
+import threading
+from datetime import datetime, timezone
+from pathlib import Path
+
+from ..errors import PRSMHealthError
+from ..jsonable import dumps
+
+#: Environment variable overriding the default history database path.
+DB_ENV = "PRSM_HEALTH_DB"
+
+
+def default_db_path() -> Path:
+    """``$PRSM_HEALTH_DB``, else ``$XDG_DATA_HOME/prsm-health/history.sqlite``."""
+    if os.environ.get(DB_ENV):
+        return Path(os.environ[DB_ENV])
+    base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+    return Path(base) / "prsm-health" / "history.sqlite"
+
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS diagnoses (
+    id                  INTEGER PRIMARY KEY AUTOINCREMENT,
+    asset_id            TEXT    NOT NULL,
+    received_at         TEXT    NOT NULL,  -- server receive time, UTC ISO-8601 (microseconds)
+    source              TEXT    NOT NULL,  -- 'json' or 'file'
+    filename            TEXT,              -- uploaded file name (source 'file')
+    window_index        INTEGER,           -- per-window rows of an upload
+    window_start        REAL,              -- [s]
+    window_end          REAL,              -- [s]
+    speed               REAL,              -- nominal screw speed given by the client [rad/s]
+    load                REAL,              -- nominal axial load given by the client [N]
+    clearance_estimate  REAL,              -- [m]
+    clearance_lower     REAL,              -- [m]
+    clearance_upper     REAL,              -- [m]
+    fault_class         TEXT,
+    class_probabilities TEXT    NOT NULL,  -- JSON object
+    model_name          TEXT    NOT NULL,
+    model_version       TEXT    NOT NULL,
+    diagnosis           TEXT    NOT NULL   -- the full Diagnosis contract JSON
+);
+CREATE INDEX IF NOT EXISTS diagnoses_asset_time ON diagnoses (asset_id, received_at, id);
+"""
+_SCHEMA_VERSION = 1
+
+
+def utc_now() -> str:
+    """Current UTC time as ISO-8601 with microseconds (fixed width, so it sorts as text)."""
+    return datetime.now(timezone.utc).isoformat(timespec="microseconds")
+
+
+def parse_time(text: str, field: str = "since") -> str:
+    """An ISO-8601 time as the store's UTC text form (a time without zone is UTC)."""
+    try:
+        value = datetime.fromisoformat(text.strip())
+    except (ValueError, AttributeError):
+        raise PRSMHealthError(
+            f"{field} = {text!r} is not an ISO-8601 time (e.g. 2024-05-01T12:00:00Z)"
+        ) from None
+    if value.tzinfo is None:
+        value = value.replace(tzinfo=timezone.utc)
+    try:
+        return value.astimezone(timezone.utc).isoformat(timespec="microseconds")
+    except (OverflowError, ValueError):
+        raise PRSMHealthError(f"{field} = {text!r} is out of range") from None
+
+
+class HistoryStore:
+    """Diagnoses per asset over time, in an embedded SQLite database.
+
+    The database uses the WAL journal (readers never block the writer, a crash never leaves a
+    half-written row) with ``synchronous=FULL`` (a committed diagnosis survives power loss);
+    every :meth:`add` is one transaction. One connection is shared by the server's threads
+    behind a lock; several processes may open the same file (SQLite locks it, writers wait up
+    to ``timeout`` seconds).
+
+    Parameters
+    ----------
+    path : str or Path
+        Database file; its directory must exist (``":memory:"`` for a throw-away store).
+    timeout : float [s]
+        How long a write waits for another process's lock.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, timeout: float = 30.0):
+        self.path = str(path)
+        if self.path != ":memory:":
+            parent = Path(self.path).expanduser().resolve().parent
+            if not parent.is_dir():
+                raise PRSMHealthError(f"{self.path}: directory {parent} does not exist")
+            if Path(self.path).is_dir():
+                raise PRSMHealthError(f"{self.path}: is a directory, not a database file")
+        self._lock = threading.Lock()
+        try:
+            self._conn = sqlite3.connect(
+                self.path, timeout=timeout, isolation_level=None, check_same_thread=False
+            )
+        except sqlite3.Error as exc:
+            raise PRSMHealthError(
+                f"{self.path}: cannot open the history database ({exc})"
+            ) from None
+        try:
+            self._conn.execute("PRAGMA journal_mode=WAL")
+            self._conn.execute("PRAGMA synchronous=FULL")
+            with self._transaction():
+                version = self._conn.execute("PRAGMA user_version").fetchone()[0]
+                if version > _SCHEMA_VERSION:
+                    raise PRSMHealthError(
+                        f"{self.path}: history schema version {version} is newer than this "
+                        f"prsm_health ({_SCHEMA_VERSION}); upgrade prsm_health"
+                    )
+                for statement in _SCHEMA.split(";"):
+                    if statement.strip():
+                        self._conn.execute(statement)
+                self._conn.execute(f"PRAGMA user_version = {_SCHEMA_VERSION}")
+        except BaseException as exc:
+            self._conn.close()
+            if isinstance(exc, sqlite3.DatabaseError):
+                raise PRSMHealthError(
+                    f"{self.path}: not a usable history database ({exc})"
+                ) from None
+            raise
+
+    @contextlib.contextmanager
+    def _transaction(self):
+        self._conn.execute("BEGIN IMMEDIATE")
+        try:
+            yield
+        except BaseException:
+            self._conn.execute("ROLLBACK")
+            raise
+        else:
+            self._conn.execute("COMMIT")
+
+    def add(
+        self,
+        asset_id: str,
+        diagnoses: list[dict],
+        *,
+        received_at: str | None = None,
+        source: str = "json",
+        filename: str | None = None,
+        speed: float | None = None,
+        load: float | None = None,
+    ) -> list[int]:
+        """Store diagnoses (contract dicts; a ``window`` key places one in its recording) in
+        one transaction; returns their ids."""
+        received_at = received_at or utc_now()
+        rows = []
+        for d in diagnoses:
+            c = d.get("clearance") or {}
+            w = d.get("window") or {}
+            model = d.get("model") or {}
+            rows.append(
+                (
+                    asset_id,
+                    received_at,
+                    source,
+                    filename,
+                    w.get("index"),
+                    w.get("start"),
+                    w.get("end"),
+                    speed,
+                    load,
+                    c.get("estimate"),
+                    c.get("lower"),
+                    c.get("upper"),
+                    d.get("fault_class"),
+                    dumps(d.get("class_probabilities", {})),
+                    str(model.get("name", "")),
+                    str(model.get("version", "")),
+                    dumps(d),
+                )
+            )
+        ids = []
+        with self._lock, self._transaction():
+            for row in rows:
+                cur = self._conn.execute(
+                    "INSERT INTO diagnoses (asset_id, received_at, source, filename, window_index,"
+                    " window_start, window_end, speed, load, clearance_estimate, clearance_lower,"
+                    " clearance_upper, fault_class, class_probabilities, model_name, model_version,"
+                    " diagnosis) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    row,
+                )
+                ids.append(cur.lastrowid)
+        return ids
+
+    def history(self, asset_id: str, *, since: str | None = None, limit: int = 100) -> dict:
+        """The most recent ``limit`` diagnoses of an asset at or after ``since`` (ISO-8601),
+        oldest first: ``{"asset_id", "count", "total", "truncated", "diagnoses": [...]}``."""
+        where, args = "asset_id = ?", [asset_id]
+        if since is not None:
+            where += " AND received_at >= ?"
+            args.append(parse_time(since))
+        with self._lock:
+            total = self._conn.execute(
+                f"SELECT COUNT(*) FROM diagnoses WHERE {where}", args
+            ).fetchone()[0]
+            rows = self._conn.execute(
+                "SELECT id, received_at, source, filename, window_index, window_start, window_end,"
+                f" speed, load, diagnosis FROM diagnoses WHERE {where}"
+                " ORDER BY received_at DESC, id DESC LIMIT ?",
+                [*args, int(limit)],
+            ).fetchall()
+        entries = []
+        for row in reversed(rows):
+            id_, received_at, source, filename, w_index, w_start, w_end, speed, load, blob = row
+            entries.append(
+                {
+                    "id": id_,
+                    "received_at": received_at,
+                    "source": source,
+                    "filename": filename,
+                    "window": None
+                    if w_index is None
+                    else {"index": w_index, "start": w_start, "end": w_end},
+                    "speed": speed,
+                    "load": load,
+                    "diagnosis": json.loads(blob),
+                }
+            )
+        return {
+            "asset_id": asset_id,
+            "count": len(entries),
+            "total": total,
+            "truncated": total > len(entries),
+            "diagnoses": entries,
+        }
+
+    def has_asset(self, asset_id: str) -> bool:
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT 1 FROM diagnoses WHERE asset_id = ? LIMIT 1", (asset_id,)
+            ).fetchone()
+        return row is not None
+
+    def close(self) -> None:
+        with self._lock:
+            self._conn.close()
