@@ -13,11 +13,11 @@ angle* (90°), whose half (45°) is measured from the axis; its contact angle is
 
 References
 ----------
-- Paper 01: ../shared/papers/01-dynamics-time-varying-mesh-stiffness.txt, parameter table §3.
-- Paper 02: ../shared/papers/02-friction-torque-efficiency.txt, parameter table.
-- Paper 03: ../shared/papers/03-recirculating-prsm-design-dynamics.txt, eqs. (1)–(5), (14).
-- Paper 04: ../shared/papers/04-axial-stiffness-experiment.txt, base parameters.
-- Paper 05: ../shared/papers/05-electric-cylinder-accuracy.txt, parameter table.
+- Paper 01 (docs/references.md): parameter table §3.
+- Paper 02 (docs/references.md): parameter table.
+- Paper 03 (docs/references.md): eqs. (1)–(5), (14).
+- Paper 04 (docs/references.md): base parameters.
+- Paper 05 (docs/references.md): parameter table.
 """
 
 from __future__ import annotations
@@ -599,7 +599,7 @@ def _paper02() -> PRSMDesign:
 
 def _paper03() -> PRSMDesign:
     # Table 1 is not printed; the geometry is the one that fits most of the paper's numbers
-    # (../shared/notes/paper-consistency.md): orbit radius 19.75 mm (§3.2), 12 rollers,
+    # (docs/validation.md, design presets): orbit radius 19.75 mm (§3.2), 12 rollers,
     # single-start 1 mm pitch, roller tooth angle α = 90°.
     d_s, d_r = 32e-3, 7.5e-3
     roller_mass = 0.02
@@ -628,7 +628,7 @@ def _paper03() -> PRSMDesign:
             carrier_mass=0.05,
             carrier_inertia=0.05 * ((d_s + d_r) / 2) ** 2,
         ),
-        reference="paper 03 §2–3 (geometry reconstructed, see notes/paper-consistency.md)",
+        reference="paper 03 §2–3 (geometry reconstructed, see docs/validation.md)",
     )
 
 

@@ -220,7 +220,7 @@ class ManufacturingVariation:
     Defaults are ISO-grade-5-like tolerances for a precision PRSM: the papers give none. They
     make the rollers share load unequally and break the perfect mesh-phase cancellation, so
     the mesh fundamental appears in the nut vibration as on real hardware
-    (../shared/notes/dynamics-findings.md).
+    (docs/validation.md, paper 01 dynamics: manufacturing variation).
 
     Parameters
     ----------

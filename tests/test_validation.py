@@ -1,6 +1,14 @@
-"""The validation report: every row well-formed, no expected reproduction failing."""
+"""The validation report: one test per paper number, every row well-formed.
 
+Each row of :func:`prsm_health.validation.collect` is its own test, with an id
+``paper<NN>-<where>-<quantity>`` (e.g. ``paper01-3-2-carrier-frequency-f-p-at-100-rad-s``), so a
+failure names the paper number it concerns and ``-k`` selects rows (``-k paper04``).
+"""
+
+import functools
 import json
+import re
+import unicodedata
 
 import pytest
 
@@ -10,22 +18,77 @@ from prsm_health.validation import (
     NOT_REPRODUCED,
     PAPER_INCONSISTENT,
     REPRODUCED,
+    Row,
     collect,
     reproduced,
     to_markdown,
 )
 
 
+@functools.cache
+def _rows() -> tuple[Row, ...]:
+    """Every row, computed once per test session (collecting runs the models)."""
+    return tuple(collect())
+
+
+# Symbols of the row texts spelt out, so ids stay readable in ASCII ("b = 10 µm" → "b-10-um").
+_SPELL = str.maketrans(
+    {
+        "µ": "u",
+        "μ": "u",
+        "Δ": "d",
+        "δ": "d",
+        "α": "alpha",
+        "β": "beta",
+        "γ": "gamma",
+        "η": "eta",
+        "θ": "theta",
+        "λ": "lambda",
+        "π": "pi",
+        "ρ": "rho",
+        "φ": "phi",
+        "ω": "omega",
+        "°": "deg",
+        "′": "p",
+        "·": "-",
+    }
+)
+
+
+def _slug(text: str) -> str:
+    text = unicodedata.normalize("NFKD", text.translate(_SPELL))
+    text = text.encode("ascii", "ignore").decode().lower()
+    return re.sub(r"[^a-z0-9]+", "-", text).strip("-")
+
+
+def _row_ids(rows) -> list[str]:
+    """``paper<NN>-<where>-<quantity>`` per row, made unique by a suffix where two coincide."""
+    ids, seen = [], {}
+    for r in rows:
+        base = f"paper{r.paper}-{_slug(r.where)}-{_slug(r.quantity)}"
+        seen[base] = seen.get(base, 0) + 1
+        ids.append(base if seen[base] == 1 else f"{base}-{seen[base]}")
+    return ids
+
+
 @pytest.fixture(scope="module")
 def rows():
-    return collect()
+    return list(_rows())
 
 
-def test_no_reproduction_fails(rows):
-    failed = [r for r in rows if r.verdict == NOT_REPRODUCED]
-    assert not failed, "\n".join(
-        f"{r.paper} {r.where} {r.quantity}: {r.model_value}" for r in failed
+@pytest.mark.parametrize("row", _rows(), ids=_row_ids(_rows()))
+def test_row(row):
+    assert not row.failed, (
+        f"paper {row.paper}, {row.where}, {row.quantity}: model {row.model_value} {row.unit} "
+        f"vs paper {row.paper_value} {row.unit} (error {row.error}, tolerance {row.tolerance}); "
+        f"{row.note}"
     )
+
+
+def test_row_ids_are_unique_and_readable():
+    ids = _row_ids(_rows())
+    assert len(set(ids)) == len(ids)
+    assert all(re.fullmatch(r"paper\d\d-[a-z0-9-]+", i) for i in ids)
 
 
 def test_rows_are_well_formed(rows):

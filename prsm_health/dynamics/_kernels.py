@@ -3,7 +3,7 @@
 Only float64 arrays and scalars cross this boundary; the layout of every array is in
 :mod:`.layout`, its physics in :mod:`.model` (which documents every term and cites paper 01).
 
-Force laws derive from one energy function (../shared/notes/dynamics-findings.md): each
+Force laws derive from one energy function (docs/validation.md, paper 01 dynamics): each
 thread engagement has an axial closure with the helix built in and a radial closure coupled
 through cot β, contact on either flank beyond a per-roller half-clearance b; the gear mesh has a
 time-varying stiffness looked up in a table over one mesh cycle. Roller centres are absolute

@@ -8,7 +8,7 @@ paper 01 §1.1 (screw z constrained).
 Force laws (one energy function; kernel in :mod:`._kernels`):
 
 * **Threads** (paper 01 §1.2.2 with the helix built into the deformation,
-  ../shared/notes/dynamics-findings.md): with θ_rev the angular position of the roller centre
+  docs/validation.md): with θ_rev the angular position of the roller centre
   about the screw (nut) axis and L the leads,
   screw side δ_s = L_s/2π·(θ_s − θ_rev) − L_r/2π·(θ_i − θ_rev) − z_i,
   nut side δ_N = z_i − z_N + L_r/2π·(θ_i − θ_rev) − L_N/2π·(θ_N − θ_rev).
@@ -31,7 +31,7 @@ Force laws (one energy function; kernel in :mod:`._kernels`):
 
 References
 ----------
-Paper 01: ../shared/papers/01-dynamics-time-varying-mesh-stiffness.txt, §1.2–1.3 (equations of
+Paper 01 (docs/references.md), §1.2–1.3 (equations of
 motion), §2 (stiffness), §3 parameter table.
 """
 

@@ -98,7 +98,7 @@ readings are softer than the standard tooth at every contact point.
 
 References
 ----------
-- Paper 01: ../shared/papers/01-dynamics-time-varying-mesh-stiffness.txt, §2.1 (equation of
+- Paper 01 (docs/references.md), §2.1 (equation of
   K_m^single, the k_b/k_s/k_a integrals, L_a(x), the contact ratio and Δφ_c rows of the table).
 - D.C.H. Yang, J.Y. Lin, "Hertzian damping, tooth friction and bending elasticity in gear
   impact dynamics", J. Mech. Trans. Autom. Des. 109 (1987) 189–196.

@@ -11,9 +11,9 @@ inside the body), negative where concave (the nut's internal flank, paper 05 ρ_
 
 References
 ----------
-- Paper 04 (../shared/papers/04-axial-stiffness-experiment.txt): curvature sum and difference
+- Paper 04 (docs/references.md): curvature sum and difference
   Θ ± χ, equivalent radius R_E = ½(Θχ)^(-1/2), δ_H = (9Q²/(16E*²R_E))^(1/3)·F_2.
-- Paper 05 (../shared/papers/05-electric-cylinder-accuracy.txt): contact deformation built from
+- Paper 05 (docs/references.md): contact deformation built from
   Σρ and the tabulated coefficient 2K(e)/(π m_a).
 - K. L. Johnson, *Contact Mechanics*, CUP 1985, §4.2 eqs. (4.4), (3.64)–(3.69): exact solution
   used here; the paper formulas are special forms of it.

@@ -1,6 +1,6 @@
 """Paper 01 rows: kinematics and frequencies (§3.1–3.3).
 
-Reference: ../shared/papers/01-dynamics-time-varying-mesh-stiffness.txt.
+Reference: paper 01 (docs/references.md).
 """
 
 from __future__ import annotations

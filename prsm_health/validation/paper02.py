@@ -1,6 +1,6 @@
 """Paper 02 rows: friction torque and efficiency table, under the model's stated reading.
 
-Reference: ../shared/papers/02-friction-torque-efficiency.txt (results table, text). Reading:
+Reference: paper 02 (docs/references.md), results table and text. Reading:
 Coulomb friction and M_fs3 summed over all n_R·n_t contacts, zero contact offset angles, the
 screw ramped linearly to 1 rad/s over t_acc, efficiencies over [0, t_acc + 0.1 s]
 (prsm_health/friction.py).

@@ -3,7 +3,7 @@
 Table 1 (structural parameters) and Table 2 (simulated vs theoretical values) are not printed;
 the model is :mod:`prsm_health.recirculating` for the ``paper03`` preset, the geometry that
 fits most of the paper's numbers (orbit radius 19.75 mm, d_s = 32, d_r = 7.5, d_n = 47 mm,
-12 rollers, 1 mm single-start pitch, α = 90°; ../shared/notes/paper-consistency.md). Because
+12 rollers, 1 mm single-start pitch, α = 90°; docs/validation.md). Because
 that geometry was reconstructed from the speeds, the orbital angle and L_r3, the rows that
 depend on d_s/d_r check the paper's consistency, not an independent prediction; the rows
 on the screw speed, nut travel and reset jump are geometry-independent.
@@ -15,7 +15,7 @@ those rows (each row says what else limits it).
 
 References
 ----------
-Paper 03: ../shared/papers/03-recirculating-prsm-design-dynamics.txt — eqs. (11)–(14), §3.2
+Paper 03 (docs/references.md) — eqs. (11)–(14), §3.2
 assembly step 4 (19.75 mm), §4.1 contact parameters, §4.2 motion results, §4.3 forces.
 """
 

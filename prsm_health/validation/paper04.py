@@ -7,13 +7,13 @@ diameters, 5 starts, lead angle 1.74° → 0.4 mm pitch; assumed 7 rollers, 10 e
 100 mm free screw). The model stiffness is the secant F/δ including the shaft (the paper's
 rig reports both secant and incremental stiffness without saying which its tables hold).
 
-Physics checks the tables fail (../shared/notes/paper-consistency.md): Hertz contact in series
+Physics checks the tables fail (docs/validation.md): Hertz contact in series
 and parallel with linear springs gives a secant stiffness that grows at most as F^(1/3)
 (δ = aF^(2/3) + bF ⇒ d ln K/d ln F = (a/3)F^(-1/3)/(aF^(-1/3) + b) ≤ 1/3), and at fixed load
 as n_R^(2/3) with the roller count where contact dominates (each roller's contact δ ∝
 (F/n_R)^(2/3)); terms independent of n_R (shaft, nut dilation) make the rise smaller still.
 
-Reference: ../shared/papers/04-axial-stiffness-experiment.txt — base parameters, contact-angle
+Reference: paper 04 (docs/references.md) — base parameters, contact-angle
 table, roller-count table, eccentricity paragraph, load table and the text after it.
 """
 

@@ -11,7 +11,7 @@ Tolerances of the reproduced rows: the paper evaluates with π ≈ 3.14 (π·d1�
 
 References
 ----------
-Paper 05: ../shared/papers/05-electric-cylinder-accuracy.txt — printed Δl(F, x), stiffness
+Paper 05 (docs/references.md) — printed Δl(F, x), stiffness
 table, contact stiffness examples, influence-coefficient vectors (x = 300 mm, F = 5000 N).
 """
 

@@ -1,0 +1,56 @@
+"""Print the channel table of docs/formats.md from the channel contract (prsm_health.channels).
+
+The table in docs/formats.md is this script's output pasted between its markers; rerun it after
+changing :data:`prsm_health.channels.CHANNELS` and paste again, or check that the doc is current:
+
+    python tools/make_formats_tables.py            # print the Markdown table
+    python tools/make_formats_tables.py --check    # exit 1 if docs/formats.md differs
+"""
+
+from __future__ import annotations
+
+import pathlib
+import sys
+
+from prsm_health.channels import CHANNELS, UNITS
+
+BEGIN = "<!-- BEGIN GENERATED: tools/make_formats_tables.py -->"
+END = "<!-- END GENERATED -->"
+DOC = pathlib.Path(__file__).resolve().parents[1] / "docs" / "formats.md"
+
+
+def channel_table() -> str:
+    """The contract channels as a Markdown table, in record order, ``time`` first."""
+    lines = [
+        "| channel | unit | kind | sensor | MCAP topic / field | meaning |",
+        "|---|---|---|---|---|---|",
+        f"| `time` | {UNITS['time']} | – | data logger clock | message `log_time` "
+        "(ns from run start) | sample time from run start |",
+    ]
+    for c in CHANNELS:
+        lines.append(
+            f"| `{c.name}` | {c.unit} | {c.kind} | {c.sensor} | `{c.topic}` / `{c.field}` "
+            f"| {c.meaning} |"
+        )
+    return "\n".join(lines)
+
+
+def main(argv: list[str]) -> int:
+    table = channel_table()
+    if "--check" not in argv:
+        print(table)
+        return 0
+    text = DOC.read_text()
+    if BEGIN not in text or END not in text:
+        print(f"error: {DOC} lacks the generated-block markers", file=sys.stderr)
+        return 2
+    current = text.split(BEGIN, 1)[1].split(END, 1)[0].strip()
+    if current != table:
+        print(f"{DOC}: channel table is stale; paste the output of {__file__}", file=sys.stderr)
+        return 1
+    print(f"{DOC}: channel table is current")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
