@@ -12,7 +12,7 @@ shard (one row group per run), atomically (temporary name, then rename); a batch
 exists is done. An interrupted generation (Ctrl-C, kill, crash) therefore resumes on the next
 call with no duplicate and no missing run, and never shows a half-written file.
 
-Layout (contract, ../shared/DESIGN.md)::
+Layout (contract, docs/formats.md)::
 
     DIR/manifest.json        recipe, package version, sample rate, units, counts
     DIR/runs.parquet         one row per run: labels and parameters
@@ -211,9 +211,9 @@ class Recipe:
                 samples,
                 f"must be an integer ≥ 1 in {mode} mode",
             )
-        # Build every run's objects once, so a bad value fails now, not in a worker.
-        specs = self.runs()
-        for spec in (specs[0], specs[-1]) if specs else ():
+        # Build every run's scenario once (≈ 0.2 ms each), so a bad value anywhere in a sweep
+        # fails now, naming the run, not later in a worker.
+        for spec in self.runs():
             spec.scenario()
 
     @property

@@ -81,7 +81,7 @@ def test_mesh_line_appears_with_manufacturing_variation():
 
 def test_ideal_rollers_cancel_the_mesh_fundamental():
     # With identical rollers at staggered phases (65 mod 7 = 2) the nut torque is periodic in
-    # T_carrier/7, so the mesh fundamental (65·f_c) cancels (notes/dynamics-findings.md).
+    # T_carrier/7, so the mesh fundamental (65·f_c) cancels (docs/validation.md).
     # Friction is switched off here: the screw–roller Coulomb friction couples the rollers'
     # normal-load fluctuations and breaks that symmetry even for identical rollers
     # (docs/validation.md). Manufacturing variation brings the line back.
@@ -152,7 +152,7 @@ def test_clearance_lowers_axial_frequency_and_raises_amplitude_under_reversing_l
 
 def test_clearance_invisible_while_preload_holds_contact():
     # Documented counter-regime: a steady 100 N load keeps every roller on one thread flank, so
-    # the thread clearance does not change the response (notes/dynamics-findings.md). Gear
+    # the thread clearance does not change the response (docs/validation.md). Gear
     # backlash held at 10 µm; the first 0.1 s (settling) is skipped.
     rms, dominant = [], []
     for b in (10e-6, 30e-6):

@@ -52,7 +52,7 @@ def test_paper01_mesh_frequency():
 
 def test_paper03_recirculating_numbers():
     # Paper 03 §4: screw 40π rad/s; nut travel in 0.1 s = 2.000 mm, v_n = 20.00 mm/s
-    # (notes/paper-consistency.md: the paper's 1.996 / 19.79 are simulation readings).
+    # (docs/validation.md: the paper's 1.996 / 19.79 are simulation readings).
     d = preset("paper03")
     w_s = 40 * math.pi
     r = speed_ratios(d)
