@@ -114,13 +114,9 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     # One OpenMP thread: a few hundred samples gain nothing from threads, and spin-waiting
     # threads of two busy processes on 2 cores made training 50× slower (docs/performance.md).
     from .dataset import Dataset
-    from .estimators import (
-        ClearanceEstimator,
-        FaultClassifier,
-        cross_validated_metrics,
-        permutation_importance_table,
-        save_model,
-    )
+    from .estimators import ClearanceEstimator, FaultClassifier
+    from .evaluation import cross_validated_metrics, permutation_importance_table
+    from .persistence import save_model
 
     require(target in TARGETS, "target", target, f"must be one of {', '.join(TARGETS)}")
     out = Path(out)

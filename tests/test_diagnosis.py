@@ -11,7 +11,7 @@ from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOp
 from prsm_health.cli import main
 from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle, read_recording
-from prsm_health.estimators import ModelVersionError
+from prsm_health.errors import ModelVersionError
 from prsm_health.mcap_io import write_mcap
 from prsm_health.training import train
 
@@ -148,7 +148,7 @@ def test_bad_inputs(model, tmp_path, capsys):
 
 
 def test_model_from_another_version(model, tmp_path, capsys, monkeypatch):
-    import prsm_health.estimators as est
+    import prsm_health.persistence as est
 
     monkeypatch.setattr(est, "_package_version", lambda: "9.9.0")
     with pytest.raises(ModelVersionError):
