@@ -71,8 +71,8 @@ class ModelBundle:
 def load_bundle(
     path: str | Path | None = None, *, allow_version_mismatch: bool = False
 ) -> ModelBundle:
-    """Load a model bundle (default: the shipped model); version checks in estimators.load_model."""
-    from .estimators import load_model
+    """Load a model bundle (default: the shipped model); version checks in persistence.load_model."""
+    from .persistence import load_model
 
     path = Path(path) if path is not None else DEFAULT_MODEL
     if not path.exists():

@@ -10,7 +10,7 @@ import pytest
 from prsm_health.cli import main
 from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle
-from prsm_health.estimators import ModelVersionError
+from prsm_health.errors import ModelVersionError
 from prsm_health.io import read_recording
 from prsm_health.io.parquet import write_run_parquet
 from prsm_health.mcap import write_mcap
@@ -150,7 +150,7 @@ def test_bad_inputs(model, tmp_path, capsys, reversing_run):
 
 
 def test_model_from_another_version(model, tmp_path, capsys, monkeypatch, reversing_run):
-    import prsm_health.estimators as est
+    import prsm_health.persistence as est
 
     monkeypatch.setattr(est, "_package_version", lambda: "9.9.0")
     with pytest.raises(ModelVersionError):

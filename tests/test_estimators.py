@@ -1,5 +1,6 @@
-"""Tests of prsm_health.estimators: sklearn contract, interval coverage, calibration,
-group importance, cross-validated metrics and safe persistence."""
+"""Tests of prsm_health.estimators (sklearn contract, interval coverage, calibration),
+prsm_health.evaluation (group importance, cross-validated metrics) and
+prsm_health.persistence (safe save/load)."""
 
 from __future__ import annotations
 
@@ -16,17 +17,10 @@ import sklearn
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from prsm_health import __version__
-from prsm_health.errors import ParameterError, PRSMHealthError
-from prsm_health.estimators import (
-    ClearanceEstimator,
-    FaultClassifier,
-    ModelVersionError,
-    _bundle_bytes,
-    cross_validated_metrics,
-    load_model,
-    permutation_importance_table,
-    save_model,
-)
+from prsm_health.errors import ModelVersionError, ParameterError, PRSMHealthError
+from prsm_health.estimators import ClearanceEstimator, FaultClassifier
+from prsm_health.evaluation import cross_validated_metrics, permutation_importance_table
+from prsm_health.persistence import _bundle_bytes, load_model, save_model
 
 # ------------------------------------------------------------------------------------------
 # scikit-learn estimator contract
@@ -500,3 +494,13 @@ def test_file_is_a_plain_skops_archive(tmp_path, bundle):
     assert "prsm_health.estimators.ClearanceEstimator" in untrusted
     with zipfile.ZipFile(io.BytesIO(data)) as zf:
         assert json.loads(zf.read("prsm_health.json"))["metadata"] == {"a": 1}
+
+
+def test_estimator_module_is_trusted():
+    """The classes a bundle holds live in a module load_model trusts (the split kept it so)."""
+    from prsm_health.persistence import _TRUSTED_ROOTS, _is_trusted
+
+    for cls in (ClearanceEstimator, FaultClassifier):
+        assert cls.__module__ in _TRUSTED_ROOTS
+        assert _is_trusted(f"{cls.__module__}.{cls.__qualname__}")
+    assert not _is_trusted("prsm_health.persistence.Path")

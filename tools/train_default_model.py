@@ -25,7 +25,7 @@ sys.path.insert(0, str(ROOT))
 from prsm_health.dataset import Dataset, Recipe, generate, load_recipe  # noqa: E402
 from prsm_health.diagnosis import diagnose_indicators, load_bundle  # noqa: E402
 from prsm_health.features import GROUPS, dataset_features  # noqa: E402
-from prsm_health.training import clearance_target, train  # noqa: E402
+from prsm_health.training import CLEARANCE_PARAMS, clearance_target, train  # noqa: E402
 
 MODELS = ROOT / "models"
 
@@ -92,14 +92,7 @@ def ablation(work: Path) -> list[dict]:
     }
     rows = []
     for label, cols in subsets.items():
-        model = ClearanceEstimator(
-            alpha=0.1,
-            lower_limit=0.0,
-            min_samples_leaf=10,
-            max_iter=200,
-            learning_rate=0.05,
-            quantiles_of="residual",
-        )
+        model = ClearanceEstimator(**CLEARANCE_PARAMS)  # the settings train() uses
         model.fit(train_rows[cols], y_train)
         pred = model.predict(test_rows[cols])
         lo, hi = model.predict_interval(test_rows[cols])
