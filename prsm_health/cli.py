@@ -267,6 +267,11 @@ def _cmd_generate(args) -> int:
         )
     else:
         print(f"{recipe.name}: {dataset_throughput(report)} → {report.out}")
+    from .dataset import Dataset
+    from .training import training_problems
+
+    for text in training_problems(Dataset(report.out).runs):
+        print(f"warning: this dataset cannot train a model as is ({text})", file=sys.stderr)
     return 0
 
 
@@ -381,16 +386,27 @@ def _cmd_train(args) -> int:
         return 0
     rows = [("model", metrics["model"]["path"], ""), ("metrics", metrics["metrics_path"], "")]
     for key, label in (("clearance_cv", "clearance CV"), ("clearance_test", "clearance held-out")):
-        if key in metrics:
+        if metrics.get(key):
             m = metrics[key]
-            rows.append((f"{label} MAE", 1e6 * m["mae"], "µm"))
-            rows.append((f"{label} 90 % interval coverage", m["interval_coverage"], ""))
-            rows.append((f"{label} mean interval width", 1e6 * m["mean_interval_width"], "µm"))
+            rows.append((f"{label} MAE", _scaled(m.get("mae"), 1e6), "µm"))
+            rows.append(
+                (f"{label} 90 % interval coverage", _scaled(m.get("interval_coverage")), "")
+            )
+            rows.append(
+                (f"{label} mean interval width", _scaled(m.get("mean_interval_width"), 1e6), "µm")
+            )
     for key, label in (("fault_cv", "fault CV"), ("fault_test", "fault held-out")):
-        if key in metrics:
-            rows.append((f"{label} macro-F1", metrics[key]["macro_f1"], ""))
+        if metrics.get(key):
+            rows.append((f"{label} macro-F1", _scaled(metrics[key].get("macro_f1")), ""))
     _print_table(rows)
+    for text in metrics.get("warnings", []):
+        print(f"warning: {text}", file=sys.stderr)
     return 0
+
+
+def _scaled(value, factor: float = 1.0):
+    """A metric for the table; '–' where it could not be computed (None)."""
+    return "–" if value is None else factor * value
 
 
 # ----------------------------------------------------------------------------- simulate

@@ -5,10 +5,22 @@ Tests marked ``slow`` (registered in pyproject.toml) train models or simulate se
 """
 
 import functools
+import os
 
-import pytest
+# One OpenMP thread for the boosted trees: the models here are small, and with more threads
+# than free cores (parallel jobs, a loaded CI machine) OpenMP spin-waiting made single tests
+# take minutes (one took 543 s with helpers running). Set before scikit-learn loads its runtime.
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOptions, simulate
+import pytest  # noqa: E402
+
+from prsm_health import (  # noqa: E402
+    HealthState,
+    OperatingProfile,
+    SensorModel,
+    SimulationOptions,
+    simulate,
+)
 
 #: The regime in which the clearance is observable (docs/validation.md): a ±300 N load
 #: reversing at 10 Hz with 2 ms edges around a zero mean, Hertzian thread flanks.

@@ -182,3 +182,17 @@ def test_simulate_mcap_and_replay(tmp_path, capsys):
     truncated.write_bytes(out.read_bytes()[:200])
     code, _, err = run(capsys, "replay", str(truncated))
     assert code == 2 and err.startswith("error: ") and len(err.strip().splitlines()) == 1
+
+
+def test_generate_warns_when_the_dataset_cannot_train(tmp_path, capsys):
+    recipe = tmp_path / "small.toml"
+    recipe.write_text(
+        'name = "small"\ndesign = "paper01"\nduration = 0.02\nsample_rate = 20000\nseed = 1\n'
+        "[sweep]\nclearance = [5e-6, 40e-6]\nspeed = [80.0]\nload = [100.0]\n"
+    )
+    assert main(["generate", str(recipe), "--out", str(tmp_path / "d"), "--workers", "1"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: this dataset cannot train a model as is" in err and "add runs" in err
+    assert main(["train", str(tmp_path / "d"), "--out", str(tmp_path / "m.skops")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: ") and len(err.splitlines()) == 1
