@@ -161,7 +161,7 @@ SAINSOT_COEFFICIENTS = np.array(
 #: a solid gear or an integral roller gear the torque leaves through a shaft of finite size.
 #: The value is a modelling choice: with 3 (a bore or shaft of one third of the root
 #: diameter) the single-pair stiffness per unit face width of standard solid steel pairs lands
-#: on ISO 6336-1's single stiffness c' (about 12–14 N/(mm·µm), tests/test_gear_mesh.py).
+#: on ISO 6336-1's single stiffness c' (about 12–14 N/(mm·µm), tests/stiffness/test_gear_mesh.py).
 SOLID_BODY_HFI = 3.0
 
 #: Smallest h_fi = r_f/r_int accepted for a bored gear: below it the rim bends like a ring

@@ -122,7 +122,7 @@ def rows() -> list[Row]:
             float(f[np.argmax(a * (f > 100))]),
             "identical rollers at staggered mesh phases (65 mod 7 = 2) cancel the mesh "
             "fundamental in the nut rotation: the strongest line is a mesh harmonic; with "
-            "manufacturing variation the 388 Hz fundamental appears (tests/test_dynamics.py)",
+            "manufacturing variation the 388 Hz fundamental appears (tests/dynamics/test_dynamics.py)",
         )
     )
     d = preset("paper01")
