@@ -140,6 +140,7 @@ def test_interrupt_and_resume_in_process(recipe_path, tmp_path):
     assert sorted(runs["run_id"]) == list(range(6))
 
 
+@pytest.mark.slow
 def test_killed_process_resumes_without_duplicates_or_holes(recipe_path, tmp_path):
     out = tmp_path / "k"
     code = f"from prsm_health.dataset import generate; generate({str(recipe_path)!r}, {str(out)!r}, workers=1, progress=False)"
@@ -169,6 +170,7 @@ def test_killed_process_resumes_without_duplicates_or_holes(recipe_path, tmp_pat
     pd.testing.assert_frame_equal(signals, _signals(reference))
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_workers(tmp_path):
     # Ctrl-C reaches the whole process group; the workers ignore it and the parent stops them,
     # so no shard is written after the command has returned (it used to finish the running and

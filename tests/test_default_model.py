@@ -12,6 +12,9 @@ from prsm_health.dynamics.simulate import simulate
 from prsm_health.sensors import SensorModel
 from prsm_health.states import HealthState, OperatingProfile
 
+# Simulates fourteen recordings for the shipped model.
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 
 

@@ -16,6 +16,9 @@ from prsm_health.io.parquet import write_run_parquet
 from prsm_health.mcap import write_mcap
 from prsm_health.training import train
 
+# Trains a model on a generated dataset (≈ 20 s) and diagnoses simulated recordings.
+pytestmark = pytest.mark.slow
+
 RECIPE = textwrap.dedent(
     """
     name = "diag-test"

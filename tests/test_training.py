@@ -158,6 +158,7 @@ def test_cli_train_too_small_is_one_error_line(tiny, tmp_path, capsys):
 # ------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_useless_model_is_reported_not_dressed_up(tiny, tmp_path, monkeypatch):
     # The tiny dataset's manifest, a larger runs table, and indicators that are all constant:
     # the models can learn nothing, so they answer one value and one class.

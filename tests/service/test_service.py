@@ -527,6 +527,7 @@ def _serve_process(db: Path, env_token: str):
             proc.wait()
 
 
+@pytest.mark.slow
 def test_history_survives_a_restart(recording, tmp_path):
     db = tmp_path / "history.sqlite"
     with _serve_process(db, "env-token-1234") as (c, url):
