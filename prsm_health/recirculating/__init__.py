@@ -12,13 +12,11 @@ Modules (each documents its readings of the paper):
 
 - :mod:`.geometry` — threadless area (eqs. 5–12), carrier/cam-ring design rules
   (eqs. 13–22, :func:`check_recirculating`), assembly offsets (eqs. 34–37).
-- :mod:`.motion` — speeds, reset events and nut/roller displacements (eqs. 23–33).
+- :mod:`.travel` — speeds, reset events and nut/roller displacements (eqs. 23–33).
 - :mod:`.impact` — ADAMS IMPACT contact (eq. 38), the single-reset pulse and the sampled
   reset force series.
 
-Every public name is re-exported here; import from ``prsm_health.recirculating``. Note that
-``prsm_health.recirculating.motion`` is the function :func:`motion` (as before the split), not
-the submodule; reach the submodule through ``sys.modules`` or ``importlib`` if ever needed.
+Every public name is re-exported here; import from ``prsm_health.recirculating``.
 
 References
 ----------
@@ -59,10 +57,7 @@ from .impact import (
     reset_force_series,
     reset_pulse,
 )
-
-# Imported last: binding the function ``motion`` replaces the submodule attribute of the
-# same name, so ``prsm_health.recirculating.motion`` stays the function it always was.
-from .motion import (
+from .travel import (
     RecirculatingMotion,
     ResetEvents,
     carrier_speed,

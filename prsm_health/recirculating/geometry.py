@@ -3,7 +3,7 @@ checks and assembly offsets.
 
 A recirculating PRSM has grooved rollers (no helix, no gears). In the nut's threadless area the
 convex platform of a cam ring lifts each roller over one screw thread and pushes it forward by
-one lead (a "reset", :mod:`prsm_health.recirculating.motion`). This module holds the
+one lead (a "reset", :mod:`prsm_health.recirculating.travel`). This module holds the
 dimensions that make that possible: the threadless area (eqs. 5–12), the carrier and cam-ring
 design rules (eqs. 13–22) and the axial roller offsets of the assembly (eqs. 34–37).
 

@@ -47,7 +47,7 @@ from .geometry import (
     orbital_angle,
     reset_stroke,
 )
-from .motion import ResetEvents, _require_speed, carrier_speed, reset_events
+from .travel import ResetEvents, _require_speed, carrier_speed, reset_events
 
 
 # ------------------------------------------------------------------------- impact (eq. 38)

@@ -343,15 +343,14 @@ def test_zero_speed_gives_zero_signal(design):
 
 # ------------------------------------------------------------------ package layout
 def test_package_reexports_every_public_name():
-    for sub in ("geometry", "motion", "impact"):
+    for sub in ("geometry", "travel", "impact"):
         module = importlib.import_module(f"prsm_health.recirculating.{sub}")
         for name in dir(module):
             obj = getattr(module, name)
             if not name.startswith("_") and getattr(obj, "__module__", None) == module.__name__:
                 assert getattr(rc, name) is obj, name
                 assert name in rc.__all__, name
-    # The function, not the submodule of the same name, as before the split.
-    assert callable(rc.motion) and rc.motion.__module__ == "prsm_health.recirculating.motion"
+    assert callable(rc.motion) and rc.motion.__module__ == "prsm_health.recirculating.travel"
 
 
 def test_reset_pulse_failure_is_a_convergence_error(design, monkeypatch):
