@@ -80,10 +80,9 @@ def _print_validation_text(rows, width: int = 100) -> None:
 
 # ----------------------------------------------------------------------------- kinematics
 def _cmd_kinematics(args) -> int:
-    from .design import preset
     from .kinematics import characteristic_frequencies, speed_ratios
 
-    design = preset(args.design)
+    design = args.design
     ratios = speed_ratios(design)
     freqs = characteristic_frequencies(design, args.speed)
     out = {
@@ -151,10 +150,9 @@ def _cmd_stiffness_gear(args) -> int:
 
 
 def _cmd_stiffness_axial(args) -> int:
-    from .design import preset
     from .stiffness.thread import axial_stiffness
 
-    design = preset(args.design)
+    design = args.design
     result = axial_stiffness(design, args.load)
     out = {
         "design": design.name,
@@ -201,18 +199,15 @@ def _cmd_stiffness_cylinder(args) -> int:
 
 # ----------------------------------------------------------------------------- friction
 def _cmd_friction(args) -> int:
-    from .design import preset
     from .friction import FrictionParameters, simulate_friction
 
     if args.design:
-        params = FrictionParameters.from_design(
-            preset(args.design), friction_scale=args.friction_scale
-        )
+        params = FrictionParameters.from_design(args.design, friction_scale=args.friction_scale)
     else:
         params = FrictionParameters(friction_scale=args.friction_scale)
     result = simulate_friction(params, args.load, args.speed, args.accel_time, args.duration)
     out = {
-        "source": args.design or "paper02 table",
+        "source": args.design.name if args.design else "paper02 table",
         "load": args.load,
         "speed": args.speed,
         "accel_time": args.accel_time,
@@ -231,6 +226,39 @@ def _cmd_friction(args) -> int:
                 ("steady efficiency", result.steady_efficiency, ""),
             ]
         )
+    return 0
+
+
+# ----------------------------------------------------------------------------- design
+def _cmd_design_template(args) -> int:
+    from .design import preset
+    from .design_files import design_to_toml
+
+    print(
+        f"# PRSM design file, from preset {args.preset}: edit the values (SI units: m, kg, kg·m²,\n"
+        "# Pa, rad), rename it, then `prsm-health design check FILE` and use it with\n"
+        "# --design FILE. Optional fields left out take their defaults (docs/formats.md).\n"
+    )
+    print(design_to_toml(preset(args.preset)), end="")
+    return 0
+
+
+def _cmd_design_show(args) -> int:
+    from .design_files import design_rows, load_design
+
+    design = load_design(args.design)
+    if args.json:
+        _print_json(design.to_dict())
+    else:
+        _print_table(design_rows(design))
+    return 0
+
+
+def _cmd_design_check(args) -> int:
+    from .design_files import load_design
+
+    design = load_design(args.file)
+    print(f"ok: {design.name}")
     return 0
 
 
@@ -513,6 +541,19 @@ class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action)
 
 
+DESIGN_HELP = "preset name (paper01…paper05) or design TOML file"
+
+
+def _design(text: str):
+    """``--design``: a preset name or a design file, loaded here so errors name the option."""
+    from .design_files import load_design
+
+    try:
+        return load_design(text)
+    except PRSMHealthError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _add_json(p, what: str = "the result") -> None:
     p.add_argument("--json", action="store_true", help=f"print {what} as JSON instead of a table")
 
@@ -539,8 +580,27 @@ def build_parser() -> argparse.ArgumentParser:
     fmt.add_argument("--markdown", action="store_true", help="print a Markdown table")
     p.set_defaults(func=_cmd_validate)
 
+    p = command("design", "design files: a template, a design's fields, a check")
+    dsub = p.add_subparsers(dest="action", required=True, parser_class=_Parser)
+
+    def design(name: str, text: str):
+        return dsub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+
+    t = design("template", "print a commented design TOML file to start from")
+    t.add_argument(
+        "--from", dest="preset", default=DEFAULT_PRESET, choices=designs, help="preset to copy"
+    )
+    t.set_defaults(func=_cmd_design_template)
+    t = design("show", "print every field of a design with its unit")
+    t.add_argument("design", help=DESIGN_HELP)
+    _add_json(t, "the design's dict form")
+    t.set_defaults(func=_cmd_design_show)
+    t = design("check", "validate a design file: 'ok: NAME', or one error line and exit 2")
+    t.add_argument("file", help="design TOML file (or a preset name)")
+    t.set_defaults(func=_cmd_design_check)
+
     p = command("kinematics", "speed ratios and characteristic frequencies of a design")
-    p.add_argument("--design", default=DEFAULT_PRESET, choices=designs, help="design preset")
+    p.add_argument("--design", type=_design, default=DEFAULT_PRESET, help=DESIGN_HELP)
     p.add_argument("--speed", type=_finite_float, required=True, help="screw speed [rad/s]")
     _add_json(p)
     p.set_defaults(func=_cmd_kinematics)
@@ -570,7 +630,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.set_defaults(func=_cmd_stiffness_gear)
 
     a = stiffness("axial", "axial stiffness of the whole PRSM (papers 01, 04)")
-    a.add_argument("--design", default=DEFAULT_PRESET, choices=designs, help="design preset")
+    a.add_argument("--design", type=_design, default=DEFAULT_PRESET, help=DESIGN_HELP)
     a.add_argument("--load", type=_finite_float, required=True, help="axial load [N]")
     _add_json(a)
     a.set_defaults(func=_cmd_stiffness_axial)
@@ -581,7 +641,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_json(c)
     c.set_defaults(func=_cmd_stiffness_cylinder)
 
-    _add_simulate_parser(command, DEFAULT_PRESET, designs)
+    _add_simulate_parser(command, DEFAULT_PRESET)
 
     g = command("generate", "generate a labelled dataset from a recipe (resumable after Ctrl-C)")
     g.add_argument("recipe", help="TOML recipe (see datasets/ and docs/formats.md)")
@@ -676,18 +736,18 @@ def build_parser() -> argparse.ArgumentParser:
     )
     f.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
     f.add_argument(
-        "--design", default=None, choices=designs, help="design preset (None: paper 02's table)"
+        "--design", type=_design, default=None, help=f"{DESIGN_HELP} (None: paper 02's table)"
     )
     _add_json(f)
     f.set_defaults(func=_cmd_friction)
     return parser
 
 
-def _add_simulate_parser(command, default_preset, designs) -> None:
+def _add_simulate_parser(command, default_preset) -> None:
     from .states import LOADS, MOTIONS
 
     s = command("simulate", "simulate a PRSM run (paper 01 dynamics) and write it")
-    s.add_argument("--design", default=default_preset, choices=designs, help="design preset")
+    s.add_argument("--design", type=_design, default=default_preset, help=DESIGN_HELP)
     s.add_argument(
         "--clearance", type=_finite_float, default=10e-6, help="thread half-clearance b [m]"
     )

@@ -35,6 +35,7 @@ import numpy as np
 
 from .channels import CHANNEL_NAMES, UNITS
 from .design import PRESETS
+from .design_files import load_design
 from .errors import ParameterError, PRSMHealthError, RecipeError, require
 from .jsonable import dumps
 from .run import Run
@@ -68,7 +69,7 @@ class Recipe:
     """A parsed, validated recipe. Build with :func:`load_recipe` or :meth:`from_dict`."""
 
     name: str
-    design: str
+    design: str | dict
     duration: float
     sample_rate: float
     seed: int
@@ -83,11 +84,19 @@ class Recipe:
     source: dict = field(default_factory=dict, compare=False)
 
     @classmethod
-    def from_dict(cls, data: dict) -> Recipe:
+    def from_dict(cls, data: dict, *, base: Path | None = None) -> Recipe:
+        """Parse and validate the dict form of a recipe.
+
+        ``design`` is a preset name, kept as is, or a design TOML file (a relative path against
+        ``base``, else the working directory) or the design's dict form: both are stored as the
+        full design dict, so ``source`` (what workers rebuild the recipe from, and what the
+        manifest and the fingerprint record) holds the design itself, not a path.
+        """
         data = dict(data)
         for key in ("name", "design", "duration", "sample_rate", "seed", "sweep"):
             if key not in data:
                 raise RecipeError(f"recipe: missing key {key!r}")
+        data["design"] = _recipe_design(data["design"], base)
         known = {f.name for f in fields(cls)} - {"source"}
         unknown = sorted(set(data) - known)
         if unknown:
@@ -113,10 +122,10 @@ class Recipe:
             "must be a non-empty string",
         )
         check(
-            self.design in PRESETS,
+            self.design in PRESETS if isinstance(self.design, str) else True,
             "design",
             self.design,
-            f"must be one of {', '.join(sorted(PRESETS))}",
+            f"must be one of {', '.join(sorted(PRESETS))} or a design TOML file",
         )
         check(
             isinstance(self.duration, (int, float)) and 0 < self.duration <= 60,
@@ -356,7 +365,19 @@ def load_recipe(path: str | Path) -> Recipe:
         raise RecipeError(f"{path}: no such recipe file") from None
     except tomllib.TOMLDecodeError as exc:
         raise RecipeError(f"{path}: not valid TOML ({exc})") from None
-    return Recipe.from_dict(data)
+    return Recipe.from_dict(data, base=path.parent)
+
+
+def _recipe_design(design, base: Path | None) -> str | dict:
+    """A preset name as is; a design file or dict as the validated design's dict form."""
+    if isinstance(design, str) and design in PRESETS:
+        return design
+    try:
+        return load_design(design, base=base).to_dict()
+    except ParameterError as exc:
+        raise RecipeError(f"recipe: {exc}") from None
+    except PRSMHealthError as exc:
+        raise RecipeError(f"recipe: design: {exc}") from None
 
 
 # ---------------------------------------------------------------------- generation

@@ -23,7 +23,7 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import MISSING, dataclass, field, fields, replace
 
 from .errors import ParameterError, require, require_positive, require_range
 
@@ -481,6 +481,78 @@ class PRSMDesign:
     def with_(self, **changes) -> PRSMDesign:
         """A validated copy with some fields changed."""
         return replace(self, **changes)
+
+    # ---------------------------------------------------------------- dict form
+    def to_dict(self) -> dict:
+        """Every field, SI units, nested dicts for materials, gear and masses (``None`` kept)."""
+        return _to_dict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> PRSMDesign:
+        """Build from the nested dict form of :meth:`to_dict`.
+
+        An unknown key raises :class:`ParameterError` naming the dotted field
+        (``design.gear.modul``) and listing the allowed keys; a value of the wrong type names
+        the field and the expected type; then the usual validation runs. Integers are accepted
+        for float fields; optional fields (``None`` default) may be left out.
+        """
+        return _from_dict(cls, data, "design")
+
+
+_NESTED = {"Material": Material, "GearGeometry": GearGeometry, "MassProperties": MassProperties}
+
+
+def _to_dict(obj) -> dict:
+    out = {}
+    for f in fields(obj):
+        value = getattr(obj, f.name)
+        out[f.name] = _to_dict(value) if type(value).__name__ in _NESTED else value
+    return out
+
+
+def _expected(annotation: str) -> tuple[str, bool]:
+    """(base type name, optional) of a field annotation such as ``"float | None"``."""
+    optional = annotation.endswith(" | None")
+    return annotation.removesuffix(" | None"), optional
+
+
+def _from_dict(kind: type, data, where: str):
+    if not isinstance(data, dict):
+        raise ParameterError(where, data, f"must be a table of {kind.__name__} fields")
+    allowed = [f.name for f in fields(kind)]
+    unknown = sorted(set(data) - set(allowed))
+    if unknown:
+        raise ParameterError(
+            f"{where}.{unknown[0]}", data[unknown[0]], f"unknown key; allowed: {', '.join(allowed)}"
+        )
+    values = {}
+    for f in fields(kind):
+        name = f"{where}.{f.name}"
+        base, optional = _expected(str(f.type))
+        if f.name not in data:
+            if f.default is MISSING and f.default_factory is MISSING:
+                raise ParameterError(name, None, f"missing: a required {base} field")
+            continue
+        value = data[f.name]
+        if value is None and optional:
+            values[f.name] = None
+        elif base in _NESTED:
+            values[f.name] = _from_dict(_NESTED[base], value, name)
+        elif base == "float":
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ParameterError(name, value, "wrong type: expected a number (float)")
+            values[f.name] = float(value)
+        elif base == "int":
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise ParameterError(name, value, "wrong type: expected an integer (int)")
+            values[f.name] = value
+        elif base == "str":
+            if not isinstance(value, str):
+                raise ParameterError(name, value, "wrong type: expected a string (str)")
+            values[f.name] = value
+        else:  # pragma: no cover - a field type this function does not know
+            raise TypeError(f"{name}: unsupported field type {f.type}")
+    return kind(**values)
 
 
 def recirculating_roller_limit(design: PRSMDesign) -> float:

@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .design import PRSMDesign, preset
+from .design import PRSMDesign
+from .design_files import load_design
 from .errors import PRSMHealthError
 from .features import extract_features, windows
 from .jsonable import finite_or_none
@@ -46,7 +47,7 @@ class ModelBundle:
     design: PRSMDesign = field(init=False)
 
     def __post_init__(self):
-        self.design = preset(self.metadata.get("design", "paper01"))
+        self.design = load_design(self.metadata.get("design", "paper01"))
 
     @property
     def name(self) -> str:

@@ -8,7 +8,8 @@ are the run labels of the contract (docs/formats.md).
 
 The dict form (and the TOML form, the same tables)::
 
-    design = "paper01"                       # preset name
+    design = "paper01"                       # preset name or design TOML file (relative to the
+                                             # scenario file), or a [design] table (design files)
     seed = 3
     [health]   clearance = 20e-6             # shorthand for screw, nut and gear; or each field
     [profile]  duration = 0.5, speed = 100.0, load = 100.0, …   (OperatingProfile fields)
@@ -22,7 +23,8 @@ import sys
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from .design import DEFAULT_PRESET, PRSMDesign, preset
+from .design import DEFAULT_PRESET, PRESETS, PRSMDesign, preset
+from .design_files import design_toml_tables, load_design
 from .dynamics.model import SimulationOptions
 from .errors import ParameterError, PRSMHealthError, require
 from .sensors import SensorModel
@@ -47,7 +49,7 @@ class Scenario:
 
     Parameters
     ----------
-    design : PRSMDesign or preset name, default "paper01"
+    design : PRSMDesign, preset name, design TOML file or dict form, default "paper01"
     health : HealthState
     profile : OperatingProfile
     sensors : SensorModel
@@ -64,8 +66,8 @@ class Scenario:
     seed: int = 0
 
     def __post_init__(self):
-        if isinstance(self.design, str):
-            object.__setattr__(self, "design", preset(self.design))
+        if not isinstance(self.design, PRSMDesign):
+            object.__setattr__(self, "design", load_design(self.design))
         require(
             isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0,
             "seed",
@@ -75,8 +77,12 @@ class Scenario:
 
     # ------------------------------------------------------------------ dict / TOML
     @classmethod
-    def from_dict(cls, data: dict) -> Scenario:
-        """Build from the nested dict form (module docstring); errors name the table and key."""
+    def from_dict(cls, data: dict, *, base: Path | None = None) -> Scenario:
+        """Build from the nested dict form (module docstring); errors name the table and key.
+
+        ``design`` is a preset name, a design TOML file (relative paths against ``base``, else
+        the working directory), the dict form of :meth:`PRSMDesign.to_dict` or a design.
+        """
         data = dict(data)
         unknown = sorted(set(data) - {"design", "seed", *_GROUPS})
         if unknown:
@@ -86,23 +92,28 @@ class Scenario:
                 f"unknown key(s); allowed: design, seed, {', '.join(_GROUPS)}",
             )
         groups = {name: _group(name, kind, data.get(name, {})) for name, kind in _GROUPS.items()}
-        return cls(design=data.get("design", DEFAULT_PRESET), seed=data.get("seed", 0), **groups)
+        design = load_design(data.get("design", DEFAULT_PRESET), base=base)
+        return cls(design=design, seed=data.get("seed", 0), **groups)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Scenario:
         """Read a scenario file (the dict form as TOML tables)."""
         path = Path(path)
         try:
-            return cls.from_dict(tomllib.loads(path.read_text()))
+            data = tomllib.loads(path.read_text())
         except FileNotFoundError:
             raise PRSMHealthError(f"{path}: no such scenario file") from None
         except tomllib.TOMLDecodeError as exc:
             raise PRSMHealthError(f"{path}: not valid TOML ({exc})") from None
+        return cls.from_dict(data, base=path.parent)
 
     def to_dict(self) -> dict:
-        """The nested dict form, as stored with every run (``Run.scenario``)."""
+        """The nested dict form, as stored with every run (``Run.scenario``).
+
+        ``design`` is the preset name for an unmodified preset, else the design's full dict.
+        """
         return {
-            "design": self.design.name,
+            "design": self.design_ref(),
             "health": self.health.as_dict(),
             "profile": self.profile.as_dict(),
             "sensors": self.sensors.as_dict(),
@@ -110,10 +121,20 @@ class Scenario:
             "seed": self.seed,
         }
 
+    def design_ref(self) -> str | dict:
+        """The preset name if the design is an unmodified preset, else its full dict form."""
+        name = self.design.name
+        if name in PRESETS and self.design == preset(name):
+            return name
+        return self.design.to_dict()
+
     def to_toml(self) -> str:
         """TOML text that :meth:`from_toml` reads back to an equal scenario."""
         data = self.to_dict()
-        lines = [f'design = "{data.pop("design")}"', f"seed = {data.pop('seed')}"]
+        design = data.pop("design")
+        lines = [f"seed = {data.pop('seed')}"]
+        if isinstance(design, str):
+            lines.insert(0, f'design = "{design}"')
         options = data["options"]
         variation = options.pop("variation")
         for table, values in data.items():
@@ -121,6 +142,8 @@ class Scenario:
             lines += [f"{k} = {_toml_value(v)}" for k, v in values.items() if v is not None]
         lines.append("\n[options.variation]")
         lines += [f"{k} = {_toml_value(v)}" for k, v in variation.items()]
+        if not isinstance(design, str):
+            lines += [""] + design_toml_tables(self.design, "design")
         return "\n".join(lines) + "\n"
 
     # ------------------------------------------------------------------ labels

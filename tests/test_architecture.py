@@ -18,6 +18,7 @@ LAYERS = {
     "channels": 0,
     "run": 0,
     "design": 1,
+    "design_files": 1,
     "states": 1,
     "kinematics": 1,
     "stiffness": 1,
