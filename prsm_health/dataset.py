@@ -26,7 +26,6 @@ import hashlib
 import itertools
 import json
 import os
-import sys
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -41,11 +40,7 @@ from .jsonable import dumps
 from .run import Run
 from .scenario import Scenario
 from .states import FAULT_CLASSES, FaultThresholds
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+from .tomlfile import read_toml
 
 FORMATS = ("parquet", "mcap", "both")
 SWEEP_MODES = ("grid", "random", "lhs")
@@ -359,13 +354,7 @@ class RunSpec:
 def load_recipe(path: str | Path) -> Recipe:
     """Parse and validate a TOML recipe; errors name the key."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise RecipeError(f"{path}: no such recipe file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise RecipeError(f"{path}: not valid TOML ({exc})") from None
-    return Recipe.from_dict(data, base=path.parent)
+    return Recipe.from_dict(read_toml(path, "recipe file", RecipeError), base=path.parent)
 
 
 def _recipe_design(design, base: Path | None) -> str | dict:

@@ -10,16 +10,11 @@ file's stem. See docs/formats.md → Design files.
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 
 from .design import PRESETS, GearGeometry, MassProperties, Material, PRSMDesign, preset
-from .errors import ParameterError, PRSMHealthError
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+from .errors import ParameterError
+from .tomlfile import read_toml
 
 #: Unit and meaning of every design field, by dotted name below the design (``gear.module``);
 #: the material fields apply to each of the three ``*_material`` tables.
@@ -111,14 +106,7 @@ def load_design(design: str | Path | dict | PRSMDesign, *, base: Path | None = N
             str(design),
             f"must be one of {', '.join(sorted(PRESETS))} or a design TOML file (*.toml)",
         )
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise PRSMHealthError(f"{path}: no such design file") from None
-    except IsADirectoryError:
-        raise PRSMHealthError(f"{path}: is a directory, not a design file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise PRSMHealthError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path, "design file")
     data.setdefault("name", path.stem)
     return PRSMDesign.from_dict(data)
 

@@ -19,21 +19,16 @@ The dict form (and the TOML form, the same tables)::
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from .design import DEFAULT_PRESET, PRESETS, PRSMDesign, preset
 from .design_files import design_toml_tables, load_design
 from .dynamics.model import SimulationOptions
-from .errors import ParameterError, PRSMHealthError, require
+from .errors import ParameterError, require
 from .sensors import SensorModel
 from .states import HealthState, ManufacturingVariation, OperatingProfile
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+from .tomlfile import read_toml
 
 _GROUPS = {
     "health": HealthState,
@@ -99,13 +94,7 @@ class Scenario:
     def from_toml(cls, path: str | Path) -> Scenario:
         """Read a scenario file (the dict form as TOML tables)."""
         path = Path(path)
-        try:
-            data = tomllib.loads(path.read_text())
-        except FileNotFoundError:
-            raise PRSMHealthError(f"{path}: no such scenario file") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise PRSMHealthError(f"{path}: not valid TOML ({exc})") from None
-        return cls.from_dict(data, base=path.parent)
+        return cls.from_dict(read_toml(path, "scenario file"), base=path.parent)
 
     def to_dict(self) -> dict:
         """The nested dict form, as stored with every run (``Run.scenario``).

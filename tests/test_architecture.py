@@ -17,6 +17,7 @@ LAYERS = {
     "jsonable": 0,
     "channels": 0,
     "run": 0,
+    "tomlfile": 0,
     "design": 1,
     "design_files": 1,
     "states": 1,
