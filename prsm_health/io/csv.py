@@ -11,11 +11,9 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-import numpy as np
-
-from ..channels import CHANNEL_NAMES
 from ..errors import PRSMHealthError
 from ..run import Run, ms_hint
+from ._columns import contract_channels, rate_from_time
 
 
 def read_csv(path: str | Path) -> Run:
@@ -35,15 +33,8 @@ def read_csv(path: str | Path) -> Run:
         time = frame["time_ms"].to_numpy(float) / 1000.0
     else:
         raise PRSMHealthError(f"{path}: no 'time' column [s] (or 'time_ms' [ms])")
-    channels = {c: frame[c].to_numpy(float) for c in CHANNEL_NAMES if c in frame.columns}
-    if not channels:
-        raise PRSMHealthError(
-            f"{path}: no usable channels (expected contract names such as nut_axial_accel; "
-            f"found {', '.join(map(str, frame.columns[:8]))})"
-        )
-    if len(time) < 2 or not np.all(np.diff(time) > 0):
-        raise PRSMHealthError(f"{path}: 'time' must increase strictly")
-    rate = 1.0 / float(np.median(np.diff(time)))
+    channels = contract_channels(path, frame.columns, lambda c: frame[c].to_numpy())
+    rate = rate_from_time(path, time)
     hint = ms_hint(rate)
     if hint:
         warnings.warn(f"{path}: {hint.lstrip(' —')}", UserWarning, stacklevel=2)

@@ -8,12 +8,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
-
-from ..channels import CHANNEL_NAMES, UNITS
+from ..channels import UNITS
 from ..errors import PRSMHealthError
 from ..jsonable import dumps
 from ..run import Run
+from ._columns import contract_channels, rate_from_time
 
 
 def write_run_parquet(run: Run, path: str | Path) -> Path:
@@ -51,20 +50,12 @@ def read_run_parquet(path: str | Path) -> Run:
     meta = table.schema.metadata or {}
     if "time" not in table.column_names:
         raise PRSMHealthError(f"{path}: no 'time' column")
-    channels = {
-        name: table.column(name).to_numpy().astype(float)
-        for name in CHANNEL_NAMES
-        if name in table.column_names
-    }
-    if not channels:
-        raise PRSMHealthError(f"{path}: none of the contract channels is present")
+    channels = contract_channels(path, table.column_names, lambda c: table.column(c).to_numpy())
     time = table.column("time").to_numpy().astype(float)
     if b"prsm_health.sample_rate" in meta:
         rate = float(meta[b"prsm_health.sample_rate"])
-    elif len(time) > 1:
-        rate = 1.0 / float(np.median(np.diff(time)))
     else:
-        raise PRSMHealthError(f"{path}: cannot tell the sample rate from one sample")
+        rate = rate_from_time(path, time)
     labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
     scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
     return Run(time, channels, rate, labels, scenario)

@@ -500,32 +500,26 @@ def test_crashed_recording_without_footer(tmp_path, short_run):
     assert len(back) == len(short_run)  # the writer had flushed every chunk
 
 
+def _one_message_file(path, topic, encoding, payload):
+    """An MCAP file with a single message, written by mcap's own Writer."""
+    with open(path, "wb") as f:
+        writer = Writer(f)
+        writer.start()
+        cid = writer.register_channel(topic, encoding, 0)
+        writer.add_message(cid, 0, payload, 0)
+        writer.finish()
+    return path
+
+
 def test_other_topics_and_encodings(tmp_path):
     path = tmp_path / "other.mcap"
-    with open(path, "wb") as f:
-        writer = Writer(f)
-        writer.start()
-        cid = writer.register_channel("/camera", "json", 0)
-        writer.add_message(cid, 0, b"{}", 0)
-        writer.finish()
-    with pytest.raises(PRSMHealthError, match="topics present: /camera"):
-        read_mcap(path)
-    with open(path, "wb") as f:
-        writer = Writer(f)
-        writer.start()
-        cid = writer.register_channel(TOPIC_DRIVE, "cbor", 0)
-        writer.add_message(cid, 0, b"\xa0", 0)
-        writer.finish()
-    with pytest.raises(PRSMHealthError, match="only 'json' is supported"):
-        read_mcap(path)
-    with open(path, "wb") as f:
-        writer = Writer(f)
-        writer.start()
-        cid = writer.register_channel(TOPIC_DRIVE, "json", 0)
-        writer.add_message(cid, 0, b"{not json", 0)
-        writer.finish()
-    with pytest.raises(PRSMHealthError, match="is not valid JSON"):
-        read_mcap(path)
+    for topic, encoding, payload, message in (
+        ("/camera", "json", b"{}", "topics present: /camera"),
+        (TOPIC_DRIVE, "cbor", b"\xa0", "only 'json' is supported"),
+        (TOPIC_DRIVE, "json", b"{not json", "is not valid JSON"),
+    ):
+        with pytest.raises(PRSMHealthError, match=message):
+            read_mcap(_one_message_file(path, topic, encoding, payload))
 
 
 # ----------------------------------------------------------------------------- replay

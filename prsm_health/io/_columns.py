@@ -1,0 +1,31 @@
+"""What the column-table readers (CSV, Parquet) share: picking the contract channels and the
+sample rate from the time axis."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+import numpy as np
+
+from ..channels import CHANNEL_NAMES
+from ..errors import PRSMHealthError
+
+
+def contract_channels(path: Path, columns: Iterable[str], column: Callable) -> dict:
+    """Every column named like a contract channel, as float arrays (SI); none is an error."""
+    columns = list(columns)
+    channels = {c: np.asarray(column(c), dtype=float) for c in CHANNEL_NAMES if c in columns}
+    if not channels:
+        raise PRSMHealthError(
+            f"{path}: no usable channels (expected contract names such as nut_axial_accel; "
+            f"found {', '.join(map(str, columns[:8]))})"
+        )
+    return channels
+
+
+def rate_from_time(path: Path, time: np.ndarray) -> float:
+    """Sample rate [Hz] of a uniformly sampled, strictly increasing time axis [s]."""
+    if len(time) < 2 or not np.all(np.diff(time) > 0):
+        raise PRSMHealthError(f"{path}: 'time' must increase strictly (and hold 2 samples or more)")
+    return 1.0 / float(np.median(np.diff(time)))
