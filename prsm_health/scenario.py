@@ -24,6 +24,7 @@ from pathlib import Path
 
 from .design import DEFAULT_PRESET, PRESETS, PRSMDesign, preset
 from .design_files import design_toml_tables, load_design
+from .drive_train import DriveTrain
 from .dynamics.model import SimulationOptions
 from .errors import ParameterError, require
 from .sensors import SensorModel
@@ -35,6 +36,7 @@ _GROUPS = {
     "profile": OperatingProfile,
     "sensors": SensorModel,
     "options": SimulationOptions,
+    "drive_train": DriveTrain,
 }
 
 
@@ -59,6 +61,7 @@ class Scenario:
     sensors: SensorModel = field(default_factory=SensorModel)
     options: SimulationOptions = field(default_factory=SimulationOptions)
     seed: int = 0
+    drive_train: DriveTrain = field(default_factory=DriveTrain)
 
     def __post_init__(self):
         if not isinstance(self.design, PRSMDesign):
@@ -107,6 +110,7 @@ class Scenario:
             "profile": self.profile.as_dict(),
             "sensors": self.sensors.as_dict(),
             "options": self.options.as_dict(),
+            "drive_train": self.drive_train.as_dict(),
             "seed": self.seed,
         }
 

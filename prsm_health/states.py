@@ -12,7 +12,7 @@ extending actuator). Reversing load profiles swing it through zero.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
@@ -20,7 +20,8 @@ from .errors import require, require_positive, require_range
 
 MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
 LOADS = ("constant", "sinusoidal", "reversing")
-DRIVES = ("prescribed", "speed_loop")
+DRIVES = ("prescribed", "speed_loop", "position_loop")
+RAMP_SHAPES = ("linear", "cosine")
 #: Fault classes of the taxonomy (run label ``fault_class``).
 FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
 
@@ -89,10 +90,18 @@ class OperatingProfile:
         around ``load`` as a trapezoidal wave with ``accel_time`` transitions.
     load_frequency : float [Hz]
         Frequency of the sinusoidal or reversing load.
-    drive : {"prescribed", "speed_loop"}
-        Prescribed screw motion (ideal servo), or a PI speed loop on the screw with its gains.
+    load_ramp_time : float or None [s]
+        Duration of each reversal of the reversing load; None: ``accel_time``.
+    load_ramp_shape : {"linear", "cosine"}
+        Shape of those reversals: a straight ramp, or a raised cosine (smooth, no jerk step).
+    drive : {"prescribed", "speed_loop", "position_loop"}
+        Prescribed motor angle (ideal servo); a PI speed loop on the motor speed; or a
+        position loop (P, ``position_loop_gain``) cascaded on that speed loop, following the
+        motion's angle — motion reversals as a position-controlled actuator makes them.
     speed_loop_bandwidth : float [Hz]
-        Closed-loop bandwidth of the speed loop (sets the PI gains from the screw inertia).
+        Closed-loop bandwidth of the speed loop (sets the PI gains from motor + screw inertia).
+    position_loop_gain : float [1/s]
+        Proportional gain of the position loop (speed command per angle error).
     torque_limit : float [N·m]
         Motor torque limit of the speed loop.
     """
@@ -106,8 +115,11 @@ class OperatingProfile:
     load: float = 100.0
     load_amplitude: float = 0.0
     load_frequency: float = 20.0
+    load_ramp_time: float | None = None
+    load_ramp_shape: str = "linear"
     drive: str = "prescribed"
     speed_loop_bandwidth: float = 50.0
+    position_loop_gain: float = 60.0
     torque_limit: float = 50.0
 
     def __post_init__(self):
@@ -149,6 +161,15 @@ class OperatingProfile:
         require_range("profile.load_amplitude", self.load_amplitude, 0.0, 1e6, unit="N")
         require_range("profile.load_frequency", self.load_frequency, 0.0, 1e4, unit="Hz")
         require_positive("profile.speed_loop_bandwidth", self.speed_loop_bandwidth)
+        require_range("profile.position_loop_gain", self.position_loop_gain, 0.0, 1e4, unit="1/s")
+        if self.load_ramp_time is not None:
+            require_range("profile.load_ramp_time", self.load_ramp_time, 0.0, 10.0, unit="s")
+        require(
+            self.load_ramp_shape in RAMP_SHAPES,
+            "profile.load_ramp_shape",
+            self.load_ramp_shape,
+            f"must be one of {', '.join(RAMP_SHAPES)}",
+        )
         require_positive("profile.torque_limit", self.torque_limit)
 
     # ------------------------------------------------------------------ knots for the kernel
@@ -186,16 +207,23 @@ class OperatingProfile:
             return np.array([[0.0, T], [F, F]]), 0.0, 0.0
         if self.load_profile == "sinusoidal":
             return np.array([[0.0, T], [F, F]]), self.load_amplitude, self.load_frequency
-        # reversing: trapezoidal wave F ± A
+        # reversing: trapezoidal wave F ± A with linear or raised-cosine reversals
         A = self.load_amplitude
         half = 0.5 / self.load_frequency if self.load_frequency > 0 else T
-        ramp = min(self.accel_time, 0.5 * half) or 1e-6
+        ramp_time = self.accel_time if self.load_ramp_time is None else self.load_ramp_time
+        ramp = min(ramp_time, 0.5 * half) or 1e-6
+        # a raised cosine as 16 linear pieces: within 0.5 % of the amplitude
+        shape = np.linspace(0.0, 1.0, 2 if self.load_ramp_shape == "linear" else 17)
+        if self.load_ramp_shape == "cosine":
+            shape = 0.5 - 0.5 * np.cos(np.pi * shape)
+        pieces = np.linspace(-0.5, 0.5, len(shape)) * ramp
         times, values = [0.0], [F + A]
         k = 1
         while k * half - ramp / 2 < T:
-            sign = -1.0 if k % 2 else 1.0
-            times += [k * half - ramp / 2, k * half + ramp / 2]
-            values += [F - sign * A, F + sign * A]
+            start = F + A if k % 2 else F - A
+            end = F - A if k % 2 else F + A
+            times += list(k * half + pieces)
+            values += list(start + (end - start) * shape)
             k += 1
         times.append(max(T, times[-1] + 1e-6))
         values.append(values[-1])
@@ -213,27 +241,50 @@ class OperatingProfile:
         return asdict(self)
 
 
+#: ISO 3408-3 lead-deviation tolerances by grade: (v_300p, v_2πp) [m] — travel variation within
+#: 300 mm and within one revolution (grade 7 has no v_2πp in the standard: engineering value).
+LEAD_GRADES = {1: (6e-6, 4e-6), 3: (12e-6, 6e-6), 5: (23e-6, 8e-6), 7: (52e-6, 10e-6)}
+
+
 @dataclass(frozen=True)
 class ManufacturingVariation:
-    """As-built scatter between rollers, drawn per run from its seed (standard deviations).
+    """As-built geometry errors, drawn per run from its seed (standard deviations or amplitudes).
 
-    Defaults are ISO-grade-5-like tolerances for a precision PRSM: the papers give none. They
-    make the rollers share load unequally and break the perfect mesh-phase cancellation, so
-    the mesh fundamental appears in the nut vibration as on real hardware
-    (docs/validation.md, paper 01 dynamics: manufacturing variation).
+    The papers give no tolerances. Defaults: a precision PRSM at ISO 3408-3 grade 5 (lead) with
+    ground threads and ISO 1328-1 grade-6-class gears; :meth:`grade` gives the lead figures of
+    other grades. They make the rollers share load unequally, break the perfect mesh-phase
+    cancellation, and excite the threads along the screw, so steady running vibrates as on real
+    hardware (docs/validation.md, excitation along the screw).
 
     Parameters
     ----------
     pitch_error : float [m]
-        Axial position error of each roller's thread against screw and nut.
+        Axial position error of each roller's thread against screw and nut (σ).
     position_error : float [rad]
-        Angular position error of each carrier pocket.
+        Angular position error of each carrier pocket (σ).
     eccentricity : float [m]
-        Radial position error of each pocket (roller runout).
+        Radial position error of each pocket (σ).
     mesh_stiffness_spread : float [-]
-        Relative scatter of each roller's gear mesh stiffness.
+        Relative scatter of each roller's gear mesh stiffness (σ).
     transmission_error : float [m]
-        Static transmission-error offset of each roller gear along the line of action.
+        Static transmission-error offset of each roller gear along the line of action (σ).
+    lead_error_cumulative : float [m]
+        ISO 3408-3 v_300p: screw travel deviation accumulated over 300 mm; the run's lead
+        deviation is drawn as N(0, (v_300p/2)²) per 300 mm (grade 5: 23 µm).
+    lead_error_periodic : float [m]
+        ISO 3408-3 v_2πp: peak-to-peak travel variation within one screw revolution (grade 5:
+        8 µm), split over the 1st–3rd harmonics of the screw angle, random phases.
+    screw_runout : float [m]
+        Radial runout of the screw thread about the bearing axis (1st harmonic).
+    roller_runout : float [m]
+        Radial runout of each roller's thread about its spin axis (amplitude scale per roller).
+    gear_pitch_error : float [m]
+        Cumulative pitch deviation F_p of the ring gear (once per turn of a roller around it).
+    gear_profile_error : float [m]
+        Profile form deviation f_fα: transmission-error harmonics 1 and 2 of the mesh.
+    flank_waviness : float [m]
+        RMS waviness of the screw and nut flanks along the contact path, wavelengths 0.3–3 mm
+        (shorter waves are averaged out by the contact ellipse), 6 components per flank.
     """
 
     pitch_error: float = 2e-6
@@ -241,6 +292,13 @@ class ManufacturingVariation:
     eccentricity: float = 2e-6
     mesh_stiffness_spread: float = 0.03
     transmission_error: float = 1e-6
+    lead_error_cumulative: float = LEAD_GRADES[5][0]
+    lead_error_periodic: float = LEAD_GRADES[5][1]
+    screw_runout: float = 5e-6
+    roller_runout: float = 2e-6
+    gear_pitch_error: float = 11e-6
+    gear_profile_error: float = 5e-6
+    flank_waviness: float = 0.25e-6
 
     def __post_init__(self):
         for name, high in (
@@ -249,13 +307,29 @@ class ManufacturingVariation:
             ("eccentricity", 1e-4),
             ("mesh_stiffness_spread", 0.5),
             ("transmission_error", 1e-4),
+            ("lead_error_cumulative", 1e-3),
+            ("lead_error_periodic", 1e-4),
+            ("screw_runout", 1e-4),
+            ("roller_runout", 1e-4),
+            ("gear_pitch_error", 1e-4),
+            ("gear_profile_error", 1e-4),
+            ("flank_waviness", 1e-5),
         ):
             require_range(f"variation.{name}", getattr(self, name), 0.0, high)
 
     @classmethod
     def ideal(cls) -> ManufacturingVariation:
-        """No scatter: every roller identical and exactly placed."""
-        return cls(0.0, 0.0, 0.0, 0.0, 0.0)
+        """No scatter and no geometric error: every roller identical and exactly placed."""
+        return cls(**{f.name: 0.0 for f in fields(cls)})
+
+    @classmethod
+    def grade(cls, grade: int, **overrides) -> ManufacturingVariation:
+        """Lead errors of ISO 3408-3 tolerance grade 1, 3, 5 or 7; other fields as given."""
+        require(
+            grade in LEAD_GRADES, "variation.grade", grade, f"must be one of {sorted(LEAD_GRADES)}"
+        )
+        v_300p, v_2pi = LEAD_GRADES[grade]
+        return cls(**{"lead_error_cumulative": v_300p, "lead_error_periodic": v_2pi, **overrides})
 
     @property
     def is_ideal(self) -> bool:

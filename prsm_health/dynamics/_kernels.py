@@ -1,13 +1,16 @@
 """numba kernels of the PRSM lumped-parameter model: right-hand side and fixed-step RK4.
 
 Only float64 arrays and scalars cross this boundary; the layout of every array is in
-:mod:`.layout`, its physics in :mod:`.model` (which documents every term and cites paper 01).
+:mod:`.layout` (read as ``L.NAME``: numba folds module constants at compile time), its physics
+in :mod:`.model` (which documents every term and cites its sources).
 
 Force laws derive from one energy function (docs/validation.md, paper 01 dynamics): each
 thread engagement has an axial closure with the helix built in and a radial closure coupled
 through cot β, contact on either flank beyond a per-roller half-clearance b; the gear mesh has a
-time-varying stiffness looked up in a table over one mesh cycle. Roller centres are absolute
-positions, so the carrier pocket springs supply the centripetal force (no separate
+time-varying stiffness looked up in a table over one mesh cycle. Geometric errors of screw, nut
+and gear enter the closures as functions of where each roller touches them, with their slopes
+in the generalised forces, so they do work exactly as the energy says. Roller centres are
+absolute positions, so the carrier pocket springs supply the centripetal force (no separate
 centrifugal term, which would double count).
 """
 
@@ -17,115 +20,7 @@ import math
 
 from numba import njit
 
-from .layout import (
-    A_AXIAL_LOAD,
-    A_DRIVE_TORQUE,
-    A_FRICTION_TORQUE,
-    A_P_DISS,
-    A_P_DRIVE,
-    A_P_FRIC,
-    A_P_LOAD,
-    C_AXIAL_LOAD,
-    C_CARRIER_SPEED,
-    C_DRIVE_TORQUE,
-    C_FRICTION_TORQUE,
-    C_NUT_AXIAL_ACCEL,
-    C_NUT_POSITION,
-    C_NUT_RADIAL_X_ACCEL,
-    C_NUT_RADIAL_Y_ACCEL,
-    C_NUT_TANGENTIAL_ACCEL,
-    C_SCREW_ANGLE,
-    C_SCREW_SPEED,
-    DRIVE_PRESCRIBED,
-    N_AUX,
-    N_EXTRA,
-    P_C_CP,
-    P_C_MESH,
-    P_C_N,
-    P_C_NA,
-    P_C_ND,
-    P_C_PN,
-    P_C_PND,
-    P_C_S,
-    P_C_SD,
-    P_C_TAN,
-    P_C_THREAD_N,
-    P_C_THREAD_S,
-    P_COS_A0,
-    P_COT_BETA,
-    P_DRIVE_MODE,
-    P_EXPONENT,
-    P_FRICTION_SCALE,
-    P_J_C,
-    P_J_N,
-    P_J_P,
-    P_J_S,
-    P_K_CP,
-    P_K_N,
-    P_K_ND,
-    P_K_PN,
-    P_K_S,
-    P_K_TAN,
-    P_K_THREAD_N,
-    P_K_THREAD_S,
-    P_KI,
-    P_KP,
-    P_LEAD_EFF,
-    P_LEAD_N,
-    P_LEAD_R,
-    P_LEAD_S,
-    P_LOAD_SIN_AMP,
-    P_LOAD_SIN_FREQ,
-    P_M_C,
-    P_M_N,
-    P_M_P,
-    P_M_S,
-    P_MU_COUL,
-    P_MU_ROLL,
-    P_MU_VISC,
-    P_ORBIT_R,
-    P_R_NUT,
-    P_R_ROLLER,
-    P_R_SCREW,
-    P_RB_RING,
-    P_RB_ROLLER,
-    P_SIN_A0,
-    P_SIN_BETA,
-    P_TORQUE_LIMIT,
-    P_V_AXIAL,
-    P_V_NUT_REF,
-    P_W_ROLL,
-    P_Z_RING,
-    Q_ROLLER0,
-    Q_THN,
-    Q_THP,
-    Q_THS,
-    Q_XN,
-    Q_XP,
-    Q_XS,
-    Q_YN,
-    Q_YP,
-    Q_YS,
-    Q_ZN,
-    R_B_G,
-    R_B_N,
-    R_B_S,
-    R_COS_PSI,
-    R_E_G,
-    R_E_N,
-    R_E_S,
-    R_MESH_PHASE,
-    R_MESH_SCALE,
-    R_POCKET_R,
-    R_PSI,
-    R_SIN_PSI,
-    ROLLER_DOF,
-    X_SPEED_INT,
-    X_W_DISS,
-    X_W_DRIVE,
-    X_W_FRIC,
-    X_W_LOAD,
-)
+from . import layout as L
 
 TWO_PI = 2.0 * math.pi
 
@@ -233,74 +128,102 @@ def _mesh_stiffness(table, phase):
     return table[i0] * (1.0 - w) + table[i1] * w
 
 
+@njit(cache=True, inline="always")
+def _wave(errors, kind, u):
+    # Sum of the error table's terms of one kind at contact coordinate u: (value, d/du).
+    value = 0.0
+    slope = 0.0
+    for k in range(errors.shape[0]):
+        if errors[k, L.E_KIND] == kind:
+            arg = errors[k, L.E_WAVE] * u + errors[k, L.E_PHASE]
+            amp = errors[k, L.E_AMP]
+            value += amp * math.sin(arg)
+            slope += amp * errors[k, L.E_WAVE] * math.cos(arg)
+    return value, slope
+
+
 @njit(cache=True)
-def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
+def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     """dy/dt of the full state at time t; auxiliary outputs (torques, powers) into ``aux``.
 
     Allocation-free: writes into ``dy`` and ``aux`` only.
     """
     n_rollers = rollers.shape[0]
-    nq = Q_ROLLER0 + ROLLER_DOF * n_rollers
+    nq = L.Q_ROLLER0 + L.ROLLER_DOF * n_rollers
     v0 = nq  # offset of velocities; generalised forces are accumulated at dy[v0 + j]
-    for j in range(2 * nq + N_EXTRA + n_rollers):
+    for j in range(2 * nq + L.N_EXTRA + n_rollers):
         dy[j] = 0.0
     for j in range(nq):
         dy[j] = y[v0 + j]
 
-    prescribed = p[P_DRIVE_MODE] == DRIVE_PRESCRIBED
+    mode = p[L.P_DRIVE_MODE]
+    prescribed = mode == L.DRIVE_PRESCRIBED
+    coupled = p[L.P_COUPLED] == 1.0
+    axial_free = p[L.P_AXIAL_FREE] == 1.0
+    on_payload = p[L.P_ON_PAYLOAD] == 1.0
+    th_ref, w_ref, alpha_ref = screw_motion(t, motion)
     if prescribed:
-        th_s, w_s, alpha_ref = screw_motion(t, motion)
-        dy[Q_THS] = w_s
+        th_m, w_m = th_ref, w_ref
+        dy[L.Q_THM] = w_ref
     else:
-        th_s = y[Q_THS]
-        w_s = y[v0 + Q_THS]
-        alpha_ref = 0.0
+        th_m, w_m = y[L.Q_THM], y[v0 + L.Q_THM]
+    if coupled:
+        th_s, w_s = y[L.Q_THS], y[v0 + L.Q_THS]
+    else:  # screw rigid on the motor shaft
+        th_s, w_s = th_m, w_m
+        dy[L.Q_THS] = w_m
 
-    x_s, y_s = y[Q_XS], y[Q_YS]
-    vx_s, vy_s = y[v0 + Q_XS], y[v0 + Q_YS]
-    x_n, y_n, th_n, z_n = y[Q_XN], y[Q_YN], y[Q_THN], y[Q_ZN]
-    vx_n, vy_n, w_n, vz_n = y[v0 + Q_XN], y[v0 + Q_YN], y[v0 + Q_THN], y[v0 + Q_ZN]
-    x_p, y_p, th_p = y[Q_XP], y[Q_YP], y[Q_THP]
-    vx_p, vy_p, w_p = y[v0 + Q_XP], y[v0 + Q_YP], y[v0 + Q_THP]
+    x_s, y_s, z_s = y[L.Q_XS], y[L.Q_YS], y[L.Q_ZS]
+    vx_s, vy_s, vz_s = y[v0 + L.Q_XS], y[v0 + L.Q_YS], y[v0 + L.Q_ZS]
+    x_n, y_n, th_n, z_n = y[L.Q_XN], y[L.Q_YN], y[L.Q_THN], y[L.Q_ZN]
+    vx_n, vy_n, w_n, vz_n = y[v0 + L.Q_XN], y[v0 + L.Q_YN], y[v0 + L.Q_THN], y[v0 + L.Q_ZN]
+    x_p, y_p, th_p = y[L.Q_XP], y[L.Q_YP], y[L.Q_THP]
+    vx_p, vy_p, w_p = y[v0 + L.Q_XP], y[v0 + L.Q_YP], y[v0 + L.Q_THP]
 
-    orbit = p[P_ORBIT_R]
-    cot_b = p[P_COT_BETA]
-    sin_b = p[P_SIN_BETA]
-    lead_s, lead_r, lead_n = p[P_LEAD_S], p[P_LEAD_R], p[P_LEAD_N]
-    rb_ring, rb_roller = p[P_RB_RING], p[P_RB_ROLLER]
-    cos_a0, sin_a0 = p[P_COS_A0], p[P_SIN_A0]
-    r_s, r_r = p[P_R_SCREW], p[P_R_ROLLER]
-    k_ts, k_tn = p[P_K_THREAD_S], p[P_K_THREAD_N]
-    c_ts, c_tn, c_mesh = p[P_C_THREAD_S], p[P_C_THREAD_N], p[P_C_MESH]
-    expo = p[P_EXPONENT]
-    k_cp, c_cp = p[P_K_CP], p[P_C_CP]
-    fscale = p[P_FRICTION_SCALE]
-    mu_c, mu_v = p[P_MU_COUL] * fscale, p[P_MU_VISC] * fscale
-    k_tan, c_tan = p[P_K_TAN], p[P_C_TAN]
-    mu_r = p[P_MU_ROLL] * fscale
-    v_axial, w_roll, lead_eff = p[P_V_AXIAL], p[P_W_ROLL], p[P_LEAD_EFF]
-    s0 = 2 * nq + N_EXTRA  # offset of the traction states
-    z_ring = p[P_Z_RING]
+    orbit = p[L.P_ORBIT_R]
+    cot_b = p[L.P_COT_BETA]
+    sin_b = p[L.P_SIN_BETA]
+    lead_s, lead_r, lead_n = p[L.P_LEAD_S], p[L.P_LEAD_R], p[L.P_LEAD_N]
+    rb_ring, rb_roller = p[L.P_RB_RING], p[L.P_RB_ROLLER]
+    cos_a0, sin_a0 = p[L.P_COS_A0], p[L.P_SIN_A0]
+    r_s, r_r = p[L.P_R_SCREW], p[L.P_R_ROLLER]
+    k_ts, k_tn = p[L.P_K_THREAD_S], p[L.P_K_THREAD_N]
+    c_ts, c_tn, c_mesh = p[L.P_C_THREAD_S], p[L.P_C_THREAD_N], p[L.P_C_MESH]
+    expo = p[L.P_EXPONENT]
+    k_cp, c_cp = p[L.P_K_CP], p[L.P_C_CP]
+    fscale = p[L.P_FRICTION_SCALE]
+    mu_c, mu_v = p[L.P_MU_COUL] * fscale, p[L.P_MU_VISC] * fscale
+    k_tan, c_tan = p[L.P_K_TAN], p[L.P_C_TAN]
+    mu_r = p[L.P_MU_ROLL] * fscale
+    v_axial, w_roll, lead_eff = p[L.P_V_AXIAL], p[L.P_W_ROLL], p[L.P_LEAD_EFF]
+    g1 = 1.0 - p[L.P_LEAD_SLOPE]  # cumulative lead error: axial closure per axial travel
+    s0 = 2 * nq + L.N_EXTRA  # offset of the traction states
+    z_ring = p[L.P_Z_RING]
 
     cos_p = math.cos(th_p)
     sin_p = math.sin(th_p)
 
     torque_screw = 0.0  # contact torque acting on the screw [N·m]
+    force_screw_axial = 0.0  # contact force on the screw along z [N]
     friction_torque = 0.0  # friction part of the screw torque, paper 02's reduction [N·m]
     p_diss = 0.0
     p_fric = 0.0
 
     for i in range(n_rollers):
-        b = Q_ROLLER0 + ROLLER_DOF * i
+        b = L.Q_ROLLER0 + L.ROLLER_DOF * i
         xr, yr, th_c, z_c = y[b], y[b + 1], y[b + 2], y[b + 3]
         vxr, vyr, w_c, vz_c = y[v0 + b], y[v0 + b + 1], y[v0 + b + 2], y[v0 + b + 3]
-        cps, sps = rollers[i, R_COS_PSI], rollers[i, R_SIN_PSI]
+        cps, sps = rollers[i, L.R_COS_PSI], rollers[i, L.R_SIN_PSI]
         c = cos_p * cps - sin_p * sps  # e_r of the pocket (rotation by angle addition)
         s = sin_p * cps + cos_p * sps
         # Deformations are measured from the assembled position (each roller's threads and
         # teeth are assembled in phase at its pocket), so the revolution angle enters as θ_p;
-        # the pocket angle ψ_i only sets the mesh phase.
-        phi = th_p + rollers[i, R_PSI]
+        # the pocket angle ψ_i sets the mesh phase and where the roller touches screw and nut.
+        psi = rollers[i, L.R_PSI]
+        phi = th_p + psi
+        # Roller thread runout ε about its spin axis, at spin angle χ = θ_c − θ_rev: the flank
+        # facing the screw recedes by ε·cos χ, the one facing the nut advances by as much.
+        runout = rollers[i, L.R_RUNOUT]
 
         # ---------------- screw–roller thread
         rho, tau, rho_dot, tau_dot = _roller_frame(
@@ -308,21 +231,36 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
         )
         th_rev = th_p + tau / orbit
         w_rev = w_p + tau_dot / orbit
-        d_ax = lead_s * (th_s - th_rev) - lead_r * (th_c - th_rev) - z_c + rollers[i, R_E_S]
-        d_ax_dot = lead_s * (w_s - w_rev) - lead_r * (w_c - w_rev) - vz_c
+        u = th_rev + psi - th_s
+        e_ax, de_ax = _wave(errors, L.ERR_SCREW_AXIAL, u)
+        e_rad, de_rad = _wave(errors, L.ERR_SCREW_RADIAL, u)
+        chi = th_c - th_rev + rollers[i, L.R_RUNOUT_PHASE]
+        ro_c, ro_s = runout * math.cos(chi), runout * math.sin(chi)
+        lead_local = lead_s - de_ax  # the error's slope acts as a local lead change
+        d_ax = (
+            lead_s * (th_s - th_rev)
+            - lead_r * (th_c - th_rev)
+            - g1 * (z_c - z_s)
+            + rollers[i, L.R_E_S]
+            + e_ax
+        )
+        d_ax_dot = lead_local * (w_s - w_rev) - lead_r * (w_c - w_rev) - g1 * (vz_c - vz_s)
+        approach = orbit - rho + e_rad - ro_c
+        approach_dot = -rho_dot + de_rad * (w_rev - w_s) + ro_s * (w_c - w_rev)
         f_plus, f_minus, diss = _thread_pair(
-            d_ax, d_ax_dot, orbit - rho, -rho_dot, rollers[i, R_B_S], cot_b, k_ts, c_ts, expo
+            d_ax, d_ax_dot, approach, approach_dot, rollers[i, L.R_B_S], cot_b, k_ts, c_ts, expo
         )
         p_diss += diss
         f_ax = f_plus - f_minus  # axial force of the screw on the roller (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller outward, screw inward
-        g_tan = f_ax * (lead_s - lead_r) / orbit  # along e_t of the roller, from θ_rev
+        # along e_t of the roller, from θ_rev (helix, radial error slope, runout)
+        g_tan = (f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s) / orbit
         # Screw–roller traction: elastic tangential compliance k_t (Mindlin) that sticks up to
         # the Coulomb limit μN and slides beyond it (reset integrator, Haessig & Friedland
         # 1991), plus viscous drag. v_slide = 0 is rolling at both pitch circles.
         v_slide = r_s * (w_s - w_rev) + r_r * (w_c - w_rev)
         cap = mu_c * (f_plus + f_minus) / sin_b
-        aux[N_AUX + i] = cap
+        aux[L.N_AUX + i] = cap
         slip = y[s0 + i]
         f_stick = k_tan * slip
         if f_stick > cap or f_stick < -cap:
@@ -339,27 +277,29 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
         f_fric += mu_v * v_slide
         p_fric += mu_v * v_slide * v_slide
         # Paper 02's steady losses: Coulomb friction μ2·N against the roller's axial sliding on
-        # the screw (screw axially fixed) and the differential-sliding torque μ3·N on the
-        # screw, reacted by the roller's revolution.
+        # the screw and the differential-sliding torque μ3·N on the screw, reacted by the
+        # roller's revolution.
         normal = (f_plus + f_minus) / sin_b
-        f_axial = -mu_c * normal * math.tanh(vz_c / v_axial)
-        p_fric -= f_axial * vz_c
+        v_ax_slide = vz_c - vz_s
+        f_axial = -mu_c * normal * math.tanh(v_ax_slide / v_axial)
+        p_fric -= f_axial * v_ax_slide
         w_rel = w_s - w_rev
         m_diff = mu_r * normal * math.tanh(w_rel / w_roll)
         p_fric += m_diff * w_rel
         friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
-        torque_screw += -f_ax * lead_s - r_s * f_fric - m_diff
+        torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff
+        force_screw_axial -= g1 * f_ax + f_axial
         # on the roller: radial push f_rad·e_r, helix reaction, traction and the reaction of the
         # differential-sliding torque along e_t
         tangential = g_tan + f_fric + m_diff / orbit
         fx_r = f_rad * c - tangential * s
         fy_r = f_rad * s + tangential * c
-        dy[v0 + Q_XS] -= fx_r
-        dy[v0 + Q_YS] -= fy_r
+        dy[v0 + L.Q_XS] -= fx_r
+        dy[v0 + L.Q_YS] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric
-        dy[v0 + b + 3] += f_ax + f_axial
+        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric - f_rad * ro_s
+        dy[v0 + b + 3] += g1 * f_ax + f_axial
 
         # ---------------- roller–nut thread
         rho, tau, rho_dot, tau_dot = _roller_frame(
@@ -367,56 +307,82 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
         )
         th_rev = th_p + tau / orbit
         w_rev = w_p + tau_dot / orbit
-        d_ax = z_c - z_n + lead_r * (th_c - th_rev) - lead_n * (th_n - th_rev) + rollers[i, R_E_N]
-        d_ax_dot = vz_c - vz_n + lead_r * (w_c - w_rev) - lead_n * (w_n - w_rev)
+        e_ax, de_ax = _wave(errors, L.ERR_NUT_AXIAL, th_rev + psi - th_n)
+        lead_local = lead_n + de_ax
+        d_ax = (
+            z_c
+            - z_n
+            + lead_r * (th_c - th_rev)
+            - lead_n * (th_n - th_rev)
+            + rollers[i, L.R_E_N]
+            + e_ax
+        )
+        d_ax_dot = vz_c - vz_n + lead_r * (w_c - w_rev) - lead_local * (w_n - w_rev)
+        chi = th_c - th_rev + rollers[i, L.R_RUNOUT_PHASE]
+        ro_c, ro_s = runout * math.cos(chi), runout * math.sin(chi)
         f_plus, f_minus, diss = _thread_pair(
-            d_ax, d_ax_dot, rho - orbit, rho_dot, rollers[i, R_B_N], cot_b, k_tn, c_tn, expo
+            d_ax,
+            d_ax_dot,
+            rho - orbit + ro_c,
+            rho_dot - ro_s * (w_c - w_rev),
+            rollers[i, L.R_B_N],
+            cot_b,
+            k_tn,
+            c_tn,
+            expo,
         )
         p_diss += diss
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
-        g_tan = -f_ax * (lead_n - lead_r) / orbit
+        g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s) / orbit
         fx_r = -f_rad * c + g_tan * (-s)
         fy_r = -f_rad * s + g_tan * c
-        dy[v0 + Q_XN] -= fx_r
-        dy[v0 + Q_YN] -= fy_r
+        dy[v0 + L.Q_XN] -= fx_r
+        dy[v0 + L.Q_YN] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] -= f_ax * lead_r
+        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s
         dy[v0 + b + 3] -= f_ax
-        dy[v0 + Q_ZN] += f_ax
-        dy[v0 + Q_THN] += f_ax * lead_n
+        dy[v0 + L.Q_ZN] += f_ax
+        dy[v0 + L.Q_THN] += f_ax * lead_local
 
         # ---------------- roller gear – ring gear mesh (line of action n = cos α0 e_t − sin α0 e_r)
-        phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, R_MESH_PHASE]
-        k_mesh = _mesh_stiffness(mesh_table, phase) * rollers[i, R_MESH_SCALE]
+        phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, L.R_MESH_PHASE]
+        k_mesh = _mesh_stiffness(mesh_table, phase) * rollers[i, L.R_MESH_SCALE]
+        e_g, de_g = _wave(errors, L.ERR_GEAR, phi - th_n)
         d_g = (
             rb_ring * th_n
             - rb_roller * th_c
             - cos_a0 * (orbit * th_p + tau)
             + sin_a0 * (rho - orbit)
-            + rollers[i, R_E_G]
+            + rollers[i, L.R_E_G]
+            + e_g
         )
         d_g_dot = (
-            rb_ring * w_n - rb_roller * w_c - cos_a0 * (orbit * w_p + tau_dot) + sin_a0 * rho_dot
+            (rb_ring - de_g) * w_n
+            - rb_roller * w_c
+            - cos_a0 * (orbit * w_p + tau_dot)
+            + sin_a0 * rho_dot
+            + de_g * w_p
         )
-        bg = rollers[i, R_B_G]
+        bg = rollers[i, L.R_B_G]
         f_drive, d1 = _flank(d_g - bg, d_g_dot, k_mesh, c_mesh, 1.0)
         f_coast, d2 = _flank(-d_g - bg, -d_g_dot, k_mesh, c_mesh, 1.0)
         p_diss += d1 + d2
         f_g = f_drive - f_coast
-        # −∂V/∂q with ∂d_g/∂(X, Y) = −n, ∂d_g/∂θ_N = r_bN, ∂d_g/∂θ_c = −r_br
+        # −∂V/∂q with ∂d_g/∂(X, Y) = −n, ∂d_g/∂θ_N = r_bN − e', ∂d_g/∂θ_c = −r_br, ∂d_g/∂θ_p ∋ e'
         fx_r = f_g * (cos_a0 * (-s) - sin_a0 * c)
         fy_r = f_g * (cos_a0 * c - sin_a0 * s)
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + Q_XN] -= fx_r
-        dy[v0 + Q_YN] -= fy_r
-        dy[v0 + Q_THN] -= f_g * rb_ring
+        dy[v0 + L.Q_XN] -= fx_r
+        dy[v0 + L.Q_YN] -= fy_r
+        dy[v0 + L.Q_THN] -= f_g * (rb_ring - de_g)
+        dy[v0 + L.Q_THP] -= f_g * de_g
         dy[v0 + b + 2] += f_g * rb_roller
 
         # ---------------- carrier pocket
-        rad = rollers[i, R_POCKET_R]
+        rad = rollers[i, L.R_POCKET_R]
         ex = xr - (x_p + rad * c)
         ey = yr - (y_p + rad * s)
         evx = vxr - (vx_p - rad * s * w_p)
@@ -426,119 +392,184 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, dy, aux):
         p_diss += c_cp * (evx * evx + evy * evy)
         dy[v0 + b] += fx
         dy[v0 + b + 1] += fy
-        dy[v0 + Q_XP] -= fx
-        dy[v0 + Q_YP] -= fy
-        dy[v0 + Q_THP] += rad * (s * fx - c * fy)
+        dy[v0 + L.Q_XP] -= fx
+        dy[v0 + L.Q_YP] -= fy
+        dy[v0 + L.Q_THP] += rad * (s * fx - c * fy)
 
     # ---------------- supports and couplings
-    dy[v0 + Q_XS] += -p[P_K_S] * x_s - p[P_C_S] * vx_s
-    dy[v0 + Q_YS] += -p[P_K_S] * y_s - p[P_C_S] * vy_s
-    dy[v0 + Q_XN] += -p[P_K_N] * x_n - p[P_C_N] * vx_n
-    dy[v0 + Q_YN] += -p[P_K_N] * y_n - p[P_C_N] * vy_n
-    dy[v0 + Q_THN] += -p[P_K_ND] * th_n - p[P_C_ND] * w_n
-    fx = -p[P_K_PN] * (x_p - x_n) - p[P_C_PN] * (vx_p - vx_n)
-    fy = -p[P_K_PN] * (y_p - y_n) - p[P_C_PN] * (vy_p - vy_n)
-    dy[v0 + Q_XP] += fx
-    dy[v0 + Q_YP] += fy
-    dy[v0 + Q_XN] -= fx
-    dy[v0 + Q_YN] -= fy
-    t_pn = -p[P_C_PND] * (w_p - w_n)
-    dy[v0 + Q_THP] += t_pn
-    dy[v0 + Q_THN] -= t_pn
-    load = axial_load(t, load_knots, p[P_LOAD_SIN_AMP], p[P_LOAD_SIN_FREQ])
-    dv_nut = vz_n - p[P_V_NUT_REF]
-    dy[v0 + Q_ZN] += -load - p[P_C_NA] * dv_nut
+    dy[v0 + L.Q_XS] += -p[L.P_K_S] * x_s - p[L.P_C_S] * vx_s
+    dy[v0 + L.Q_YS] += -p[L.P_K_S] * y_s - p[L.P_C_S] * vy_s
+    dy[v0 + L.Q_XN] += -p[L.P_K_N] * x_n - p[L.P_C_N] * vx_n
+    dy[v0 + L.Q_YN] += -p[L.P_K_N] * y_n - p[L.P_C_N] * vy_n
+    dy[v0 + L.Q_THN] += -p[L.P_K_ND] * th_n - p[L.P_C_ND] * w_n
+    fx = -p[L.P_K_PN] * (x_p - x_n) - p[L.P_C_PN] * (vx_p - vx_n)
+    fy = -p[L.P_K_PN] * (y_p - y_n) - p[L.P_C_PN] * (vy_p - vy_n)
+    dy[v0 + L.Q_XP] += fx
+    dy[v0 + L.Q_YP] += fy
+    dy[v0 + L.Q_XN] -= fx
+    dy[v0 + L.Q_YN] -= fy
+    t_pn = -p[L.P_C_PND] * (w_p - w_n)
+    dy[v0 + L.Q_THP] += t_pn
+    dy[v0 + L.Q_THN] -= t_pn
     p_diss += (
-        p[P_C_S] * (vx_s * vx_s + vy_s * vy_s)
-        + p[P_C_N] * (vx_n * vx_n + vy_n * vy_n)
-        + p[P_C_ND] * w_n * w_n
-        + p[P_C_PN] * ((vx_p - vx_n) ** 2 + (vy_p - vy_n) ** 2)
-        + p[P_C_PND] * (w_p - w_n) ** 2
-        + p[P_C_NA] * dv_nut * vz_n
-        + p[P_C_SD] * w_s * w_s
+        p[L.P_C_S] * (vx_s * vx_s + vy_s * vy_s)
+        + p[L.P_C_N] * (vx_n * vx_n + vy_n * vy_n)
+        + p[L.P_C_ND] * w_n * w_n
+        + p[L.P_C_PN] * ((vx_p - vx_n) ** 2 + (vy_p - vy_n) ** 2)
+        + p[L.P_C_PND] * (w_p - w_n) ** 2
+        + p[L.P_C_SD] * w_s * w_s
     )
 
-    # ---------------- screw drive
-    j_s = p[P_J_S]
-    if prescribed:
-        drive = j_s * alpha_ref - torque_screw + p[P_C_SD] * w_s
-        dy[v0 + Q_THS] = alpha_ref
+    # Lubricant squeeze film in the thread gaps: damps the nut's axial motion relative to the
+    # screw's kinematic position (through the rollers, whose own modes are far faster).
+    v_film = vz_n - vz_s - lead_eff * w_s
+    f_film = p[L.P_C_FILM] * v_film
+    dy[v0 + L.Q_ZN] -= f_film
+    force_screw_axial += f_film
+    torque_screw += f_film * lead_eff
+    p_diss += f_film * v_film
+
+    # ---------------- load: on the payload through the linkage, or ideal on the nut
+    load = axial_load(t, load_knots, p[L.P_LOAD_SIN_AMP], p[L.P_LOAD_SIN_FREQ])
+    dv_nut = vz_n - p[L.P_V_NUT_REF]
+    dy[v0 + L.Q_ZN] -= p[L.P_C_NA] * dv_nut
+    p_diss += p[L.P_C_NA] * dv_nut * vz_n
+    if on_payload:
+        v_link = vz_n - y[v0 + L.Q_ZL]
+        link = p[L.P_K_LINK] * (z_n - y[L.Q_ZL]) + p[L.P_C_LINK] * v_link
+        dy[v0 + L.Q_ZN] -= link
+        dy[v0 + L.Q_ZL] = (link - load) / p[L.P_M_L]
+        p_diss += p[L.P_C_LINK] * v_link * v_link
+        p_load = -load * y[v0 + L.Q_ZL]
     else:
-        w_ref = screw_motion(t, motion)[1]
-        drive = p[P_KP] * (w_ref - w_s) + p[P_KI] * y[2 * nq + X_SPEED_INT]
-        limit = p[P_TORQUE_LIMIT]
+        link = load
+        dy[v0 + L.Q_ZN] -= load
+        p_load = -load * vz_n
+
+    # ---------------- screw axial: thrust bearing with play (or held)
+    if axial_free:
+        play = p[L.P_BEAR_PLAY]
+        k_b, c_b = p[L.P_K_BEAR], p[L.P_C_BEAR]
+        f_up, d1 = _flank(-z_s - play, -vz_s, k_b, c_b, 1.0)
+        f_down, d2 = _flank(z_s - play, vz_s, k_b, c_b, 1.0)
+        p_diss += d1 + d2
+        dy[v0 + L.Q_ZS] = (force_screw_axial + f_up - f_down) / p[L.P_M_S]
+    else:
+        dy[v0 + L.Q_ZS] = 0.0
+
+    # ---------------- motor, coupling and drive
+    j_m, j_s = p[L.P_J_M], p[L.P_J_S]
+    if coupled:
+        t_coup = p[L.P_K_COUP] * (th_m - th_s) + p[L.P_C_COUP] * (w_m - w_s)
+        p_diss += p[L.P_C_COUP] * (w_m - w_s) ** 2
+        dy[v0 + L.Q_THS] = (t_coup + torque_screw - p[L.P_C_SD] * w_s) / j_s
+        load_torque = t_coup  # what the motor shaft must deliver beside its own inertia
+        j_drive = j_m
+    else:
+        load_torque = -torque_screw + p[L.P_C_SD] * w_s
+        j_drive = j_m + j_s
+    if prescribed:
+        drive = j_drive * alpha_ref + load_torque
+        alpha_m = alpha_ref
+    else:
+        w_cmd = w_ref
+        if mode == L.DRIVE_POSITION_LOOP:
+            w_cmd = w_ref + p[L.P_KP_POS] * (th_ref - th_m)
+        drive = p[L.P_KP] * (w_cmd - w_m) + p[L.P_KI] * y[2 * nq + L.X_SPEED_INT]
+        limit = p[L.P_TORQUE_LIMIT]
         if drive > limit:
             drive = limit
         elif drive < -limit:
             drive = -limit
-        dy[v0 + Q_THS] = (drive + torque_screw - p[P_C_SD] * w_s) / j_s
-        dy[2 * nq + X_SPEED_INT] = w_ref - w_s
+        alpha_m = (drive - load_torque) / j_drive
+        dy[2 * nq + L.X_SPEED_INT] = w_cmd - w_m
+    dy[v0 + L.Q_THM] = alpha_m
+    if not coupled:
+        dy[v0 + L.Q_THS] = alpha_m
 
     # ---------------- accelerations
-    m_s, m_n, m_p, m_c = p[P_M_S], p[P_M_N], p[P_M_P], p[P_M_C]
-    dy[v0 + Q_XS] /= m_s
-    dy[v0 + Q_YS] /= m_s
-    dy[v0 + Q_XN] /= m_n
-    dy[v0 + Q_YN] /= m_n
-    dy[v0 + Q_THN] /= p[P_J_N]
-    dy[v0 + Q_ZN] /= m_n
-    dy[v0 + Q_XP] /= m_p
-    dy[v0 + Q_YP] /= m_p
-    dy[v0 + Q_THP] /= p[P_J_P]
+    m_s, m_n, m_p, m_c = p[L.P_M_S], p[L.P_M_N], p[L.P_M_P], p[L.P_M_C]
+    dy[v0 + L.Q_XS] /= m_s
+    dy[v0 + L.Q_YS] /= m_s
+    dy[v0 + L.Q_XN] /= m_n
+    dy[v0 + L.Q_YN] /= m_n
+    dy[v0 + L.Q_THN] /= p[L.P_J_N]
+    dy[v0 + L.Q_ZN] /= m_n
+    dy[v0 + L.Q_XP] /= m_p
+    dy[v0 + L.Q_YP] /= m_p
+    dy[v0 + L.Q_THP] /= p[L.P_J_P]
+    if not on_payload:  # the payload coordinate follows the nut
+        dy[v0 + L.Q_ZL] = dy[v0 + L.Q_ZN]
     for i in range(n_rollers):
-        b = v0 + Q_ROLLER0 + ROLLER_DOF * i
+        b = v0 + L.Q_ROLLER0 + L.ROLLER_DOF * i
         dy[b] /= m_c
         dy[b + 1] /= m_c
-        dy[b + 2] /= p[P_J_C]
+        dy[b + 2] /= p[L.P_J_C]
         dy[b + 3] /= m_c
 
     e0 = 2 * nq
-    p_drive = drive * w_s
-    p_load = -load * vz_n
-    dy[e0 + X_W_DRIVE] = p_drive
-    dy[e0 + X_W_LOAD] = p_load
-    dy[e0 + X_W_DISS] = p_diss + p_fric
-    dy[e0 + X_W_FRIC] = p_fric
-    aux[A_DRIVE_TORQUE] = drive
-    aux[A_FRICTION_TORQUE] = friction_torque
-    aux[A_AXIAL_LOAD] = load
-    aux[A_P_DRIVE] = p_drive
-    aux[A_P_LOAD] = p_load
-    aux[A_P_DISS] = p_diss + p_fric
-    aux[A_P_FRIC] = p_fric
+    p_drive = drive * w_m
+    dy[e0 + L.X_W_DRIVE] = p_drive
+    dy[e0 + L.X_W_LOAD] = p_load
+    dy[e0 + L.X_W_DISS] = p_diss + p_fric
+    dy[e0 + L.X_W_FRIC] = p_fric
+    aux[L.A_MOTOR_TORQUE] = drive
+    aux[L.A_FRICTION_TORQUE] = friction_torque
+    aux[L.A_AXIAL_LOAD] = link
+    aux[L.A_LOAD_FORCE] = load
+    aux[L.A_P_DRIVE] = p_drive
+    aux[L.A_P_LOAD] = p_load
+    aux[L.A_P_DISS] = p_diss + p_fric
+    aux[L.A_P_FRIC] = p_fric
 
 
 @njit(cache=True)
 def _record(y, dy, aux, p, nq, out_row):
     v0 = nq
-    out_row[C_SCREW_ANGLE] = y[Q_THS]
-    out_row[C_SCREW_SPEED] = y[v0 + Q_THS]
-    out_row[C_CARRIER_SPEED] = y[v0 + Q_THP]
-    out_row[C_NUT_POSITION] = y[Q_ZN]
-    out_row[C_NUT_AXIAL_ACCEL] = dy[v0 + Q_ZN]
-    out_row[C_NUT_TANGENTIAL_ACCEL] = p[P_R_NUT] * dy[v0 + Q_THN]
-    out_row[C_NUT_RADIAL_X_ACCEL] = dy[v0 + Q_XN]
-    out_row[C_NUT_RADIAL_Y_ACCEL] = dy[v0 + Q_YN]
-    out_row[C_DRIVE_TORQUE] = aux[A_DRIVE_TORQUE]
-    out_row[C_FRICTION_TORQUE] = aux[A_FRICTION_TORQUE]
-    out_row[C_AXIAL_LOAD] = aux[A_AXIAL_LOAD]
+    out_row[L.C_MOTOR_ANGLE] = y[L.Q_THM]
+    out_row[L.C_MOTOR_SPEED] = y[v0 + L.Q_THM]
+    out_row[L.C_MOTOR_TORQUE] = aux[L.A_MOTOR_TORQUE]
+    out_row[L.C_SCREW_ANGLE] = y[L.Q_THS]
+    out_row[L.C_SCREW_SPEED] = y[v0 + L.Q_THS]
+    out_row[L.C_CARRIER_SPEED] = y[v0 + L.Q_THP]
+    out_row[L.C_NUT_POSITION] = y[L.Q_ZN]
+    out_row[L.C_NUT_AXIAL_ACCEL] = dy[v0 + L.Q_ZN]
+    out_row[L.C_NUT_TANGENTIAL_ACCEL] = p[L.P_R_NUT] * dy[v0 + L.Q_THN]
+    out_row[L.C_NUT_RADIAL_X_ACCEL] = dy[v0 + L.Q_XN]
+    out_row[L.C_NUT_RADIAL_Y_ACCEL] = dy[v0 + L.Q_YN]
+    out_row[L.C_FRICTION_TORQUE] = aux[L.A_FRICTION_TORQUE]
+    out_row[L.C_AXIAL_LOAD] = aux[L.A_AXIAL_LOAD]
+    out_row[L.C_PAYLOAD_POSITION] = y[L.Q_ZL]
+    out_row[L.C_SCREW_AXIAL_POSITION] = y[L.Q_ZS]
+    out_row[L.C_LOAD_FORCE] = aux[L.A_LOAD_FORCE]
 
 
 @njit(cache=True)
 def _clamp_traction(y, p, nq, aux, n_rollers):
     # A stuck contact cannot hold more than its Coulomb limit: when the normal load drops, the
     # elastic tangential displacement resets to the limit and its released energy is dissipated.
-    k_tan = p[P_K_TAN]
-    s0 = 2 * nq + N_EXTRA
+    k_tan = p[L.P_K_TAN]
+    s0 = 2 * nq + L.N_EXTRA
     for i in range(n_rollers):
-        limit = aux[N_AUX + i] / k_tan
+        limit = aux[L.N_AUX + i] / k_tan
         slip = y[s0 + i]
         if slip > limit or slip < -limit:
             new = limit if slip > 0.0 else -limit
             released = 0.5 * k_tan * (slip * slip - new * new)
             y[s0 + i] = new
-            y[2 * nq + X_W_DISS] += released
-            y[2 * nq + X_W_FRIC] += released
+            y[2 * nq + L.X_W_DISS] += released
+            y[2 * nq + L.X_W_FRIC] += released
+
+
+@njit(cache=True, inline="always")
+def _hold_prescribed(y, t, p, motion, nq):
+    # The prescribed angle is not integrated: set it (and the rigidly coupled screw) exactly.
+    th, w, _ = screw_motion(t, motion)
+    y[L.Q_THM] = th
+    y[nq + L.Q_THM] = w
+    if p[L.P_COUPLED] != 1.0:
+        y[L.Q_THS] = th
+        y[nq + L.Q_THS] = w
 
 
 @njit(cache=True)
@@ -553,6 +584,7 @@ def integrate(
     mesh_table,
     motion,
     load_knots,
+    errors,
     out,
     k1,
     k2,
@@ -563,22 +595,20 @@ def integrate(
 ):
     """Advance ``y`` in place by ``n_steps`` RK4 steps of ``h``; record every ``record_every``.
 
-    Records the channels at the start of each recorded step into ``out`` (rows). Returns
+    Records the truth signals at the start of each recorded step into ``out`` (rows). Returns
     (status, step): status 0 = done, 1 = non-finite state detected at ``step``.
     Work arrays k1…k4, tmp, aux are passed in so the loop allocates nothing.
     """
     n_state = y.shape[0]
-    nq = Q_ROLLER0 + ROLLER_DOF * rollers.shape[0]
-    prescribed = p[P_DRIVE_MODE] == DRIVE_PRESCRIBED
+    nq = L.Q_ROLLER0 + L.ROLLER_DOF * rollers.shape[0]
+    prescribed = p[L.P_DRIVE_MODE] == L.DRIVE_PRESCRIBED
     row = 0
     half = 0.5 * h
     for step in range(n_steps):
         t = t0 + step * h
         if prescribed:
-            th, w, _ = screw_motion(t, motion)
-            y[Q_THS] = th
-            y[nq + Q_THS] = w
-        rhs(t, y, p, rollers, mesh_table, motion, load_knots, k1, aux)
+            _hold_prescribed(y, t, p, motion, nq)
+        rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, k1, aux)
         if step % record_every == 0:
             ok = True
             for j in range(2 * nq):
@@ -591,20 +621,18 @@ def integrate(
             row += 1
         for j in range(n_state):
             tmp[j] = y[j] + half * k1[j]
-        rhs(t + half, tmp, p, rollers, mesh_table, motion, load_knots, k2, aux)
+        rhs(t + half, tmp, p, rollers, mesh_table, motion, load_knots, errors, k2, aux)
         for j in range(n_state):
             tmp[j] = y[j] + half * k2[j]
-        rhs(t + half, tmp, p, rollers, mesh_table, motion, load_knots, k3, aux)
+        rhs(t + half, tmp, p, rollers, mesh_table, motion, load_knots, errors, k3, aux)
         for j in range(n_state):
             tmp[j] = y[j] + h * k3[j]
-        rhs(t + h, tmp, p, rollers, mesh_table, motion, load_knots, k4, aux)
+        rhs(t + h, tmp, p, rollers, mesh_table, motion, load_knots, errors, k4, aux)
         for j in range(n_state):
             y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
         _clamp_traction(y, p, nq, aux, rollers.shape[0])
     if prescribed:
-        th, w, _ = screw_motion(t0 + n_steps * h, motion)
-        y[Q_THS] = th
-        y[nq + Q_THS] = w
+        _hold_prescribed(y, t0 + n_steps * h, p, motion, nq)
     for j in range(2 * nq):
         if not math.isfinite(y[j]):
             return 1, n_steps

@@ -5,14 +5,16 @@ every entry is documented in :mod:`prsm_health.dynamics.model`, which fills them
 """
 
 # ----------------------------------------------------------------- generalised coordinates q
-# Screw: lateral x, y and rotation θ_s (axially fixed).
+# Screw: lateral x, y and rotation θ_s.
 Q_XS, Q_YS, Q_THS = 0, 1, 2
 # Nut (with ring gear): lateral x, y, rotation θ_N, axial z_N.
 Q_XN, Q_YN, Q_THN, Q_ZN = 3, 4, 5, 6
 # Carrier: lateral x, y, rotation θ_p.
 Q_XP, Q_YP, Q_THP = 7, 8, 9
+# Drive train: motor rotor angle θ_m, screw axial z_s (on its thrust bearing), payload z_L.
+Q_THM, Q_ZS, Q_ZL = 10, 11, 12
 # Roller i occupies Q_ROLLER0 + 4·i + (0: X, 1: Y absolute centre position, 2: spin θ, 3: axial z).
-Q_ROLLER0 = 10
+Q_ROLLER0 = 13
 ROLLER_DOF = 4
 
 
@@ -63,9 +65,29 @@ P_MU_ROLL = 53  # differential-sliding coefficient μ3 of paper 02 [m]
 P_V_AXIAL = 54  # regularisation speed of the axial Coulomb sliding [m/s]
 P_W_ROLL = 55  # regularisation speed of the differential-sliding torque [rad/s]
 P_LEAD_EFF = 56  # effective lead per radian (nut travel per screw radian) [m/rad]
-N_PARAMS = 57
+# Drive train (prsm_health.drive_train)
+P_J_M = 57  # motor rotor inertia [kg·m²]
+P_COUPLED = 58  # 0: screw rigidly on the motor, 1: torsional coupling
+P_K_COUP, P_C_COUP = 59, 60  # coupling [N·m/rad], [N·m·s/rad]
+P_AXIAL_FREE = 61  # 0: screw axially fixed, 1: on its thrust bearing
+P_K_BEAR, P_C_BEAR, P_BEAR_PLAY = 62, 63, 64  # thrust bearing [N/m], [N·s/m], half play [m]
+P_ON_PAYLOAD = 65  # 0: load on the nut (ideal force), 1: on the payload through the linkage
+P_M_L, P_K_LINK, P_C_LINK = 66, 67, 68  # payload [kg], linkage [N/m], [N·s/m]
+P_C_FILM = 69  # lubricant squeeze-film damper, nut vs screw kinematics [N·s/m]
+P_KP_POS = 70  # position-loop gain [1/s]
+P_LEAD_SLOPE = 71  # cumulative lead error of the screw, axial error per axial travel [-]
+N_PARAMS = 72
 
-DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP = 0, 1
+DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
+
+# ----------------------------------------------------------------- geometric error terms
+# Rows of the error table: (kind, wave number [1/rad], amplitude [m], phase [rad]); each adds
+# amplitude·sin(wave·u + phase) to one closure, u the contact coordinate of its kind:
+#   screw axial / radial: u = θ_rev + ψ_i − θ_s (where roller i touches the screw surface),
+#   nut axial: u = θ_rev + ψ_i − θ_N (where it touches the nut), gear: u = θ_p + ψ_i − θ_N.
+E_KIND, E_WAVE, E_AMP, E_PHASE = 0, 1, 2, 3
+N_ERROR_COLUMNS = 4
+ERR_SCREW_AXIAL, ERR_SCREW_RADIAL, ERR_NUT_AXIAL, ERR_GEAR = 0, 1, 2, 3
 
 # ----------------------------------------------------------------- per-roller parameters
 R_COS_PSI, R_SIN_PSI = 0, 1  # angular position of the pocket on the carrier
@@ -76,10 +98,14 @@ R_E_G = 8  # gear transmission error offset [m]
 R_MESH_PHASE = 9  # mesh phase error added to the geometric phase [cycles]
 R_MESH_SCALE = 10  # mesh stiffness scale (tooth-to-tooth variation) [-]
 R_PSI = 11  # angular position of the pocket [rad]
-N_ROLLER_PARAMS = 12
+R_RUNOUT, R_RUNOUT_PHASE = 12, 13  # roller thread runout about its spin axis [m], phase [rad]
+N_ROLLER_PARAMS = 14
 
-# ----------------------------------------------------------------- recorded channels
+# ----------------------------------------------------------------- recorded truth signals
 (
+    C_MOTOR_ANGLE,
+    C_MOTOR_SPEED,
+    C_MOTOR_TORQUE,
     C_SCREW_ANGLE,
     C_SCREW_SPEED,
     C_CARRIER_SPEED,
@@ -88,17 +114,29 @@ N_ROLLER_PARAMS = 12
     C_NUT_TANGENTIAL_ACCEL,
     C_NUT_RADIAL_X_ACCEL,
     C_NUT_RADIAL_Y_ACCEL,
-    C_DRIVE_TORQUE,
     C_FRICTION_TORQUE,
     C_AXIAL_LOAD,
-) = range(11)
-N_CHANNELS = 11
-# Names, units and meanings of these channels: prsm_health.channels.CHANNELS (same order).
+    C_PAYLOAD_POSITION,
+    C_SCREW_AXIAL_POSITION,
+    C_LOAD_FORCE,
+) = range(16)
+N_CHANNELS = 16
+# Names, units and meanings: prsm_health.channels.TRUTH_CHANNELS (same order); every measured
+# channel is a sensor's reading of one of them (prsm_health.instrumentation).
 
 # Auxiliary outputs of one right-hand-side evaluation; after them, per roller, the Coulomb
 # limit μ·N of its screw–roller traction [N].
-A_DRIVE_TORQUE, A_FRICTION_TORQUE, A_AXIAL_LOAD, A_P_DRIVE, A_P_LOAD, A_P_DISS, A_P_FRIC = range(7)
-N_AUX = 7
+(
+    A_MOTOR_TORQUE,
+    A_FRICTION_TORQUE,
+    A_AXIAL_LOAD,
+    A_P_DRIVE,
+    A_P_LOAD,
+    A_P_DISS,
+    A_P_FRIC,
+    A_LOAD_FORCE,
+) = range(8)
+N_AUX = 8
 
 
 def n_aux(n_rollers: int) -> int:

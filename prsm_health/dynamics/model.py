@@ -26,8 +26,27 @@ Force laws (one energy function; kernel in :mod:`._kernels`):
   μ_sc·v (paper 01 table: μ_sc = 25 N·s/m) on the sliding speed
   v = r_s(ω_s − ω_rev) + r_r(ω_i − ω_rev), times the health state's friction scale. The
   roller–nut contact is rolling (paper 01 §1.2.2).
-* **Supports** (paper 01 K_s, K_N, K_Nd, K_pN, K_cp; values not given — engineering defaults
+* **Supports** (paper 01 K_s, K_N, K_pN, K_cp; values not given — engineering defaults
   below), linear with damping set by damping ratios.
+* **Drive train** (:mod:`prsm_health.drive_train`, beyond paper 01): motor rotor θ_m driving
+  the screw through a torsional coupling; screw axial z_s on its thrust bearing (stiffness,
+  optional play); nut anti-rotation guide; the load acting on a payload z_L tied to the nut by
+  a linkage spring–damper. ``DriveTrain.paper01()`` restores the paper's rigid screw drive,
+  axially fixed screw and ideal force on the nut.
+* **Contact damping**: each flank carries material (hysteretic) damping at
+  ``contact_damping_ratio`` of the nut axial mode; the lubricant film in the thread gaps adds a
+  squeeze-film damper on the nut's axial motion relative to the screw's kinematic position,
+  sized so that a nut impact on its threads rebounds with the coefficient of restitution
+  ``contact_restitution`` e: ζ = −ln e / √(π² + ln² e) of the nut axial mode. Dry steel at
+  low speed has e ≈ 0.9 (Goldsmith, *Impact*, 1960); a lubricant film lowers it, the more the
+  slower the impact (Davis, Serayssol & Hinch 1986, J. Fluid Mech. 163; Joseph et al. 2001,
+  J. Fluid Mech. 433): range 0.3–0.9, default 0.6 (engineering estimate). The film damper acts
+  on the nut alone because the rollers' own modes are 30× faster: putting the same damping in
+  each flank would make them stiff for the explicit integrator (docs/performance.md).
+* **Geometric errors along the screw** (:class:`~prsm_health.states.ManufacturingVariation`):
+  cumulative and periodic lead error (ISO 3408-3 grade), screw and roller runout, ring-gear
+  pitch and profile error (transmission-error harmonics), flank waviness; each enters the
+  closures as a function of where the roller touches the part.
 
 References
 ----------
@@ -43,6 +62,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..design import PRSMDesign
+from ..drive_train import DriveTrain
 from ..errors import require, require_positive, require_range
 from ..friction import FrictionParameters
 from ..kinematics import speed_ratios
@@ -68,8 +88,11 @@ class SimulationOptions:
     variation : ManufacturingVariation
         As-built roller scatter (``ManufacturingVariation.ideal()`` to switch it off).
     contact_damping_ratio : float [-]
-        Damping ratio of the nut axial mode (thread contacts, stiffness-proportional) and of
-        the gear mesh (c = 2ζ√(k·J_r/r_b²)).
+        Material damping of the contacts: ratio of the nut axial mode given by the thread
+        flanks (stiffness-proportional) and of the gear mesh (c = 2ζ√(k·J_r/r_b²)).
+    contact_restitution : float [-]
+        Coefficient of restitution of a nut impact on its threads, set by the lubricant film
+        (module docstring): 0.3–0.9.
     settle_time : float [s]
         Simulated before t = 0 at the initial speed and load and discarded, so the start-up
         transient of the as-built rollers finding their load share is not in the run.
@@ -87,7 +110,6 @@ class SimulationOptions:
         2(1 − ν)/(2 − ν) = 0.82 for steel. It holds the rollers rolling on the screw while the
         traction stays below μN, as creep does on real hardware.
     screw_support_stiffness, nut_guide_stiffness, carrier_nut_stiffness, pocket_stiffness : float [N/m]
-    nut_torsional_stiffness : float [N·m/rad]
     nut_guide_damping : float [N·s/m]
         Viscous friction of the nut's linear guide against the ground (paper 01's C_Na).
     threaded_tooth : bool
@@ -102,6 +124,7 @@ class SimulationOptions:
     contact_law: str = "linear"
     variation: ManufacturingVariation = field(default_factory=ManufacturingVariation)
     contact_damping_ratio: float = 0.03
+    contact_restitution: float = 0.6
     support_damping_ratio: float = 0.05
     friction_coefficient: float = _PAPER02_FRICTION.sliding
     rolling_friction: float = _PAPER02_FRICTION.rolling
@@ -109,7 +132,6 @@ class SimulationOptions:
     traction_stiffness_ratio: float = 0.82
     screw_support_stiffness: float = 1e8
     nut_guide_stiffness: float = 1e8
-    nut_torsional_stiffness: float = 1e5
     carrier_nut_stiffness: float = 1e7
     pocket_stiffness: float = 1e8
     nut_guide_damping: float = 5.0
@@ -126,6 +148,7 @@ class SimulationOptions:
             f"must be one of {', '.join(CONTACT_LAWS)}",
         )
         require_range("options.contact_damping_ratio", self.contact_damping_ratio, 0.0, 1.0)
+        require_range("options.contact_restitution", self.contact_restitution, 0.05, 1.0)
         require_range("options.support_damping_ratio", self.support_damping_ratio, 0.0, 1.0)
         require_range("options.friction_coefficient", self.friction_coefficient, 0.0, 1.0)
         require_range("options.rolling_friction", self.rolling_friction, 0.0, 1e-3, unit="m")
@@ -134,7 +157,6 @@ class SimulationOptions:
         for name in (
             "screw_support_stiffness",
             "nut_guide_stiffness",
-            "nut_torsional_stiffness",
             "carrier_nut_stiffness",
             "pocket_stiffness",
         ):
@@ -157,11 +179,13 @@ class Model:
     health: HealthState
     profile: OperatingProfile
     options: SimulationOptions
+    drive_train: DriveTrain
     params: np.ndarray  # (N_PARAMS,)
     rollers: np.ndarray  # (n_rollers, N_ROLLER_PARAMS)
     mesh_table: np.ndarray  # (n_points,) mesh stiffness over one cycle [N/m]
     motion: np.ndarray  # (3, K) screw speed knots
     load_knots: np.ndarray  # (2, K)
+    errors: np.ndarray  # (n_terms, N_ERROR_COLUMNS) geometric error terms
     thread_stiffness: tuple[float, float]  # linearised axial stiffness per roller side [N/m]
     roller_load: float  # per-roller axial load the laws are built around [N]
 
@@ -220,8 +244,9 @@ def build_model(
     profile: OperatingProfile,
     options: SimulationOptions,
     seed: int,
+    drive_train: DriveTrain | None = None,
 ) -> Model:
-    """Pack design, health state, profile and options into kernel arrays.
+    """Pack design, health state, profile, options and drive train into kernel arrays.
 
     Parameters
     ----------
@@ -231,7 +256,9 @@ def build_model(
     options : SimulationOptions
     seed : int
         Seeds the manufacturing variation and the uneven wear.
+    drive_train : DriveTrain, default DriveTrain()
     """
+    drive_train = drive_train or DriveTrain()
     require(
         design.gear is not None,
         "design",
@@ -282,7 +309,7 @@ def build_model(
     p[L.P_C_S] = 2 * zeta_s * math.sqrt(p[L.P_K_S] * m.screw_mass)
     p[L.P_K_N] = options.nut_guide_stiffness
     p[L.P_C_N] = 2 * zeta_s * math.sqrt(p[L.P_K_N] * m.nut_mass)
-    p[L.P_K_ND] = options.nut_torsional_stiffness
+    p[L.P_K_ND] = drive_train.anti_rotation_stiffness
     p[L.P_C_ND] = 2 * zeta_s * math.sqrt(p[L.P_K_ND] * m.nut_inertia)
     p[L.P_K_PN] = options.carrier_nut_stiffness
     p[L.P_C_PN] = 2 * zeta_s * math.sqrt(p[L.P_K_PN] * m.carrier_mass)
@@ -305,36 +332,101 @@ def build_model(
     )
     p[L.P_C_TAN] = 2 * zeta_c * math.sqrt(p[L.P_K_TAN] * m.roller_inertia / r_r**2)
     p[L.P_FRICTION_SCALE] = health.friction_scale
-    p[L.P_DRIVE_MODE] = L.DRIVE_PRESCRIBED if profile.drive == "prescribed" else L.DRIVE_SPEED_LOOP
+    p[L.P_DRIVE_MODE] = {
+        "prescribed": L.DRIVE_PRESCRIBED,
+        "speed_loop": L.DRIVE_SPEED_LOOP,
+        "position_loop": L.DRIVE_POSITION_LOOP,
+    }[profile.drive]
+    # PI speed loop on the motor speed, gains from the inertia it drives (motor + screw)
+    j_drive = drive_train.motor_inertia + m.screw_inertia
     omega_bw = 2 * math.pi * profile.speed_loop_bandwidth
-    p[L.P_KP] = m.screw_inertia * omega_bw * 2.0
-    p[L.P_KI] = m.screw_inertia * omega_bw**2
+    p[L.P_KP] = j_drive * omega_bw * 2.0
+    p[L.P_KI] = j_drive * omega_bw**2
+    p[L.P_KP_POS] = profile.position_loop_gain
     p[L.P_TORQUE_LIMIT] = profile.torque_limit
     p[L.P_LOAD_SIN_AMP], p[L.P_LOAD_SIN_FREQ] = amp, freq
+    _drive_train_params(p, drive_train, design, k_axial, options.contact_restitution)
 
-    rollers = _roller_params(design, health, options.variation, orbit, seed)
+    rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
+    rollers = _roller_params(design, health, options.variation, orbit, rng)
+    errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng)
     return Model(
         design=design,
         health=health,
         profile=profile,
         options=options,
+        drive_train=drive_train,
         params=p,
         rollers=rollers,
         mesh_table=mesh,
         motion=np.ascontiguousarray(profile.motion_knots()),
         load_knots=np.ascontiguousarray(load_knots),
+        errors=errors,
         thread_stiffness=(tangents[0], tangents[1]),
         roller_load=roller_load,
     )
 
 
-def _roller_params(design, health, variation, orbit, seed) -> np.ndarray:
+def _drive_train_params(p, drive_train, design, k_axial, restitution) -> None:
+    """Motor, coupling, thrust bearing, linkage, payload and the squeeze-film damper."""
+    dt, m = drive_train, design.masses
+    zeta_film = -math.log(restitution) / math.sqrt(math.pi**2 + math.log(restitution) ** 2)
+    p[L.P_C_FILM] = 2 * zeta_film * math.sqrt(k_axial * m.nut_mass)
+    p[L.P_J_M] = dt.motor_inertia
+    p[L.P_COUPLED] = 1.0 if dt.coupled else 0.0
+    p[L.P_K_COUP] = dt.coupling_stiffness
+    j_pair = dt.motor_inertia * m.screw_inertia / (dt.motor_inertia + m.screw_inertia)
+    p[L.P_C_COUP] = 2 * dt.coupling_damping_ratio * math.sqrt(dt.coupling_stiffness * j_pair)
+    p[L.P_AXIAL_FREE] = 0.0 if dt.rigid_thrust_bearing else 1.0
+    p[L.P_K_BEAR] = dt.thrust_bearing_stiffness
+    p[L.P_C_BEAR] = (
+        2 * dt.thrust_bearing_damping_ratio * math.sqrt(dt.thrust_bearing_stiffness * m.screw_mass)
+    )
+    p[L.P_BEAR_PLAY] = dt.thrust_bearing_play
+    p[L.P_ON_PAYLOAD] = 1.0 if dt.load_application == "payload" else 0.0
+    p[L.P_M_L] = dt.payload_mass
+    p[L.P_K_LINK] = dt.linkage_stiffness
+    p[L.P_C_LINK] = (
+        2 * dt.linkage_damping_ratio * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
+    )
+
+
+def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:
+    """Geometric error table (layout ``E_*`` rows) and the cumulative lead slope [-]."""
+    v = variation
+    r_s, r_n = design.screw_diameter / 2, design.nut_diameter / 2
+    draws = rng.standard_normal(2)
+    phases = rng.uniform(0.0, 2 * math.pi, 24)
+    wavelengths = np.exp(rng.uniform(math.log(0.3e-3), math.log(3e-3), 12))
+    rows = []
+    # periodic lead error: v_2πp peak to peak over harmonics 1–3 of the contact angle
+    for k, share in enumerate((0.6, 0.3, 0.1)):
+        rows.append((L.ERR_SCREW_AXIAL, k + 1.0, 0.5 * v.lead_error_periodic * share, phases[k]))
+    rows.append((L.ERR_SCREW_RADIAL, 1.0, v.screw_runout, phases[3]))
+    # flank waviness along the contact path, 6 components per flank of equal share
+    amp = v.flank_waviness * math.sqrt(2.0 / 6.0)
+    for j in range(6):
+        rows.append((L.ERR_SCREW_AXIAL, r_s / wavelengths[j], amp, phases[4 + j]))
+        rows.append((L.ERR_NUT_AXIAL, r_n / wavelengths[6 + j], amp, phases[10 + j]))
+    if design.gear is not None:
+        z = float(design.gear.ring_teeth)
+        rows.append((L.ERR_GEAR, 1.0, 0.5 * v.gear_pitch_error, phases[16]))
+        rows.append((L.ERR_GEAR, z, 0.5 * v.gear_profile_error, phases[17]))
+        rows.append((L.ERR_GEAR, 2 * z, 0.25 * v.gear_profile_error, phases[18]))
+    errors = np.array([row for row in rows if row[2] > 0.0], dtype=float)
+    errors = np.ascontiguousarray(errors.reshape(-1, L.N_ERROR_COLUMNS))
+    lead_slope = 0.5 * v.lead_error_cumulative / 0.3 * float(draws[0])
+    return errors, lead_slope
+
+
+def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     n = design.n_rollers
-    rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
     # Always draw the same numbers in the same order, so switching one tolerance off leaves
     # the others unchanged for a given seed.
     z = rng.standard_normal((6, n))
     wear = rng.uniform(-1.0, 1.0, n)
+    runout = np.abs(rng.standard_normal(n))
+    runout_phase = rng.uniform(0.0, 2 * math.pi, n)
     psi = 2 * math.pi * np.arange(n) / n + variation.position_error * z[0]
     r = np.zeros((n, L.N_ROLLER_PARAMS))
     r[:, L.R_PSI] = psi
@@ -350,6 +442,8 @@ def _roller_params(design, health, variation, orbit, seed) -> np.ndarray:
     r[:, L.R_E_G] = variation.transmission_error * z[4]
     r[:, L.R_MESH_PHASE] = 0.0
     r[:, L.R_MESH_SCALE] = np.clip(1.0 + variation.mesh_stiffness_spread * z[5], 0.5, 1.5)
+    r[:, L.R_RUNOUT] = variation.roller_runout * runout
+    r[:, L.R_RUNOUT_PHASE] = runout_phase
     return r
 
 
@@ -362,10 +456,10 @@ def static_closure(model: Model, side: int) -> float:
 
 
 def initial_state(model: Model, t0: float = 0.0) -> np.ndarray:
-    """Rigid-body motion at the profile's initial speed, axial contacts at their static load.
+    """Rigid-body motion at the profile's initial speed, contacts at their static load.
 
-    Starting on the kinematic solution with the static thread deflections avoids a start-up
-    transient that would otherwise dominate short runs.
+    Starting on the kinematic solution with the static thread, bearing, linkage and coupling
+    deflections avoids a start-up transient that would otherwise dominate short runs.
     """
     d = model.design
     n = model.n_rollers
@@ -378,16 +472,27 @@ def initial_state(model: Model, t0: float = 0.0) -> np.ndarray:
     w_r = ratios.roller_spin * w_s
     v_nut = ratios.nut * w_s
     load0 = float(model.load_knots[1, 0])
+    sign = 1.0 if load0 >= 0 else -1.0
+    # Static deflections: coupling twist under the ideal screw torque, screw pushed back on its
+    # bearing, linkage stretched by the load.
+    twist = load0 * ratios.nut / p[L.P_K_COUP] if p[L.P_COUPLED] == 1.0 else 0.0
+    z_s = 0.0
+    if p[L.P_AXIAL_FREE] == 1.0 and load0:
+        z_s = -sign * (p[L.P_BEAR_PLAY] + abs(load0) / p[L.P_K_BEAR])
     # Rigid-body positions at t0 (negative when settling): every angle and axial position on
     # the kinematic solution, so no deformation comes from the start time itself.
-    th_s = w_s * t0
+    th_m = w_s * t0
+    th_s = th_m - twist
+    y[L.Q_THM] = th_m
+    y[nq + L.Q_THM] = w_s
     y[L.Q_THS] = th_s
     y[L.Q_THP] = ratios.carrier * th_s
+    y[L.Q_ZS] = z_s
     y[nq + L.Q_THS] = w_s
     y[nq + L.Q_THP] = w_c
     y[nq + L.Q_ZN] = v_nut
+    y[nq + L.Q_ZL] = v_nut
     # Axial offsets carrying the initial load: nut pushed back through both thread sides.
-    sign = 1.0 if load0 >= 0 else -1.0
     frac = abs(load0) / max(model.roller_load * n, 1e-12)
     shape = frac if p[L.P_EXPONENT] == 1.0 else frac ** (2.0 / 3.0)
     for i in range(n):
@@ -400,11 +505,14 @@ def initial_state(model: Model, t0: float = 0.0) -> np.ndarray:
         y[nq + b + 2] = w_r
         y[nq + b + 3] = v_nut
         d_s = sign * (r[i, L.R_B_S] + shape * static_closure(model, 0)) if load0 else 0.0
-        # δ_s = −z_i + e_s (+ the rigid-body terms, zero on the kinematic solution)
-        y[b + 3] = -d_s + r[i, L.R_E_S] + ratios.nut * th_s
+        # δ_s = −(z_i − z_s) + e_s (+ the rigid-body terms, zero on the kinematic solution)
+        y[b + 3] = z_s - d_s + r[i, L.R_E_S] + ratios.nut * th_s
     z_c_mean = float(np.mean(y[L.Q_ROLLER0 + 3 : nq : L.ROLLER_DOF]))
     d_n_mean = (
         sign * (float(np.mean(r[:, L.R_B_N])) + shape * static_closure(model, 1)) if load0 else 0.0
     )
     y[L.Q_ZN] = z_c_mean - d_n_mean + float(np.mean(r[:, L.R_E_N]))
+    y[L.Q_ZL] = y[L.Q_ZN]
+    if p[L.P_ON_PAYLOAD] == 1.0:
+        y[L.Q_ZL] -= load0 / p[L.P_K_LINK]
     return y

@@ -20,6 +20,25 @@ from . import _kernels
 from . import layout as L
 from .model import Model, SimulationOptions, build_model, initial_state
 
+TRUTH_ORDER = (
+    "motor_angle",
+    "motor_speed",
+    "motor_torque",
+    "screw_angle",
+    "screw_speed",
+    "carrier_speed",
+    "nut_position",
+    "nut_axial_accel",
+    "nut_tangential_accel",
+    "nut_radial_x_accel",
+    "nut_radial_y_accel",
+    "friction_torque",
+    "axial_load",
+    "payload_position",
+    "screw_axial_position",
+    "load_force",
+)
+
 #: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
 STABILITY_MARGIN = 0.9
 
@@ -46,20 +65,24 @@ def linearised_eigenvalues(model: Model) -> np.ndarray:
         model, rollers=rollers, load_knots=np.array([[0.0, 1.0], [operating, operating]])
     )
     y0 = initial_state(loaded)
-    prescribed = model.params[L.P_DRIVE_MODE] == L.DRIVE_PRESCRIBED
-    extras = range(2 * nq, 2 * nq + L.N_EXTRA)
-    free = [
-        j
-        for j in range(model.n_state)
-        if j not in extras and not (prescribed and j in (L.Q_THS, nq + L.Q_THS))
-    ]
+    p = model.params
+    held = set(range(2 * nq, 2 * nq + L.N_EXTRA))  # energies and the loop integrator
+    if p[L.P_DRIVE_MODE] == L.DRIVE_PRESCRIBED:
+        held |= {L.Q_THM, nq + L.Q_THM}
+    if p[L.P_COUPLED] != 1.0:  # the screw angle is the motor's
+        held |= {L.Q_THS, nq + L.Q_THS}
+    if p[L.P_AXIAL_FREE] != 1.0:
+        held |= {L.Q_ZS, nq + L.Q_ZS}
+    if p[L.P_ON_PAYLOAD] != 1.0:  # the payload coordinate follows the nut
+        held |= {L.Q_ZL, nq + L.Q_ZL}
+    free = [j for j in range(model.n_state) if j not in held]
     velocity = (np.arange(model.n_state) >= nq) & (np.arange(model.n_state) < 2 * nq)
     scale = np.where(velocity, 1e-7, 1e-10)
     f_plus = np.empty(model.n_state)
     f_minus = np.empty(model.n_state)
     aux = np.zeros(L.n_aux(model.n_rollers))
     jac = np.empty((len(free), len(free)))
-    args = (model.params, rollers, model.mesh_table, loaded.motion, loaded.load_knots)
+    args = (model.params, rollers, model.mesh_table, loaded.motion, loaded.load_knots, model.errors)
     for col, j in enumerate(free):
         y = y0.copy()
         y[j] += scale[j]
@@ -91,10 +114,11 @@ def max_stable_step(model: Model) -> tuple[float, float]:
 
 
 def settling_model(model: Model) -> Model:
-    """The model with the nut axial motion critically damped about its rigid-body speed.
+    """The model with the nut axial motion critically damped about its rigid-body speed, and
+    coupling, thrust bearing and linkage critically damped.
 
-    Used before t = 0 only: the rollers find their (uneven) load shares without ringing, so a
-    run starts in its loaded steady state.
+    Used before t = 0 only: the rollers find their (uneven) load shares and the drive train its
+    static deflections without ringing, so a run starts in its loaded steady state.
     """
     from ..kinematics import speed_ratios
 
@@ -106,6 +130,11 @@ def settling_model(model: Model) -> Model:
     # settling damper c_s·(v − v_rigid) plus the guide's own c_g·v, as one damper
     params[L.P_C_NA] = c_settle + c_guide
     params[L.P_V_NUT_REF] = c_settle * v_rigid / (c_settle + c_guide)
+    m, dt = model.design.masses, model.drive_train
+    j_pair = dt.motor_inertia * m.screw_inertia / (dt.motor_inertia + m.screw_inertia)
+    params[L.P_C_COUP] = 2.0 * math.sqrt(dt.coupling_stiffness * j_pair)
+    params[L.P_C_BEAR] = 2.0 * math.sqrt(dt.thrust_bearing_stiffness * m.screw_mass)
+    params[L.P_C_LINK] = 2.0 * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
     return replace(model, params=params)
 
 
@@ -173,7 +202,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     """Simulate a :class:`~prsm_health.scenario.Scenario`; see :func:`simulate`."""
     design, health, profile = scenario.design, scenario.health, scenario.profile
     sensors, options, seed = scenario.sensors, scenario.options, scenario.seed
-    model = build_model(design, health, profile, options, seed)
+    model = build_model(design, health, profile, options, seed, scenario.drive_train)
     h, factor = choose_step(options.max_step, sensors.sample_rate)
     h_stable, f_max = max_stable_step(model)
     if h > h_stable:
@@ -191,8 +220,14 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
             0.0  # energy book starts at t = 0
         )
     raw = _integrate(model, y, h, n_steps, progress)
+    truth_raw = {name: raw[:, k] for k, name in enumerate(TRUTH_ORDER)}
+    old = {  # transitional: the sensors read the truth of the motor where the screw was
+        "screw_angle": truth_raw["motor_angle"],
+        "screw_speed": truth_raw["motor_speed"],
+        "drive_torque": truth_raw["motor_torque"],
+    }
     channels = measure(
-        {name: raw[:, k] for k, name in enumerate(CHANNEL_NAMES)},
+        {name: old.get(name, truth_raw.get(name)) for name in CHANNEL_NAMES},
         1.0 / h,
         sensors,
         np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
@@ -258,6 +293,7 @@ def _integrate(
             model.mesh_table,
             model.motion,
             model.load_knots,
+            model.errors,
             raw[done : done + count] if record else raw,
             *work,
             aux,
