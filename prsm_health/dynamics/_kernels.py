@@ -208,6 +208,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     friction_torque = 0.0  # friction part of the screw torque, paper 02's reduction [N·m]
     p_diss = 0.0
     p_fric = 0.0
+    engaged = 0.0  # rollers in contact with both screw and nut (load path closed)
 
     for i in range(n_rollers):
         b = L.Q_ROLLER0 + L.ROLLER_DOF * i
@@ -251,6 +252,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
             d_ax, d_ax_dot, approach, approach_dot, rollers[i, L.R_B_S], cot_b, k_ts, c_ts, expo
         )
         p_diss += diss
+        screw_contact = f_plus + f_minus > 0.0
         f_ax = f_plus - f_minus  # axial force of the screw on the roller (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller outward, screw inward
         # along e_t of the roller, from θ_rev (helix, radial error slope, runout)
@@ -332,6 +334,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
             expo,
         )
         p_diss += diss
+        if screw_contact and f_plus + f_minus > 0.0:
+            engaged += 1.0
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
         g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s) / orbit
@@ -420,10 +424,12 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         + p[L.P_C_SD] * w_s * w_s
     )
 
-    # Lubricant squeeze film in the thread gaps: damps the nut's axial motion relative to the
-    # screw's kinematic position (through the rollers, whose own modes are far faster).
+    # Lubricant squeeze film of the loaded thread contacts: damps the nut's axial motion relative
+    # to the screw's kinematic position (through the rollers, whose own modes are far faster),
+    # in proportion to the rollers whose load path is closed — not across an open gap, where
+    # the film is thick and its damping negligible (it scales as 1/h³).
     v_film = vz_n - vz_s - lead_eff * w_s
-    f_film = p[L.P_C_FILM] * v_film
+    f_film = p[L.P_C_FILM] * engaged / n_rollers * v_film
     dy[v0 + L.Q_ZN] -= f_film
     force_screw_axial += f_film
     torque_screw += f_film * lead_eff

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..channels import CHANNEL_NAMES
 from ..design import DEFAULT_PRESET, PRSMDesign
+from ..drive_train import DriveTrain
 from ..errors import SimulationError, require
 from ..run import Run
 from ..sensors import SensorModel, measure
@@ -152,6 +153,7 @@ def simulate(
     seed: int = 0,
     *,
     options: SimulationOptions | None = None,
+    drive_train: DriveTrain | None = None,
     progress: bool = False,
 ) -> Run:
     """Simulate a PRSM run and return its sampled sensor channels.
@@ -166,6 +168,9 @@ def simulate(
         Seeds manufacturing variation, uneven wear and sensor noise: same seed, same run
         (bit-identical).
     options : SimulationOptions
+    drive_train : DriveTrain, default DriveTrain()
+        Motor, coupling, thrust bearing, linkage and payload (``DriveTrain.paper01()`` for the
+        paper's rigid drive and ideal force on the nut).
     progress : bool
         Show a progress bar (long runs).
 
@@ -194,6 +199,7 @@ def simulate(
         sensors=sensors or SensorModel(),
         options=options or SimulationOptions(),
         seed=int(seed),
+        drive_train=drive_train or DriveTrain(),
     )
     return simulate_scenario(scenario, progress=progress)
 

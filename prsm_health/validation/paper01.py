@@ -15,6 +15,7 @@ from ..dynamics.simulate import simulate
 from ..kinematics import characteristic_frequencies, speed_ratios
 from ..sensors import SensorModel
 from ..spectra import amplitude_spectrum, dominant_frequency
+from ..drive_train import DriveTrain
 from ..states import HealthState, ManufacturingVariation, OperatingProfile
 from ..stiffness.thread import roller_side_stiffness
 from . import Row, inconsistent, not_computable, reproduced
@@ -23,7 +24,8 @@ IDEAL = SimulationOptions(variation=ManufacturingVariation.ideal())
 
 
 def _simulate(speed: float, clearance: float, duration: float = 0.4):
-    """Paper 01's §3 case: identical rollers (assumption 2), F_a = 100 N, b_s = b_N = b."""
+    """Paper 01's §3 case: identical rollers (assumption 2), F_a = 100 N on the nut, b_s = b_N = b,
+    screw driven rigidly and axially fixed (the paper's model, ``DriveTrain.paper01()``)."""
     return simulate(
         "paper01",
         HealthState(clearance_screw=clearance, clearance_nut=clearance, clearance_gear=10e-6),
@@ -31,6 +33,7 @@ def _simulate(speed: float, clearance: float, duration: float = 0.4):
         SensorModel(sample_rate=20_000),
         1,
         options=IDEAL,
+        drive_train=DriveTrain.paper01(),
     )
 
 

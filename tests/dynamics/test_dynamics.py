@@ -19,6 +19,7 @@ from prsm_health import (
     simulate,
     speed_ratios,
 )
+from prsm_health.drive_train import DriveTrain
 from prsm_health.dynamics.model import build_model
 from prsm_health.dynamics.simulate import linearised_eigenvalues, max_stable_step
 from prsm_health.spectra import amplitude_spectrum, dominant_frequency
@@ -27,7 +28,20 @@ from prsm_health.stiffness.thread import roller_side_stiffness
 IDEAL = SimulationOptions(variation=ManufacturingVariation.ideal())
 
 
-def run(speed=100.0, load=100.0, clearance=10e-6, duration=0.3, seed=1, options=None, **profile):
+#: Paper 01's own actuator: rigid screw drive, axially fixed screw, ideal force on the nut.
+PAPER = DriveTrain.paper01()
+
+
+def run(
+    speed=100.0,
+    load=100.0,
+    clearance=10e-6,
+    duration=0.3,
+    seed=1,
+    options=None,
+    drive_train=PAPER,
+    **profile,
+):
     return simulate(
         "paper01",
         HealthState.uniform(clearance),
@@ -35,6 +49,7 @@ def run(speed=100.0, load=100.0, clearance=10e-6, duration=0.3, seed=1, options=
         SensorModel(sample_rate=20_000),
         seed,
         options=options,
+        drive_train=drive_train,
     )
 
 
@@ -132,22 +147,19 @@ def test_nut_axial_mode_matches_thread_stiffness():
     assert _dominant(r["nut_axial_accel"], r.sample_rate) == pytest.approx(expected, abs=40.0)
 
 
-def test_clearance_lowers_axial_frequency_and_raises_amplitude_under_reversing_load(
-    reversing_run,
-):
+def test_clearance_raises_impact_amplitude_under_reversing_load(reversing_run):
     # Documented regime (docs/validation.md): a ±300 N load reversing at 10 Hz makes the nut
-    # cross the 2b gap. The peak-to-peak acceleration rises with b = 10 → 20 → 30 µm by ≈ 1.5×
-    # per step, far beyond what a different impact sequence on another CPU changes. The dominant
-    # axial frequency sits on harmonics of the 10 Hz impact train and is not monotone at every
-    # operating point; across the four surveyed (60/100 rad/s × 0/100 N) b = 30 µm was always
-    # ≥ 20 % below b = 10 µm, so only that end-to-end drop is asserted.
-    freqs, amps = [], []
-    for b in (10e-6, 20e-6, 30e-6):
-        x = reversing_run(b, duration=0.5, seed=1)["nut_axial_accel"]
-        freqs.append(_dominant(x, 20_000.0))
-        amps.append(np.ptp(x))
-    assert freqs[2] < freqs[0], freqs
-    assert amps[0] < amps[1] < amps[2], amps
+    # cross the 2b gap and strike the other flanks. With the default drive train (payload on a
+    # linkage) and lubricated contacts (restitution 0.6) the peak-to-peak acceleration rose by
+    # ≥ 1.3× per step b = 10 → 20 → 30 µm in every run tried; the assertion asks for 1.1×, far
+    # beyond what another impact sequence on another CPU changes. Paper 01's second signature,
+    # a dominant axial frequency falling with b, is not asserted: with the drive train it is
+    # not monotone (docs/validation.md, clearance-signature map).
+    amps = [
+        np.ptp(reversing_run(b, duration=0.5, seed=1)["nut_axial_accel"])
+        for b in (10e-6, 20e-6, 30e-6)
+    ]
+    assert amps[1] > 1.1 * amps[0] and amps[2] > 1.1 * amps[1], amps
 
 
 def test_clearance_invisible_while_preload_holds_contact():
