@@ -130,12 +130,12 @@ def test_bad_windows():
 
 def test_simulated_clearance_signature(reversing_run):
     # Reversing ±300 N load (docs/validation.md): lost motion grows by ≈ 4·15 µm per step (robust
-    # to the impact sequence); the dominant axial frequency falls from 5 to 35 µm (end to end
-    # only: intermediate steps depend on which impact-train harmonic dominates).
-    lost, freq = [], []
+    # to the impact sequence) and the impact RMS rises. The dominant axial frequency is not
+    # asserted: with the drive train it is not monotone in b (clearance-signature map).
+    lost, rms = [], []
     for b in (5e-6, 20e-6, 35e-6):
         f = extract_features(reversing_run(b, duration=0.3, seed=2))
         lost.append(f["lost_motion"])
-        freq.append(f["axial_dominant_frequency"])
+        rms.append(f["ax_rms"])
     assert lost[0] < lost[1] < lost[2]
-    assert freq[2] < freq[0]
+    assert rms[0] < rms[2]
