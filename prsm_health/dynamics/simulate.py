@@ -49,7 +49,14 @@ def _rk4_amplification(z: np.ndarray) -> np.ndarray:
 
 
 def linearised_eigenvalues(model: Model) -> np.ndarray:
-    """Eigenvalues [1/s] of the model linearised on the loaded flanks at the operating load.
+    """Eigenvalues [1/s] of the model linearised on the loaded flanks at the operating load
+    (:func:`linearised_modes`)."""
+    return linearised_modes(model)[0]
+
+
+def linearised_modes(model: Model) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """Eigenvalues [1/s], eigenvectors (columns) and the state indices they span, of the model
+    linearised on the loaded flanks at the operating load.
 
     Clearances are closed and every roller carries the operating load on one flank of each
     thread and on the gear, so all contact stiffnesses act (at their tangent values for the
@@ -91,7 +98,8 @@ def linearised_eigenvalues(model: Model) -> np.ndarray:
         y[j] -= 2 * scale[j]
         _kernels.rhs(0.0, y, *args, f_minus, aux)
         jac[:, col] = (f_plus[free] - f_minus[free]) / (2 * scale[j])
-    return np.linalg.eigvals(jac)
+    values, vectors = np.linalg.eig(jac)
+    return values, vectors, free
 
 
 def max_stable_step(model: Model) -> tuple[float, float]:
