@@ -336,7 +336,8 @@ class RunSpec:
             raise RecipeError(f"recipe (run {self.run_id}): {exc}") from None
 
     def labels(self, run: Run | None = None) -> dict:
-        """The run's labels: id, split, fault class and the scenario's labels (nominal values)."""
+        """The run's labels: id, split, fault class, the scenario's labels (nominal values) and,
+        given the simulated run, its realised clearances."""
         scenario = self.scenario()
         health = scenario.health
         clearance = max(health.clearance_screw, health.clearance_nut)
@@ -347,6 +348,7 @@ class RunSpec:
             **scenario.labels(),
         }
         if run is not None:
+            out.update({k: v for k, v in run.labels.items() if "_realised_" in k})
             out["n_samples"] = len(run)
         return out
 

@@ -434,17 +434,34 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     r[:, L.R_SIN_PSI] = np.sin(psi)
     r[:, L.R_POCKET_R] = orbit + variation.eccentricity * z[1]
     scale = 1.0 + health.wear_spread * wear
-    r[:, L.R_B_S] = health.clearance_screw * scale
-    r[:, L.R_B_N] = health.clearance_nut * scale
-    r[:, L.R_B_G] = health.clearance_gear
     r[:, L.R_E_S] = variation.pitch_error * z[2]
     r[:, L.R_E_N] = variation.pitch_error * z[3]
     r[:, L.R_E_G] = variation.transmission_error * z[4]
+    # As assembled, the clearance takes up each roller's pitch and transmission errors, so a
+    # new screw (b = 0) has no interference: a roller whose thread sits Δe off the others gets
+    # |Δe|/2 more play on each thread side, its gear |Δe_g| more backlash. Preload is not a
+    # clearance of zero but a parameter of its own.
+    pitch = r[:, L.R_E_S] + r[:, L.R_E_N]
+    take_up = 0.5 * np.abs(pitch - np.mean(pitch))
+    r[:, L.R_B_S] = health.clearance_screw * scale + take_up
+    r[:, L.R_B_N] = health.clearance_nut * scale + take_up
+    r[:, L.R_B_G] = health.clearance_gear + np.abs(r[:, L.R_E_G] - np.mean(r[:, L.R_E_G]))
     r[:, L.R_MESH_PHASE] = 0.0
     r[:, L.R_MESH_SCALE] = np.clip(1.0 + variation.mesh_stiffness_spread * z[5], 0.5, 1.5)
     r[:, L.R_RUNOUT] = variation.roller_runout * runout
     r[:, L.R_RUNOUT_PHASE] = runout_phase
     return r
+
+
+def realised_clearances(model: Model) -> dict[str, float]:
+    """Run labels of the as-built half-clearances [m]: mean, min and max over the rollers of
+    each engagement (uneven wear and the assembly's take-up of pitch errors included)."""
+    out = {}
+    for name, column in (("screw", L.R_B_S), ("nut", L.R_B_N), ("gear", L.R_B_G)):
+        values = model.rollers[:, column]
+        for stat in ("mean", "min", "max"):
+            out[f"clearance_{name}_realised_{stat}"] = float(getattr(np, stat)(values))
+    return out
 
 
 def static_closure(model: Model, side: int) -> float:

@@ -19,7 +19,7 @@ from ..sensors import SensorModel, measure
 from ..states import HealthState, OperatingProfile
 from . import _kernels
 from . import layout as L
-from .model import Model, SimulationOptions, build_model, initial_state
+from .model import Model, SimulationOptions, build_model, initial_state, realised_clearances
 
 TRUTH_ORDER = (
     "motor_angle",
@@ -259,7 +259,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         time=time,
         channels=channels,
         sample_rate=sensors.sample_rate,
-        labels=scenario.labels(),
+        labels={**scenario.labels(), **realised_clearances(model)},
         scenario={
             **scenario.to_dict(),
             "integration_step": h,
