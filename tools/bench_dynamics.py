@@ -64,6 +64,7 @@ def bench_kernel(duration: float) -> float:
         model.mesh_table,
         model.motion,
         model.load_knots,
+        model.errors,
         raw,
         *work,
         aux,
@@ -85,8 +86,8 @@ def bench_solve_ivp(duration: float) -> tuple[float, int]:
 
     def f(t, y):
         y = np.array(y)
-        th, w, _ = _kernels.screw_motion(t, model.motion)  # prescribed screw, as in the kernel
-        y[L.Q_THS], y[nq + L.Q_THS] = th, w
+        th, w, _ = _kernels.screw_motion(t, model.motion)  # prescribed motor, as in the kernel
+        y[L.Q_THM], y[nq + L.Q_THM] = th, w
         dy = np.empty_like(y)
         _kernels.rhs(
             t,
@@ -96,6 +97,7 @@ def bench_solve_ivp(duration: float) -> tuple[float, int]:
             model.mesh_table,
             model.motion,
             model.load_knots,
+            model.errors,
             dy,
             aux,
         )
@@ -117,7 +119,7 @@ m = build_model(preset("paper01"), HealthState(), OperatingProfile(duration=d, s
 n = int(d / 5e-6); y = initial_state(m); raw = np.empty((n, L.N_CHANNELS))
 work = [np.empty(m.n_state) for _ in range(5)]; aux = np.zeros(L.n_aux(m.n_rollers))
 t0 = time.perf_counter()
-_kernels.integrate(y, 0.0, 5e-6, n, 1, m.params, m.rollers, m.mesh_table, m.motion, m.load_knots, raw, *work, aux)
+_kernels.integrate(y, 0.0, 5e-6, n, 1, m.params, m.rollers, m.mesh_table, m.motion, m.load_knots, m.errors, raw, *work, aux)
 print(d / (time.perf_counter() - t0))
 """
 

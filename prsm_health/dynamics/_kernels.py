@@ -130,16 +130,17 @@ def _mesh_stiffness(table, phase):
 
 @njit(cache=True, inline="always")
 def _wave(errors, kind, u):
-    # Sum of the error table's terms of one kind at contact coordinate u: (value, d/du).
-    value = 0.0
-    slope = 0.0
-    for k in range(errors.shape[0]):
-        if errors[k, L.E_KIND] == kind:
-            arg = errors[k, L.E_WAVE] * u + errors[k, L.E_PHASE]
-            amp = errors[k, L.E_AMP]
-            value += amp * math.sin(arg)
-            slope += amp * errors[k, L.E_WAVE] * math.cos(arg)
-    return value, slope
+    # Error profile of one kind at contact coordinate u, linearly interpolated in its table:
+    # (value [m], slope d/du [m/rad]).
+    n = errors.shape[1] - 1
+    period = errors[kind, 0]
+    x = (u / period - math.floor(u / period)) * n
+    i0 = int(x)
+    if i0 >= n:
+        i0 = n - 1
+    i1 = i0 + 1 if i0 + 1 < n else 0
+    a, b = errors[kind, 1 + i0], errors[kind, 1 + i1]
+    return a + (b - a) * (x - i0), (b - a) * n / period
 
 
 @njit(cache=True)

@@ -80,14 +80,15 @@ N_PARAMS = 72
 
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 
-# ----------------------------------------------------------------- geometric error terms
-# Rows of the error table: (kind, wave number [1/rad], amplitude [m], phase [rad]); each adds
-# amplitude·sin(wave·u + phase) to one closure, u the contact coordinate of its kind:
+# ----------------------------------------------------------------- geometric error tables
+# One row per kind: column 0 the period P [rad] of the error profile, columns 1…N its values
+# [m] at u = P·k/N, interpolated linearly (the kernel's slope is that of the interpolant, so
+# forces and energy stay consistent). The contact coordinate u of each kind:
 #   screw axial / radial: u = θ_rev + ψ_i − θ_s (where roller i touches the screw surface),
 #   nut axial: u = θ_rev + ψ_i − θ_N (where it touches the nut), gear: u = θ_p + ψ_i − θ_N.
-E_KIND, E_WAVE, E_AMP, E_PHASE = 0, 1, 2, 3
-N_ERROR_COLUMNS = 4
 ERR_SCREW_AXIAL, ERR_SCREW_RADIAL, ERR_NUT_AXIAL, ERR_GEAR = 0, 1, 2, 3
+N_ERROR_KINDS = 4
+N_ERROR_POINTS = 16384
 
 # ----------------------------------------------------------------- per-roller parameters
 R_COS_PSI, R_SIN_PSI = 0, 1  # angular position of the pocket on the carrier

@@ -185,7 +185,7 @@ class Model:
     mesh_table: np.ndarray  # (n_points,) mesh stiffness over one cycle [N/m]
     motion: np.ndarray  # (3, K) screw speed knots
     load_knots: np.ndarray  # (2, K)
-    errors: np.ndarray  # (n_terms, N_ERROR_COLUMNS) geometric error terms
+    errors: np.ndarray  # (N_ERROR_KINDS, 1 + N_ERROR_POINTS) geometric error tables
     thread_stiffness: tuple[float, float]  # linearised axial stiffness per roller side [N/m]
     roller_load: float  # per-roller axial load the laws are built around [N]
 
@@ -392,31 +392,50 @@ def _drive_train_params(p, drive_train, design, k_axial, restitution) -> None:
 
 
 def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:
-    """Geometric error table (layout ``E_*`` rows) and the cumulative lead slope [-]."""
+    """Geometric error tables (layout ``ERR_*`` rows) and the cumulative lead slope [-].
+
+    Each kind is a sum of sinusoids of its contact coordinate, tabulated over its period: one
+    screw or nut revolution for runout and gear errors, 16 for the lead error and waviness
+    along the helix (their wave numbers rounded to multiples of 1/16, so the profile closes).
+    """
     v = variation
     r_s, r_n = design.screw_diameter / 2, design.nut_diameter / 2
     draws = rng.standard_normal(2)
     phases = rng.uniform(0.0, 2 * math.pi, 24)
     wavelengths = np.exp(rng.uniform(math.log(0.3e-3), math.log(3e-3), 12))
-    rows = []
+    turns = 16
+    terms: dict[int, list] = {kind: [] for kind in range(L.N_ERROR_KINDS)}
     # periodic lead error: v_2πp peak to peak over harmonics 1–3 of the contact angle
     for k, share in enumerate((0.6, 0.3, 0.1)):
-        rows.append((L.ERR_SCREW_AXIAL, k + 1.0, 0.5 * v.lead_error_periodic * share, phases[k]))
-    rows.append((L.ERR_SCREW_RADIAL, 1.0, v.screw_runout, phases[3]))
+        terms[L.ERR_SCREW_AXIAL].append((k + 1.0, 0.5 * v.lead_error_periodic * share, phases[k]))
+    terms[L.ERR_SCREW_RADIAL].append((1.0, v.screw_runout, phases[3]))
     # flank waviness along the contact path, 6 components per flank of equal share
     amp = v.flank_waviness * math.sqrt(2.0 / 6.0)
     for j in range(6):
-        rows.append((L.ERR_SCREW_AXIAL, r_s / wavelengths[j], amp, phases[4 + j]))
-        rows.append((L.ERR_NUT_AXIAL, r_n / wavelengths[6 + j], amp, phases[10 + j]))
+        for kind, radius, w in ((L.ERR_SCREW_AXIAL, r_s, j), (L.ERR_NUT_AXIAL, r_n, 6 + j)):
+            wave = round(radius / wavelengths[w] * turns) / turns
+            terms[kind].append((wave, amp, phases[4 + w]))
     if design.gear is not None:
         z = float(design.gear.ring_teeth)
-        rows.append((L.ERR_GEAR, 1.0, 0.5 * v.gear_pitch_error, phases[16]))
-        rows.append((L.ERR_GEAR, z, 0.5 * v.gear_profile_error, phases[17]))
-        rows.append((L.ERR_GEAR, 2 * z, 0.25 * v.gear_profile_error, phases[18]))
-    errors = np.array([row for row in rows if row[2] > 0.0], dtype=float)
-    errors = np.ascontiguousarray(errors.reshape(-1, L.N_ERROR_COLUMNS))
+        terms[L.ERR_GEAR] += [
+            (1.0, 0.5 * v.gear_pitch_error, phases[16]),
+            (z, 0.5 * v.gear_profile_error, phases[17]),
+            (2 * z, 0.25 * v.gear_profile_error, phases[18]),
+        ]
+    periods = {
+        L.ERR_SCREW_AXIAL: 2 * math.pi * turns,
+        L.ERR_SCREW_RADIAL: 2 * math.pi,
+        L.ERR_NUT_AXIAL: 2 * math.pi * turns,
+        L.ERR_GEAR: 2 * math.pi,
+    }
+    tables = np.zeros((L.N_ERROR_KINDS, L.N_ERROR_POINTS + 1))
+    for kind, rows in terms.items():
+        u = np.arange(L.N_ERROR_POINTS) * periods[kind] / L.N_ERROR_POINTS
+        tables[kind, 0] = periods[kind]
+        for wave, amplitude, phase in rows:
+            tables[kind, 1:] += amplitude * np.sin(wave * u + phase)
     lead_slope = 0.5 * v.lead_error_cumulative / 0.3 * float(draws[0])
-    return errors, lead_slope
+    return tables, lead_slope
 
 
 def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
