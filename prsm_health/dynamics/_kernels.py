@@ -237,7 +237,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         e_ax, de_ax = _wave(errors, L.ERR_SCREW_AXIAL, u)
         e_rad, de_rad = _wave(errors, L.ERR_SCREW_RADIAL, u)
         chi = th_c - th_rev + rollers[i, L.R_RUNOUT_PHASE]
-        ro_c, ro_s = runout * math.cos(chi), runout * math.sin(chi)
+        cos_chi, minus_sin_chi = _wave(errors, L.ERR_UNIT_COSINE, chi)
+        ro_c, ro_s = runout * cos_chi, -runout * minus_sin_chi
         lead_local = lead_s - de_ax  # the error's slope acts as a local lead change
         d_ax = (
             lead_s * (th_s - th_rev)
@@ -322,7 +323,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         )
         d_ax_dot = vz_c - vz_n + lead_r * (w_c - w_rev) - lead_local * (w_n - w_rev)
         chi = th_c - th_rev + rollers[i, L.R_RUNOUT_PHASE]
-        ro_c, ro_s = runout * math.cos(chi), runout * math.sin(chi)
+        cos_chi, minus_sin_chi = _wave(errors, L.ERR_UNIT_COSINE, chi)
+        ro_c, ro_s = runout * cos_chi, -runout * minus_sin_chi
         f_plus, f_minus, diss = _thread_pair(
             d_ax,
             d_ax_dot,

@@ -86,8 +86,10 @@ DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 # forces and energy stay consistent). The contact coordinate u of each kind:
 #   screw axial / radial: u = θ_rev + ψ_i − θ_s (where roller i touches the screw surface),
 #   nut axial: u = θ_rev + ψ_i − θ_N (where it touches the nut), gear: u = θ_p + ψ_i − θ_N.
-ERR_SCREW_AXIAL, ERR_SCREW_RADIAL, ERR_NUT_AXIAL, ERR_GEAR = 0, 1, 2, 3
-N_ERROR_KINDS = 4
+# The last row is cos u over one turn: the roller runout's cos and −sin by one lookup, far
+# cheaper than two trigonometric calls per roller and side.
+ERR_SCREW_AXIAL, ERR_SCREW_RADIAL, ERR_NUT_AXIAL, ERR_GEAR, ERR_UNIT_COSINE = 0, 1, 2, 3, 4
+N_ERROR_KINDS = 5
 N_ERROR_POINTS = 16384
 
 # ----------------------------------------------------------------- per-roller parameters

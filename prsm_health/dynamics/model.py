@@ -427,7 +427,9 @@ def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:
         L.ERR_SCREW_RADIAL: 2 * math.pi,
         L.ERR_NUT_AXIAL: 2 * math.pi * turns,
         L.ERR_GEAR: 2 * math.pi,
+        L.ERR_UNIT_COSINE: 2 * math.pi,
     }
+    terms[L.ERR_UNIT_COSINE].append((1.0, 1.0, math.pi / 2))
     tables = np.zeros((L.N_ERROR_KINDS, L.N_ERROR_POINTS + 1))
     for kind, rows in terms.items():
         u = np.arange(L.N_ERROR_POINTS) * periods[kind] / L.N_ERROR_POINTS

@@ -56,7 +56,9 @@ def run(
 @pytest.mark.parametrize("speed", [1.0, 100.0])
 def test_carrier_speed_ratio_matches_rigid_body(speed):
     # Issue: within 0.5 % of r_s/(2(r_s + r_c)) = 0.375 at 1 and 100 rad/s, steady state.
-    r = run(speed=speed, duration=0.2)
+    # Ideal geometry: over the 0.1 rad a 1 rad/s run turns, the local slope of the lead errors
+    # and waviness (≈ 0.3 % of the lead) would modulate the ratio.
+    r = run(speed=speed, duration=0.2, options=IDEAL)
     half = len(r) // 2
     ratio = np.mean(r["carrier_speed"][half:]) / np.mean(r["screw_speed"][half:])
     assert ratio == pytest.approx(speed_ratios(preset("paper01")).carrier, rel=5e-3)
