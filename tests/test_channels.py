@@ -1,30 +1,76 @@
 """The channel contract is declared once and every consumer agrees with it."""
 
+import numpy as np
 import pytest
 
 from prsm_health import channels
 from prsm_health.dynamics import layout
+from prsm_health.dynamics.simulate import _truth_from_record
 from prsm_health.errors import PRSMHealthError
 
 
-def test_record_order_matches_the_kernel_layout():
-    index = {c.name: k for k, c in enumerate(channels.CHANNELS)}
-    for name in channels.CHANNEL_NAMES:
-        assert getattr(layout, "C_" + name.upper()) == index[name]
-    assert layout.N_CHANNELS == len(channels.CHANNELS)
+def test_the_simulator_gives_every_truth_signal_in_contract_order():
+    # The simulator turns the kernel's record (layout C_* columns) into the truth signals; a
+    # record column named like a truth signal (C_<NAME>) is that signal, sample for sample.
+    raw = np.arange(5.0 * layout.N_CHANNELS).reshape(5, layout.N_CHANNELS)
+    truth = _truth_from_record(raw)
+    assert tuple(truth) == channels.TRUTH_NAMES
+    assert all(np.shape(v) == (5,) for v in truth.values())
+    recorded = {
+        name: getattr(layout, "C_" + name.upper())
+        for name in channels.TRUTH_NAMES
+        if hasattr(layout, "C_" + name.upper())
+    }
+    assert recorded  # the kernel records truth signals under their own names
+    for name, column in recorded.items():
+        assert np.array_equal(truth[name], raw[:, column]), name
 
 
-def test_every_channel_is_measured_or_truth_and_on_one_topic():
-    assert set(channels.MEASURED_NAMES) | set(channels.TRUTH_NAMES) == set(channels.CHANNEL_NAMES)
-    assert not set(channels.MEASURED_NAMES) & set(channels.TRUTH_NAMES)
-    fields = [f for pairs in channels.TOPIC_FIELDS.values() for f, _ in pairs]
-    assert len(fields) == len(channels.CHANNELS)
-    assert {"friction_torque", "carrier_speed"} <= set(channels.TRUTH_NAMES)
+def test_measured_and_truth_are_apart():
+    assert all(c.kind == channels.MEASURED for c in channels.CHANNELS)
+    assert all(c.kind == channels.TRUTH for c in channels.TRUTH_CHANNELS)
+    assert channels.CHANNEL_NAMES == tuple(c.name for c in channels.CHANNELS)
+    assert len(set(channels.TRUTH_NAMES)) == len(channels.TRUTH_NAMES) == 16
+    # No truth-only signal is a channel; the shared names are the true value of what a sensor
+    # reads, and are told apart in files by the truth_ prefix.
+    assert {"friction_torque", "carrier_speed", "motor_torque", "load_force"}.isdisjoint(
+        channels.CHANNEL_NAMES
+    )
+    assert not any(name.startswith(channels.TRUTH_PREFIX) for name in channels.CHANNEL_NAMES)
+    columns = [channels.truth_column(n) for n in channels.TRUTH_NAMES]
+    assert set(columns).isdisjoint(channels.CHANNEL_NAMES)
+    assert columns[0] == "truth_motor_angle"
+
+
+def test_every_file_column_has_one_unit():
+    units = channels.UNITS
+    assert list(units) == [
+        "time",
+        *channels.CHANNEL_NAMES,
+        *(channels.truth_column(n) for n in channels.TRUTH_NAMES),
+    ]
+    for c in channels.TRUTH_CHANNELS:
+        assert units[channels.truth_column(c.name)] == c.unit
+        assert c.sensor and c.meaning
+
+
+def test_every_signal_is_on_one_topic_field():
+    pairs = {t: dict(p) for t, p in channels.TOPIC_FIELDS.items()}
+    assert set(pairs) == {*channels.MEASURED_TOPICS, channels.TOPIC_TRUTH}
+    measured = [n for t in channels.MEASURED_TOPICS for n in pairs[t].values()]
+    assert sorted(measured) == sorted(channels.CHANNEL_NAMES)
+    assert list(pairs[channels.TOPIC_TRUTH]) == list(channels.TRUTH_NAMES)  # field = name
+    assert list(pairs[channels.TOPIC_TRUTH].values()) == list(channels.TRUTH_NAMES)
 
 
 def test_unknown_channel_lists_the_contract():
     with pytest.raises(PRSMHealthError, match="nut_axial_accel"):
         channels.channel("nut_axial_acc")
+    with pytest.raises(PRSMHealthError, match="truth signals are not measured"):
+        channels.channel("friction_torque")
+    with pytest.raises(PRSMHealthError, match="motor_angle"):
+        channels.truth_channel("motor_angel")
+    assert channels.truth_channel("load_force").unit == "N"
 
 
 def test_import_is_lazy():

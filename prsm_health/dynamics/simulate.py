@@ -14,7 +14,7 @@ from ..channels import CHANNEL_NAMES
 from ..design import DEFAULT_PRESET, PRSMDesign
 from ..errors import SimulationError, require
 from ..run import Run
-from ..sensors import SensorModel, measure
+from ..sensors import SensorModel, decimate, measure
 from ..states import HealthState, OperatingProfile
 from . import _kernels
 from . import layout as L
@@ -143,7 +143,9 @@ def simulate(
     Returns
     -------
     Run
-        Contract channels at ``sensors.sample_rate``; ``run.energy`` holds the energy book.
+        Measured channels at ``sensors.sample_rate``; ``run.truth`` holds the truth signals on
+        the same time axis (anti-alias decimated, no sensor errors), ``run.energy`` the
+        energy book.
 
     Raises
     ------
@@ -190,13 +192,20 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
             0.0  # energy book starts at t = 0
         )
-    raw = _integrate(model, y, h, n_steps, progress)
+    truth_raw = _truth_from_record(_integrate(model, y, h, n_steps, progress))
+    # What each sensor reads (contract): the drive's angle, speed and torque on the motor side.
+    sensed = {
+        "screw_angle": "motor_angle",
+        "screw_speed": "motor_speed",
+        "drive_torque": "motor_torque",
+    }
     channels = measure(
-        {name: raw[:, k] for k, name in enumerate(CHANNEL_NAMES)},
+        {name: truth_raw[sensed.get(name, name)] for name in CHANNEL_NAMES},
         1.0 / h,
         sensors,
         np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
     )
+    truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
     n_out = len(channels["screw_angle"])
     time = np.arange(n_out) / sensors.sample_rate
     nq = model.n_coordinates
@@ -218,7 +227,37 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
             "highest_natural_frequency": f_max,
         },
         energy=energy,
+        truth=truth,
     )
+
+
+def _truth_from_record(raw: np.ndarray) -> dict[str, np.ndarray]:
+    """Truth signals (contract order) at the integration rate from the kernel's record.
+
+    The kernel records the screw-driven model's quantities (layout ``C_*``): the motor is the
+    screw (rigid coupling, no thrust-bearing compliance) and the load acts on the nut directly,
+    so the motor, screw and payload signals coincide and the screw stays axially at 0.
+    """
+    load = raw[:, L.C_AXIAL_LOAD]
+    nut = raw[:, L.C_NUT_POSITION]
+    return {
+        "motor_angle": raw[:, L.C_SCREW_ANGLE],
+        "motor_speed": raw[:, L.C_SCREW_SPEED],
+        "motor_torque": raw[:, L.C_DRIVE_TORQUE],
+        "screw_angle": raw[:, L.C_SCREW_ANGLE],
+        "screw_speed": raw[:, L.C_SCREW_SPEED],
+        "carrier_speed": raw[:, L.C_CARRIER_SPEED],
+        "nut_position": nut,
+        "nut_axial_accel": raw[:, L.C_NUT_AXIAL_ACCEL],
+        "nut_tangential_accel": raw[:, L.C_NUT_TANGENTIAL_ACCEL],
+        "nut_radial_x_accel": raw[:, L.C_NUT_RADIAL_X_ACCEL],
+        "nut_radial_y_accel": raw[:, L.C_NUT_RADIAL_Y_ACCEL],
+        "friction_torque": raw[:, L.C_FRICTION_TORQUE],
+        "axial_load": load,
+        "payload_position": nut,
+        "screw_axial_position": np.zeros(len(raw)),
+        "load_force": load,
+    }
 
 
 def _integrate(
