@@ -73,6 +73,16 @@ def test_unknown_channel_lists_the_contract():
     assert channels.truth_channel("load_force").unit == "N"
 
 
+def test_formats_doc_tables_are_current():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    tool = Path(__file__).resolve().parents[1] / "tools" / "make_formats_tables.py"
+    out = subprocess.run([sys.executable, str(tool), "--check"], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+
+
 def test_import_is_lazy():
     import subprocess
     import sys
