@@ -16,7 +16,8 @@ Layout (contract, docs/formats.md)::
 
     DIR/manifest.json        recipe, package version, sample rate, units, counts
     DIR/runs.parquet         one row per run: labels and parameters
-    DIR/signals/part-NNNNN.parquet   run_id, time and the channels; row group = run
+    DIR/signals/part-NNNNN.parquet   run_id, time, the measured channels, truth_<name>;
+                                     row group = run
     DIR/mcap/run-NNNNNN.mcap         with --format mcap|both
 """
 
@@ -32,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .channels import CHANNEL_NAMES, UNITS
+from .channels import CHANNEL_NAMES, TRUTH_PREFIX, UNITS
 from .design import PRESETS
 from .design_files import load_design
 from .errors import ParameterError, PRSMHealthError, RecipeError, require
@@ -403,17 +404,16 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
             from .mcap import write_mcap
 
             write_mcap(run, _mcap_path(out, run_id))
-        columns = {
-            "run_id": pa.array(np.full(len(run), run_id, np.int32)),
-            "time": pa.array(run.time),
-        }
-        for name in CHANNEL_NAMES:
-            columns[name] = pa.array(run.channels[name].astype(dtype))
+        columns = {"run_id": pa.array(np.full(len(run), run_id, np.int32))}
+        for name, values in run.columns().items():
+            # time stays float64: float32 would round the sample times
+            columns[name] = pa.array(values if name == "time" else values.astype(dtype))
         tables.append(pa.table(columns))
         labels.append(label)
     # One shard per batch, one row group per run; the labels ride in the footer so a shard and
-    # its labels appear together, atomically (temporary name, then rename).
-    metadata = _schema_metadata(recipe)
+    # its labels appear together, atomically (temporary name, then rename). The runs of a
+    # recipe share their instrumentation, hence their columns.
+    metadata = _schema_metadata(recipe, tables[0].column_names[1:])
     metadata[b"prsm_health.labels"] = json.dumps(labels).encode()
     shard = _shard_path(out, batch)
     tmp = shard.with_name(shard.name + f".partial-{os.getpid()}")
@@ -429,9 +429,9 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
     return labels
 
 
-def _schema_metadata(recipe: Recipe) -> dict:
+def _schema_metadata(recipe: Recipe, columns: list[str]) -> dict:
     return {
-        b"prsm_health.units": json.dumps({k: UNITS[k] for k in ("time", *CHANNEL_NAMES)}).encode(),
+        b"prsm_health.units": json.dumps({k: UNITS[k] for k in columns}).encode(),
         b"prsm_health.sample_rate": repr(float(recipe.sample_rate)).encode(),
         b"prsm_health.recipe": recipe.name.encode(),
     }
@@ -655,6 +655,7 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
         for group, label in enumerate(_shard_labels(shard)):
             rows.append(dict(label, shard=f"signals/{shard.name}", row_group=group))
     frame = pd.DataFrame(rows).sort_values("run_id").reset_index(drop=True)
+    stored = pq.read_schema(_shard_path(out, 0)).names
     table = pa.Table.from_pandas(frame, preserve_index=False)
     tmp = out / "runs.parquet.partial"
     pq.write_table(table, tmp)
@@ -665,7 +666,8 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
         "package": {"name": "prsm_health", "version": __version__},
         "sample_rate": recipe.sample_rate,
         "duration": recipe.duration,
-        "channels": {k: UNITS[k] for k in ("time", *CHANNEL_NAMES)},
+        "channels": {k: UNITS[k] for k in stored if k == "time" or k in CHANNEL_NAMES},
+        "truth": {k: UNITS[k] for k in stored if k in UNITS and k.startswith(TRUTH_PREFIX)},
         "dtype": recipe.dtype,
         "formats": formats,
         "fault_taxonomy": {
@@ -709,19 +711,34 @@ class Dataset:
     def sample_rate(self) -> float:
         return float(self.manifest["sample_rate"])
 
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """The measured channels the dataset's runs have, in contract order."""
+        return tuple(c for c in CHANNEL_NAMES if c in self.manifest["channels"])
+
     def __len__(self) -> int:
         return len(self.runs)
 
-    def run(self, run_id: int) -> Run:
-        """The signals of one run as a :class:`~prsm_health.run.Run` (one row group read)."""
+    def run(self, run_id: int, *, truth: bool = True) -> Run:
+        """The signals of one run as a :class:`~prsm_health.run.Run` (one row group read):
+        the measured channels, and the truth signals in ``Run.truth`` unless ``truth`` is
+        False (then their columns are not read)."""
         import pyarrow.parquet as pq
+
+        from .io._columns import contract_channels, truth_columns
 
         rows = self.runs[self.runs["run_id"] == run_id]
         if rows.empty:
             raise PRSMHealthError(f"run_id {run_id} is not in {self.path}")
         row = rows.iloc[0]
-        table = pq.ParquetFile(self.path / row["shard"]).read_row_group(int(row["row_group"]))
-        channels = {name: table.column(name).to_numpy().astype(float) for name in CHANNEL_NAMES}
+        path = self.path / row["shard"]
+        shard = pq.ParquetFile(path)
+        names = shard.schema_arrow.names
+        if not truth:
+            names = [c for c in names if not c.startswith(TRUTH_PREFIX)]
+        table = shard.read_row_group(int(row["row_group"]), columns=names)
+        channels = contract_channels(path, names, lambda c: table.column(c).to_numpy())
+        signals = truth_columns(names, lambda c: table.column(c).to_numpy())
         labels = {
             k: (v.item() if hasattr(v, "item") else v)
             for k, v in row.items()
@@ -733,6 +750,7 @@ class Dataset:
             self.sample_rate,
             labels,
             {"recipe": self.manifest["recipe"]},
+            truth=signals,
         )
 
     def iter_runs(self, run_ids: Iterable[int] | None = None):

@@ -2,11 +2,21 @@
 
 A **model bundle** (saved by :func:`prsm_health.training.train`) holds the clearance estimator,
 the fault classifier, the indicator names they were trained on, the window length of the
-training runs and the design. :func:`diagnose` cuts a recording into windows of that length,
-computes the indicators (:mod:`prsm_health.features`) of each, and returns a :class:`Diagnosis`
-for the whole recording with one per window; :func:`replay` does the same window by window
-while an MCAP recording streams. ``Diagnosis.to_json()`` is the Diagnosis contract
-(docs/formats.md)::
+training runs, the design and the measured channels of the training runs. :func:`diagnose`
+cuts a recording into windows of that length, computes the indicators
+(:mod:`prsm_health.features`) of each, and returns a :class:`Diagnosis` for the whole recording
+with one per window; :func:`replay` does the same window by window while an MCAP recording
+streams. The diagnosis reads the measured channels only, never a
+recording's truth signals.
+
+Missing channels: the indicator set is fixed (:data:`prsm_health.features.FEATURES`) and an
+indicator whose channel a window lacks is NaN. A model was trained on the runs' channels: a
+recording that lacks one of them is refused (:class:`RecordingError` naming the channels),
+because the model never learnt to do without it; a channel the model was trained without is
+harmless (its indicators were NaN in training, the model never uses them). Bundles saved before
+the channel list was recorded are not checked.
+
+``Diagnosis.to_json()`` is the Diagnosis contract (docs/formats.md)::
 
     {"clearance": {"estimate": m, "lower": m, "upper": m}, "fault_class": str,
      "class_probabilities": {class: p}, "indicators": {name: value},
@@ -21,9 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .channels import MEASURED_TOPICS
 from .design import PRSMDesign
 from .design_files import load_design
-from .errors import PRSMHealthError
+from .errors import PRSMHealthError, RecordingError
 from .features import extract_features, windows
 from .jsonable import finite_or_none
 from .run import MIN_SAMPLES, Run
@@ -64,9 +75,25 @@ class ModelBundle:
         """Window length the model was trained on [s]."""
         return float(self.metadata.get("window", 0.4))
 
+    @property
+    def channels(self) -> tuple[str, ...] | None:
+        """Measured channels of the training runs; None for a bundle that predates the record."""
+        channels = self.metadata.get("channels")
+        return None if channels is None else tuple(channels)
+
     def reference(self) -> dict:
         """The ``model`` entry of a diagnosis."""
         return {"name": self.name, "version": self.version, "design": self.design.name}
+
+    def check_channels(self, run: Run, what: str = "recording") -> None:
+        """Refuse a recording that lacks a channel the model was trained with."""
+        missing = [c for c in self.channels or () if c not in run.channels]
+        if missing:
+            raise RecordingError(
+                f"{what} lacks channel(s) {', '.join(missing)} that model {self.name!r} was "
+                f"trained with ({', '.join(self.channels)}); use a model trained for this "
+                "instrumentation"
+            )
 
 
 def load_bundle(
@@ -219,6 +246,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
 
 def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:
     """Diagnosis of one window (a :class:`Run` of about the model's window length)."""
+    bundle.check_channels(run, "window")
     return diagnose_indicators([extract_features(run, bundle.design)], bundle)[0]
 
 
@@ -239,7 +267,7 @@ def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
     tail = len(run) - n * len(parts)
     notes = []
     if tail >= max(MIN_SAMPLES, MIN_TAIL_FRACTION * n):
-        parts.append(_slice(run, len(run) - tail, len(run)))
+        parts.append(run.slice(len(run) - tail, len(run)))
         notes.append(f"last window is {tail / run.sample_rate:.3g} s, shorter than {length:g} s")
     elif tail > 0:
         notes.append(
@@ -247,12 +275,6 @@ def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
             f"({length:g} s)"
         )
     return parts, notes
-
-
-def _slice(run: Run, a: int, b: int) -> Run:
-    return Run(
-        run.time[a:b], {k: v[a:b] for k, v in run.channels.items()}, run.sample_rate, run.labels
-    )
 
 
 def diagnose(
@@ -268,7 +290,8 @@ def diagnose(
         Window length; default the model's training window (see :func:`split_windows`).
     """
     bundle = bundle or load_bundle()
-    run.validate()
+    run = run.without_truth().validate()
+    bundle.check_channels(run)
     parts, notes = split_windows(run, window or bundle.window)
     rows = [extract_features(part, bundle.design) for part in parts]
     per_window = diagnose_indicators(rows, bundle)
@@ -325,7 +348,7 @@ def replay(
 
     length = window or (bundle.window if bundle else 1.0)
     writer = DiagnosisWriter(path, out) if (out and bundle) else None
-    stream = iter_windows(path, length, rate=rate)
+    stream = iter_windows(path, length, rate=rate, topics=MEASURED_TOPICS)
     try:
         for w in stream:
             step = ReplayStep(w.index, w.start, w.end)

@@ -9,9 +9,17 @@ estimators handle missing values. Spectra use Hann windows with explicit scaling
 * power spectral densities are Welch estimates (Hann, 75 % overlap, density scaling, units²/Hz);
   band energies integrate them (units², i.e. the band's mean-square value).
 
-Gear-mesh lines are located from the measured speeds: the carrier speed channel when present,
-else the screw speed through the rigid-body ratio; when the speed varies by more than 5 % in a
-window the signal is resampled to uniform screw angle (order domain) before the spectrum.
+Indicators are computed from the measured channels (:attr:`Run.channels`) only. A channel the
+recording lacks (an instrumentation profile without the load cell, without some accelerometer
+axes) makes the indicators that need it NaN: the indicator set is always :data:`FEATURES`.
+Truth signals (:attr:`Run.truth`, simulator only) are read only when the caller names them
+(``extract_features(run, truth=("friction_torque",))``, :data:`TRUTH_FEATURES`): research
+indicators, never a model input by default.
+
+Gear-mesh lines are located from the measured screw speed through the design's rigid-body
+carrier ratio (from the true carrier speed only when ``"carrier_speed"`` is asked for); when the
+speed varies by more than 5 % in a window the signal is resampled to uniform screw angle (order
+domain) before the spectrum.
 
 The shifted-axial-frequency indicator compares the dominant nut axial frequency with the healthy
 baseline the physics predicts for the same design and load: √(k_axial/m_N)/2π, k_axial the
@@ -72,8 +80,6 @@ def _feature_table() -> dict[str, str]:
             "axial_frequency_shift": "Hz",
             "axial_frequency_shift_relative": "-",
             "axial_dominant_amplitude": "m/s²",
-            "friction_torque_mean": "N·m",
-            "friction_torque_ripple": "N·m",
             "drive_torque_mean": "N·m",
             "drive_torque_ripple": "N·m",
             "efficiency": "-",
@@ -86,8 +92,16 @@ def _feature_table() -> dict[str, str]:
     return units
 
 
-#: Indicator name → unit, in the column order of :func:`extract_features`.
+#: Indicator name → unit, in the column order of :func:`extract_features`: measured channels only.
 FEATURES: dict[str, str] = _feature_table()
+
+#: Truth signals :func:`extract_features` reads when asked (``truth=(name, …)``), and the
+#: indicators each adds (after :data:`FEATURES`). ``carrier_speed`` adds none: it locates the
+#: mesh lines from the true carrier speed instead of the measured screw speed.
+TRUTH_FEATURES: dict[str, dict[str, str]] = {
+    "friction_torque": {"friction_torque_mean": "N·m", "friction_torque_ripple": "N·m"},
+    "carrier_speed": {},
+}
 
 #: Indicator groups for importance and ablation studies.
 GROUPS = {
@@ -154,21 +168,63 @@ def _order_resample(x: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, float
     return np.interp(grid, angle, x), (grid[1] - grid[0])
 
 
-def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[str, float]:
+def _truth_request(run: Run, truth) -> tuple[str, ...]:
+    """The truth signals asked for, checked: known to :data:`TRUTH_FEATURES` and in the run."""
+    if isinstance(truth, str):
+        raise PRSMHealthError(f"truth = {truth!r}: give a tuple of names, e.g. ({truth!r},)")
+    truth = tuple(truth)
+    unknown = [n for n in truth if n not in TRUTH_FEATURES]
+    if unknown:
+        raise PRSMHealthError(
+            f"no truth indicator reads {', '.join(map(repr, unknown))}; "
+            f"available: {', '.join(TRUTH_FEATURES)}"
+        )
+    missing = [n for n in truth if n not in run.truth]
+    if missing:
+        raise PRSMHealthError(
+            f"truth {', '.join(missing)} asked for, but the run has no such truth signal "
+            "(only simulated runs have truth)"
+        )
+    return truth
+
+
+def extract_features(
+    run: Run, design: PRSMDesign | str | None = None, *, truth: tuple[str, ...] = ()
+) -> dict[str, float]:
     """All indicators of one run or window.
 
     Parameters
     ----------
     run : Run
-        Contract channels at ``run.sample_rate``; missing channels give NaN indicators.
+        Measured channels at ``run.sample_rate``; missing channels give NaN indicators.
+        ``run.truth`` is not read unless named in ``truth``.
     design : PRSMDesign, preset name or None
         Default: the run's ``labels["design"]``, else paper01.
+    truth : tuple of str
+        Truth signals to use (keys of :data:`TRUTH_FEATURES`), research only: each adds its
+        indicators; ``"carrier_speed"`` locates the mesh lines from the true carrier speed.
 
     Returns
     -------
-    dict of name → float, in :data:`FEATURES` order and units.
+    dict of name → float, in :data:`FEATURES` order and units, then the indicators of the
+    truth signals asked for.
+
+    Raises
+    ------
+    RecordingError
+        The measured channels (or the truth signals asked for) cannot be processed.
+    PRSMHealthError
+        No nut acceleration and no nut position; an unknown or absent truth signal asked for.
     """
-    run.validate(what="window")
+    truth = _truth_request(run, truth)
+    # Only what is read: the measured channels and the truth signals asked for.
+    run = Run(
+        run.time,
+        run.channels,
+        run.sample_rate,
+        run.labels,
+        truth={name: run.truth[name] for name in truth},
+    ).validate(what="window")
     if not any(ch in run.channels for ch in VIBRATION) and "nut_position" not in run.channels:
         raise PRSMHealthError(
             "no usable channels: need nut accelerations or nut position (contract names)"
@@ -178,6 +234,8 @@ def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[s
     design = preset(design) if isinstance(design, str) else design
     rate = run.sample_rate
     out = dict.fromkeys(FEATURES, np.nan)
+    for name in truth:
+        out.update(dict.fromkeys(TRUTH_FEATURES[name], np.nan))
     ch = run.channels
 
     for name, prefix in SHORT.items():
@@ -194,8 +252,8 @@ def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[s
         out["load_range"] = float(np.ptp(load))
 
     # ---- gear mesh lines
-    if "carrier_speed" in ch:
-        f_c = abs(float(np.mean(ch["carrier_speed"]))) / (2 * math.pi)
+    if "carrier_speed" in run.truth:
+        f_c = abs(float(np.mean(run.truth["carrier_speed"]))) / (2 * math.pi)
     elif speed is not None:
         f_c = abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi)
     else:
@@ -250,9 +308,9 @@ def extract_features(run: Run, design: PRSMDesign | str | None = None) -> dict[s
             out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
 
     # ---- torque
-    if "friction_torque" in ch:
-        out["friction_torque_mean"] = float(np.mean(ch["friction_torque"]))
-        out["friction_torque_ripple"] = float(np.std(ch["friction_torque"]))
+    if "friction_torque" in run.truth:
+        out["friction_torque_mean"] = float(np.mean(run.truth["friction_torque"]))
+        out["friction_torque_ripple"] = float(np.std(run.truth["friction_torque"]))
     if "drive_torque" in ch:
         out["drive_torque_mean"] = float(np.mean(ch["drive_torque"]))
         out["drive_torque_ripple"] = float(np.std(ch["drive_torque"]))
@@ -284,20 +342,14 @@ def windows(run: Run, length: float, hop: float | None = None):
             f"{ms_hint(run.sample_rate)}"
         )
     for start in range(0, len(run) - n + 1, step):
-        sl = slice(start, start + n)
-        yield Run(
-            run.time[sl],
-            {k: v[sl] for k, v in run.channels.items()},
-            run.sample_rate,
-            run.labels,
-            run.scenario,
-        )
+        yield run.slice(start, start + n)
 
 
-def dataset_features(dataset, run_ids=None, progress: bool = False):
+def dataset_features(dataset, run_ids=None, progress: bool = False, truth: tuple[str, ...] = ()):
     """Indicators of every run of a :class:`~prsm_health.dataset.Dataset` as a DataFrame.
 
-    Columns: :data:`FEATURES` plus the run labels (run_id, split, fault_class, clearances, …).
+    Columns: :data:`FEATURES` (then the indicators of the truth signals named in ``truth``, see
+    :func:`extract_features`) plus the run labels (run_id, split, fault_class, clearances, …).
     """
     import pandas as pd
 
@@ -309,8 +361,8 @@ def dataset_features(dataset, run_ids=None, progress: bool = False):
 
         iterator = tqdm(ids, unit="run", desc="features")
     for run_id in iterator:
-        run = dataset.run(int(run_id))
-        row = extract_features(run)
+        run = dataset.run(int(run_id), truth=bool(truth))
+        row = extract_features(run, truth=truth)
         row.update(run.labels)
         rows.append(row)
     return pd.DataFrame(rows)

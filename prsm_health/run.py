@@ -1,9 +1,11 @@
-"""A simulated or recorded run: time, contract channels, labels, and its single-file Parquet form.
+"""A simulated or recorded run: time, measured channels, truth, labels.
 
-Channel names and units follow the signal-channel contract (:mod:`prsm_health.channels`). A
-single run written to ``.parquet`` has the columns ``time`` and every channel, with the units,
-sample rate, labels and scenario in the Parquet schema metadata, so pandas/pyarrow/duckdb read it
-as is. :meth:`Run.validate` is the one place that decides whether a recording can be processed.
+Channel names and units follow the signal-channel contract (:mod:`prsm_health.channels`):
+:attr:`Run.channels` holds the measured channels a recording has, :attr:`Run.truth` the
+simulator's truth signals (empty for a recording from hardware); the two never mix. A run as a
+table (:meth:`Run.to_frame`, the single-run Parquet file of :mod:`prsm_health.io.parquet`) has
+the columns ``time``, the measured channels, then ``truth_<name>`` for each truth signal.
+:meth:`Run.validate` is the one place that decides whether a recording can be processed.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .channels import CHANNEL_NAMES
+from .channels import CHANNEL_NAMES, TRUTH_NAMES, truth_column
 from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
 
 #: Fewest samples a recording or window needs: below it the spectra have too few bins for the
@@ -28,7 +30,8 @@ class Run:
     ----------
     time : ndarray [s]
     channels : dict of name → ndarray
-        Contract channels (see :data:`UNITS`), SI.
+        Measured contract channels (:data:`~prsm_health.channels.CHANNEL_NAMES`), SI: what the
+        sensors gave. A recording may lack some.
     sample_rate : float [Hz]
     labels : dict
         Run labels (contract): clearances [m], nominal speed [rad/s] and load [N], seed, …
@@ -37,6 +40,10 @@ class Run:
     energy : dict
         Energy book of the simulation [J] (drive, load, dissipated, friction) — empty for
         recordings.
+    truth : dict of name → ndarray
+        Truth signals of a simulated run (:data:`~prsm_health.channels.TRUTH_NAMES`, without
+        the ``truth_`` prefix), SI, on the same time axis, free of sensor errors — empty for
+        recordings. Never an input of the diagnosis.
     """
 
     time: np.ndarray
@@ -45,8 +52,13 @@ class Run:
     labels: dict = field(default_factory=dict)
     scenario: dict = field(default_factory=dict)
     energy: dict = field(default_factory=dict)
+    truth: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
+        if name in self.truth and name not in self.channels:
+            raise PRSMHealthError(
+                f"{name!r} is not a measured channel of this run; its truth is run.truth[{name!r}]"
+            )
         return lookup_channel(self.time, self.channels, name)
 
     def __len__(self) -> int:
@@ -83,8 +95,8 @@ class Run:
         Raises
         ------
         RecordingError
-            Too short, no channel, non-finite or non-increasing time, a channel of another
-            length, non-finite or out-of-range samples.
+            Too short, no channel, non-finite or non-increasing time, a channel or truth
+            signal of another length, non-finite samples, out-of-range channel samples.
         RecordingTooLongError
             More than ``max_samples`` samples.
         """
@@ -123,15 +135,48 @@ class Run:
                     f"{what}: channel {name} has samples beyond ±{max_abs:g} "
                     "(SI units expected: m, rad, N, N·m, m/s²)"
                 )
+        for name, values in self.truth.items():
+            values = np.asarray(values, dtype=float)
+            if len(values) != n:
+                raise RecordingError(
+                    f"{what}: truth {name} has {len(values)} samples, time has {n}"
+                )
+            if not np.all(np.isfinite(values)):
+                raise RecordingError(f"{what}: truth {name} contains NaN or infinite values")
         return self
 
-    def to_frame(self):
-        """pandas DataFrame with ``time`` and the channels in contract order."""
-        import pandas as pd
+    def without_truth(self) -> Run:
+        """The same recording with the measured channels only (arrays shared, not copied)."""
+        return Run(
+            self.time, self.channels, self.sample_rate, self.labels, self.scenario, self.energy
+        )
 
+    def slice(self, start: int, stop: int) -> Run:
+        """Samples ``[start, stop)`` as a run (views): channels, truth, labels and scenario; no
+        energy book (it is the whole run's)."""
+        sl = slice(start, stop)
+        return Run(
+            self.time[sl],
+            {k: v[sl] for k, v in self.channels.items()},
+            self.sample_rate,
+            self.labels,
+            self.scenario,
+            truth={k: v[sl] for k, v in self.truth.items()},
+        )
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The run as file columns (contract): ``time``, the measured channels, then
+        ``truth_<name>`` for each truth signal, in contract order."""
         data = {"time": self.time}
         data.update({name: self.channels[name] for name in CHANNEL_NAMES if name in self.channels})
-        return pd.DataFrame(data)
+        data.update({truth_column(n): self.truth[n] for n in TRUTH_NAMES if n in self.truth})
+        return data
+
+    def to_frame(self):
+        """pandas DataFrame of :meth:`columns`."""
+        import pandas as pd
+
+        return pd.DataFrame(self.columns())
 
 
 def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str) -> np.ndarray:

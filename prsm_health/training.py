@@ -533,6 +533,8 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
             "runs": metrics["runs"],
         },
         "clearance_range": metrics.get("clearance_range"),
+        # what a recording must have to be diagnosed by this model (diagnosis.check_channels)
+        "channels": list(ds.channels),
         "observability_feature": OBSERVABILITY_FEATURE,
         "target": target,
     }

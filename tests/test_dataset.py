@@ -13,7 +13,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from prsm_health.channels import CHANNEL_NAMES
+from prsm_health.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
 from prsm_health.dataset import Dataset, Recipe, RecipeError, generate, load_recipe
 from prsm_health.dynamics.simulate import simulate
 
@@ -100,7 +100,13 @@ def test_workers_1_and_2_identical_and_readers(recipe_path, tmp_path):
     runs_pl = pl.read_parquet(tmp_path / "a" / "runs.parquet")
     assert runs_pl.height == 6
     signals_pl = pl.read_parquet(str(tmp_path / "a" / "signals" / "*.parquet"))
-    assert set(CHANNEL_NAMES) <= set(signals_pl.columns)
+    truth_columns = [truth_column(n) for n in TRUTH_NAMES]
+    assert signals_pl.columns == ["run_id", "time", *CHANNEL_NAMES, *truth_columns]
+    assert manifest["truth"] == {c: UNITS[c] for c in truth_columns}
+    assert "carrier_speed" not in manifest["channels"]
+    shard = pq.read_table(next((tmp_path / "a" / "signals").glob("*.parquet")))
+    assert shard.schema.field("truth_friction_torque").type == "float"  # recipe dtype float32
+    assert json.loads(meta[b"prsm_health.units"])["truth_load_force"] == "N"
     counts = duckdb.sql(
         f"select run_id, count(*) n from read_parquet('{tmp_path / 'a' / 'signals' / '*.parquet'}') group by run_id order by run_id"
     ).fetchall()
@@ -124,7 +130,36 @@ def test_dataset_run_equals_simulation(recipe_path, tmp_path):
     assert np.array_equal(stored.time, direct.time)
     for name in CHANNEL_NAMES:  # float32 storage: equal to float32 precision
         assert np.array_equal(stored[name], direct[name].astype(np.float32).astype(float)), name
+    assert list(stored.truth) == list(TRUTH_NAMES)
+    for name in TRUTH_NAMES:
+        expected = direct.truth[name].astype(np.float32).astype(float)
+        assert np.array_equal(stored.truth[name], expected), name
     assert stored.labels["clearance_screw"] == scenario.health.clearance_screw
+    assert ds.run(4, truth=False).truth == {}
+    assert ds.channels == CHANNEL_NAMES
+
+
+def test_runs_with_some_channels_are_stored_as_they_are(recipe_path, tmp_path, monkeypatch):
+    # An instrumentation without the load cell and the radial accelerometers: the shards hold
+    # the fitted channels only, the manifest and the loader say so.
+    from prsm_health.scenario import Scenario
+
+    simulate_all = Scenario.simulate
+    dropped = ("axial_load", "nut_radial_x_accel", "nut_radial_y_accel")
+
+    def fitted(self, *args, **kwargs):
+        run = simulate_all(self, *args, **kwargs)
+        run.channels = {k: v for k, v in run.channels.items() if k not in dropped}
+        return run
+
+    monkeypatch.setattr(Scenario, "simulate", fitted)
+    generate(recipe_path, tmp_path / "d", workers=1, progress=False)
+    ds = Dataset(tmp_path / "d")
+    kept = tuple(c for c in CHANNEL_NAMES if c not in dropped)
+    assert ds.channels == kept and tuple(ds.manifest["channels"]) == ("time", *kept)
+    run = ds.run(1)
+    assert tuple(run.channels) == kept and list(run.truth) == list(TRUTH_NAMES)
+    assert "axial_load" in run.truth  # the truth is whole whatever the sensors
 
 
 def test_interrupt_and_resume_in_process(recipe_path, tmp_path):

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.cli import main
 from prsm_health.dataset import generate
 from prsm_health.diagnosis import diagnose, load_bundle
@@ -62,6 +63,9 @@ def test_training_writes_model_and_metrics(model):
     assert {"clearance_cv", "fault_cv", "clearance_importance", "fault_importance"} <= set(stored)
     groups = {r["name"] for r in stored["clearance_importance"] if r["kind"] == "group"}
     assert {"mesh", "axial_frequency", "lost_motion"} <= groups
+    bundle = load_bundle(path)
+    assert bundle.channels == CHANNEL_NAMES  # what a recording must have for this model
+    assert not {"friction_torque_mean", "friction_torque_ripple"} & set(bundle.feature_names)
 
 
 def test_diagnosis_contract(model, reversing_run):

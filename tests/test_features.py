@@ -9,8 +9,10 @@ from prsm_health import (
     preset,
     speed_ratios,
 )
-from prsm_health.errors import PRSMHealthError
-from prsm_health.features import FEATURES, GROUPS, extract_features, windows
+from prsm_health.channels import CHANNEL_NAMES, TRUTH_NAMES
+from prsm_health.diagnosis import ModelBundle, diagnose
+from prsm_health.errors import PRSMHealthError, RecordingError
+from prsm_health.features import FEATURES, GROUPS, TRUTH_FEATURES, extract_features, windows
 from prsm_health.run import Run
 
 RATE = 20_000.0
@@ -18,24 +20,35 @@ D = preset("paper01")
 
 
 def synthetic(n=20_000, speed=100.0, extra=None, load=None):
+    """Measured channels with known indicators; the truth holds a friction torque and the
+    rigid-body carrier speed."""
     t = np.arange(n) / RATE
     ratios = speed_ratios(D)
     f_mesh = D.gear.ring_teeth * ratios.carrier * speed / (2 * math.pi)
     ch = {
         "screw_angle": speed * t,
         "screw_speed": np.full(n, speed),
-        "carrier_speed": np.full(n, ratios.carrier * speed),
         "nut_position": ratios.nut * speed * t,
         "nut_axial_accel": 0.3 * np.sin(2 * math.pi * 437.3 * t),
         "nut_tangential_accel": 0.02 * np.sin(2 * math.pi * f_mesh * t + 0.3),
         "nut_radial_x_accel": 0.01 * np.sin(2 * math.pi * 2 * f_mesh * t),
         "nut_radial_y_accel": np.zeros(n),
         "drive_torque": np.full(n, 0.2),
-        "friction_torque": 0.03 + 0.001 * np.sin(2 * math.pi * 10 * t),
         "axial_load": np.full(n, 100.0) if load is None else load(t),
     }
     ch.update(extra or {})
-    return Run(t, ch, RATE, {"design": "paper01"}), f_mesh
+    truth = {
+        "carrier_speed": np.full(n, ratios.carrier * speed),
+        "friction_torque": 0.03 + 0.001 * np.sin(2 * math.pi * 10 * t),
+    }
+    return Run(t, ch, RATE, {"design": "paper01"}, truth=truth), f_mesh
+
+
+def same(a: dict, b: dict) -> bool:
+    """Equal indicator dicts, NaN equal to NaN."""
+    return list(a) == list(b) and all(
+        (math.isnan(a[k]) and math.isnan(b[k])) or a[k] == b[k] for k in a
+    )
 
 
 def test_every_indicator_has_a_unit_and_a_group_member_exists():
@@ -71,7 +84,6 @@ def test_order_domain_when_speed_varies():
         extra={
             "screw_angle": angle,
             "screw_speed": speed,
-            "carrier_speed": ratios.carrier * speed,
             "nut_tangential_accel": 0.05 * np.sin(mesh_phase),
         },
     )
@@ -126,6 +138,89 @@ def test_bad_windows():
     with pytest.raises(PRSMHealthError, match="no usable channels"):
         extract_features(empty)
     assert len(list(windows(synthetic()[0], 0.25))) == 4
+
+
+# ----------------------------------------------------------------------------- truth apart
+def test_truth_is_never_read_by_default():
+    r, _ = synthetic()
+    n = len(r)
+    reference = extract_features(Run(r.time, r.channels, RATE, r.labels))
+    rng = np.random.default_rng(0)
+    # Every truth signal present, with values no sensor would give, then all NaN: a feature
+    # that read any of them would change (or the NaN would stop the extraction).
+    for fill in (lambda: 1e6 * rng.standard_normal(n), lambda: np.full(n, np.nan)):
+        r.truth = {name: fill() for name in TRUTH_NAMES}
+        assert same(extract_features(r), reference)
+    assert not any(k.startswith("truth_") or k.startswith("friction_") for k in reference)
+
+
+def test_a_run_with_only_truth_has_no_features():
+    r, _ = synthetic()
+    truth_only = Run(r.time, {}, RATE, r.labels, truth={**r.channels, **r.truth})
+    with pytest.raises(RecordingError, match="no contract channel"):
+        extract_features(truth_only)
+    # Under their file column names they are not channels either.
+    prefixed = Run(r.time, {"truth_" + k: v for k, v in r.channels.items()}, RATE, r.labels)
+    with pytest.raises(PRSMHealthError, match="no usable channels"):
+        extract_features(prefixed)
+
+
+def test_truth_indicators_only_when_asked():
+    r, f_mesh = synthetic()
+    f = extract_features(r, truth=("friction_torque",))
+    assert list(f) == [*FEATURES, *TRUTH_FEATURES["friction_torque"]]
+    assert f["friction_torque_mean"] == pytest.approx(0.03, rel=1e-6)
+    assert f["friction_torque_ripple"] == pytest.approx(0.001 / math.sqrt(2), rel=1e-3)
+    # The true carrier speed, 2 % off the rigid-body ratio (rollers slip), moves the mesh line
+    # only when asked for.
+    r.truth["carrier_speed"] = 1.02 * r.truth["carrier_speed"]
+    assert extract_features(r)["mesh_frequency"] == pytest.approx(f_mesh, rel=1e-12)
+    slipping = extract_features(r, truth=("carrier_speed",))
+    assert list(slipping) == list(FEATURES)
+    assert slipping["mesh_frequency"] == pytest.approx(1.02 * f_mesh, rel=1e-12)
+    for truth, needle in [
+        (("motor_angle",), "no truth indicator reads 'motor_angle'"),
+        ("friction_torque", "give a tuple"),
+    ]:
+        with pytest.raises(PRSMHealthError, match=needle):
+            extract_features(r, truth=truth)
+    recording = Run(r.time, r.channels, RATE, r.labels)
+    with pytest.raises(PRSMHealthError, match="only simulated runs have truth"):
+        extract_features(recording, truth=("friction_torque",))
+    r.truth["friction_torque"][5] = np.nan  # asked for: checked like a channel
+    with pytest.raises(RecordingError, match="truth friction_torque contains NaN"):
+        extract_features(r, truth=("friction_torque",))
+
+
+# ----------------------------------------------------------------------------- missing channels
+def test_missing_channels_give_nan_indicators_of_a_fixed_set():
+    r, _ = synthetic()
+    full = extract_features(r)
+    # A profile with an axial accelerometer, the drive and no load cell.
+    fitted = ("screw_angle", "screw_speed", "nut_position", "nut_axial_accel", "drive_torque")
+    sparse = extract_features(Run(r.time, {k: r.channels[k] for k in fitted}, RATE, r.labels))
+    assert list(sparse) == list(FEATURES)
+    for key in ("tan_rms", "rx_mesh_h2", "ry_kurtosis", "load_mean", "load_range", "efficiency"):
+        assert math.isnan(sparse[key]), key
+    for key in ("ax_rms", "axial_dominant_frequency", "mesh_frequency", "drive_torque_mean"):
+        assert sparse[key] == full[key], key
+    # Without the load cell the axial baseline is taken at the nominal 100 N.
+    assert sparse["axial_baseline_frequency"] == pytest.approx(full["axial_baseline_frequency"])
+
+
+def test_a_model_refuses_a_recording_without_a_channel_it_was_trained_with():
+    r, _ = synthetic()
+    no_load_cell = {k: v for k, v in r.channels.items() if k != "axial_load"}
+    bundle = ModelBundle(None, None, list(FEATURES), {"name": "m", "channels": list(CHANNEL_NAMES)})
+    with pytest.raises(RecordingError, match="lacks channel.s. axial_load that model 'm'"):
+        diagnose(Run(r.time, no_load_cell, RATE, r.labels), bundle)
+    # Trained without the load cell: its indicators were NaN in training, the recording's are
+    # not used; a bundle without a channel record is not checked.
+    fitted = [c for c in CHANNEL_NAMES if c != "axial_load"]
+    for metadata in ({"channels": fitted}, {}):
+        bundle = ModelBundle(None, None, list(FEATURES), metadata)
+        assert diagnose(Run(r.time, no_load_cell, RATE, r.labels), bundle).windows
+        assert diagnose(r, bundle).windows
 
 
 def test_simulated_clearance_signature(reversing_run):

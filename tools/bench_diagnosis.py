@@ -47,7 +47,7 @@ def main() -> None:
     diagnose_indicators(rows, bundle)
     t_model_batch = time.perf_counter() - t0
     n = len(parts)
-    print(f"{n} windows of 1 s at 20 kHz (20,000 samples × 11 channels)\n")
+    print(f"{n} windows of 1 s at 20 kHz (20,000 samples × {len(parts[0].channels)} channels)\n")
     print("| stage | windows per second |")
     print("|---|---|")
     print(f"| indicators only | {n / t_features:.1f} |")

@@ -8,8 +8,8 @@ The baselines are what a user would write from the mcap documentation:
   numpy arrays;
 - replay: the same iterator in log-time order, cutting fixed windows.
 
-Both sides handle the same messages (two topics, 11 contract channels, one message per sample
-and topic), and the script checks that each reads the other's file to the same values. The
+Both sides handle the same messages (the two measured topics, 9 contract channels, one message
+per sample and topic), and the script checks that each reads the other's file to the same values. The
 signals are synthetic (sines + noise at full double precision, like simulator output), so the
 JSON text has realistic lengths without running the simulator.
 
@@ -30,9 +30,12 @@ import numpy as np
 from mcap.reader import make_reader
 from mcap.writer import Writer
 
-from prsm_health.channels import CHANNEL_NAMES
+from prsm_health.channels import CHANNEL_NAMES, MEASURED_TOPICS
 from prsm_health.mcap import TOPIC_FIELDS, iter_windows, read_mcap, write_mcap
 from prsm_health.run import Run
+
+# A recording from hardware: the measured topics only (no /prsm/truth).
+TOPICS = {topic: TOPIC_FIELDS[topic] for topic in MEASURED_TOPICS}
 
 
 def synthetic_run(duration: float, rate: float) -> Run:
@@ -51,7 +54,7 @@ def baseline_write(run: Run, path: Path) -> None:
         writer = Writer(f)
         writer.start()
         topics = []
-        for topic, pairs in TOPIC_FIELDS.items():
+        for topic, pairs in TOPICS.items():
             schema = {
                 "type": "object",
                 "properties": {name: {"type": "number"} for name, _ in pairs},
@@ -71,7 +74,7 @@ def baseline_write(run: Run, path: Path) -> None:
 
 
 def baseline_read(path: Path) -> dict[str, np.ndarray]:
-    names = {topic: dict(pairs) for topic, pairs in TOPIC_FIELDS.items()}
+    names = {topic: dict(pairs) for topic, pairs in TOPICS.items()}
     lists: dict[str, list] = {}
     with open(path, "rb") as f:
         for _, channel, message in make_reader(f).iter_messages():
@@ -84,7 +87,7 @@ def baseline_read(path: Path) -> dict[str, np.ndarray]:
 
 
 def baseline_replay(path: Path, window: float) -> int:
-    names = {topic: dict(pairs) for topic, pairs in TOPIC_FIELDS.items()}
+    names = {topic: dict(pairs) for topic, pairs in TOPICS.items()}
     window_ns = round(window * 1e9)
     end = window_ns
     current: dict[str, list] = {}
@@ -119,7 +122,7 @@ def main() -> None:
     args = parser.parse_args()
 
     run = synthetic_run(args.duration, args.rate)
-    messages = len(run) * len(TOPIC_FIELDS)
+    messages = len(run) * len(TOPICS)
     with tempfile.TemporaryDirectory() as tmp:
         ours, theirs = Path(tmp) / "ours.mcap", Path(tmp) / "theirs.mcap"
         # Warm-up (imports, first-call costs), then check both sides agree.
@@ -151,7 +154,7 @@ def main() -> None:
 
     print(
         f"{args.duration:g} s at {args.rate:g} Hz, {len(CHANNEL_NAMES)} channels: "
-        f"{messages} messages on {len(TOPIC_FIELDS)} topics; best of {args.repeat}\n"
+        f"{messages} messages on {len(TOPICS)} topics; best of {args.repeat}\n"
     )
     print("| operation | prsm_health [msg/s] | baseline mcap + json [msg/s] | speed-up |")
     print("|---|---:|---:|---:|")

@@ -233,6 +233,7 @@ def run(args) -> dict:
         "window_s": args.window,
         "sample_rate_hz": rec.sample_rate,
         "samples_per_request": len(rec),
+        "channels_per_request": len(rec.channels),
         "request_bytes": len(payloads[0]),
         "server_workers": args.workers or ServiceLimits().workers,
         "cpu_count": os.cpu_count(),
@@ -257,7 +258,7 @@ def _report(r: dict) -> str:
         f"service load test: {r['clients']} clients, {r['answered']}/{r['requests']} requests answered"
         f"{' (time cap reached)' if r['time_capped'] else ''} in {r['elapsed_s']:.1f} s",
         f"  request: {r['window_s']:g} s at {r['sample_rate_hz']:g} Hz, {r['samples_per_request']} samples"
-        f" x 11 channels, {r['request_bytes'] / 1e6:.1f} MB JSON; model {r['model']}",
+        f" x {r['channels_per_request']} channels, {r['request_bytes'] / 1e6:.1f} MB JSON; model {r['model']}",
         f"  machine: {r['cpu_count']} CPUs, server workers {r['server_workers']}",
         f"  throughput: {r['throughput_rps']:.2f} diagnoses/s ({r['signal_seconds_per_s']:.2f} s of signal per s)",
     ]

@@ -1,9 +1,10 @@
-"""Print the channel table of docs/formats.md from the channel contract (prsm_health.channels).
+"""Print the channel tables of docs/formats.md from the channel contract (prsm_health.channels).
 
-The table in docs/formats.md is this script's output pasted between its markers; rerun it after
-changing :data:`prsm_health.channels.CHANNELS` and paste again, or check that the doc is current:
+The tables in docs/formats.md are this script's output pasted between its markers; rerun it
+after changing :data:`prsm_health.channels.CHANNELS` or :data:`~prsm_health.channels.TRUTH_CHANNELS`
+and paste again, or check that the doc is current (a test does):
 
-    python tools/make_formats_tables.py            # print the Markdown table
+    python tools/make_formats_tables.py            # print the Markdown tables
     python tools/make_formats_tables.py --check    # exit 1 if docs/formats.md differs
 """
 
@@ -12,7 +13,7 @@ from __future__ import annotations
 import pathlib
 import sys
 
-from prsm_health.channels import CHANNELS, UNITS
+from prsm_health.channels import CHANNELS, TRUTH_CHANNELS, UNITS, truth_column
 
 BEGIN = "<!-- BEGIN GENERATED: tools/make_formats_tables.py -->"
 END = "<!-- END GENERATED -->"
@@ -20,17 +21,26 @@ DOC = pathlib.Path(__file__).resolve().parents[1] / "docs" / "formats.md"
 
 
 def channel_table() -> str:
-    """The contract channels as a Markdown table, in record order, ``time`` first."""
+    """The measured channels (``time`` first), then the truth signals, as Markdown tables in
+    contract order."""
     lines = [
-        "| channel | unit | kind | sensor | MCAP topic / field | meaning |",
-        "|---|---|---|---|---|---|",
-        f"| `time` | {UNITS['time']} | – | data logger clock | message `log_time` "
+        "| measured channel | unit | sensor | MCAP topic / field | meaning |",
+        "|---|---|---|---|---|",
+        f"| `time` | {UNITS['time']} | data logger clock | message `log_time` "
         "(ns from run start) | sample time from run start |",
     ]
     for c in CHANNELS:
         lines.append(
-            f"| `{c.name}` | {c.unit} | {c.kind} | {c.sensor} | `{c.topic}` / `{c.field}` "
-            f"| {c.meaning} |"
+            f"| `{c.name}` | {c.unit} | {c.sensor} | `{c.topic}` / `{c.field}` | {c.meaning} |"
+        )
+    lines += [
+        "",
+        "| truth signal | Parquet/CSV column | unit | its sensor reading, or why no sensor gives it | meaning |",
+        "|---|---|---|---|---|",
+    ]
+    for c in TRUTH_CHANNELS:
+        lines.append(
+            f"| `{c.name}` | `{truth_column(c.name)}` | {c.unit} | {c.sensor} | {c.meaning} |"
         )
     return "\n".join(lines)
 
@@ -46,9 +56,9 @@ def main(argv: list[str]) -> int:
         return 2
     current = text.split(BEGIN, 1)[1].split(END, 1)[0].strip()
     if current != table:
-        print(f"{DOC}: channel table is stale; paste the output of {__file__}", file=sys.stderr)
+        print(f"{DOC}: channel tables are stale; paste the output of {__file__}", file=sys.stderr)
         return 1
-    print(f"{DOC}: channel table is current")
+    print(f"{DOC}: channel tables are current")
     return 0
 
 

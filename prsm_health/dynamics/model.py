@@ -386,9 +386,7 @@ def _drive_train_params(p, drive_train, design, k_axial, restitution) -> None:
     p[L.P_ON_PAYLOAD] = 1.0 if dt.load_application == "payload" else 0.0
     p[L.P_M_L] = dt.payload_mass
     p[L.P_K_LINK] = dt.linkage_stiffness
-    p[L.P_C_LINK] = (
-        2 * dt.linkage_damping_ratio * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
-    )
+    p[L.P_C_LINK] = 2 * dt.linkage_damping_ratio * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
 
 
 def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:

@@ -10,35 +10,16 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES
+from ..channels import CHANNEL_NAMES, TRUTH_NAMES
 from ..design import DEFAULT_PRESET, PRSMDesign
 from ..drive_train import DriveTrain
 from ..errors import SimulationError, require
 from ..run import Run
-from ..sensors import SensorModel, measure
+from ..sensors import SensorModel, decimate, measure
 from ..states import HealthState, OperatingProfile
 from . import _kernels
 from . import layout as L
 from .model import Model, SimulationOptions, build_model, initial_state, realised_clearances
-
-TRUTH_ORDER = (
-    "motor_angle",
-    "motor_speed",
-    "motor_torque",
-    "screw_angle",
-    "screw_speed",
-    "carrier_speed",
-    "nut_position",
-    "nut_axial_accel",
-    "nut_tangential_accel",
-    "nut_radial_x_accel",
-    "nut_radial_y_accel",
-    "friction_torque",
-    "axial_load",
-    "payload_position",
-    "screw_axial_position",
-    "load_force",
-)
 
 #: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
 STABILITY_MARGIN = 0.9
@@ -185,7 +166,9 @@ def simulate(
     Returns
     -------
     Run
-        Contract channels at ``sensors.sample_rate``; ``run.energy`` holds the energy book.
+        Measured channels at ``sensors.sample_rate``; ``run.truth`` holds the truth signals on
+        the same time axis (anti-alias decimated, no sensor errors), ``run.energy`` the
+        energy book.
 
     Raises
     ------
@@ -233,19 +216,20 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
             0.0  # energy book starts at t = 0
         )
-    raw = _integrate(model, y, h, n_steps, progress)
-    truth_raw = {name: raw[:, k] for k, name in enumerate(TRUTH_ORDER)}
-    old = {  # transitional: the sensors read the truth of the motor where the screw was
-        "screw_angle": truth_raw["motor_angle"],
-        "screw_speed": truth_raw["motor_speed"],
-        "drive_torque": truth_raw["motor_torque"],
+    truth_raw = _truth_from_record(_integrate(model, y, h, n_steps, progress))
+    # What each sensor reads (contract): the drive's angle, speed and torque on the motor side.
+    sensed = {
+        "screw_angle": "motor_angle",
+        "screw_speed": "motor_speed",
+        "drive_torque": "motor_torque",
     }
     channels = measure(
-        {name: old.get(name, truth_raw.get(name)) for name in CHANNEL_NAMES},
+        {name: truth_raw[sensed.get(name, name)] for name in CHANNEL_NAMES},
         1.0 / h,
         sensors,
         np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
     )
+    truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
     n_out = len(channels["screw_angle"])
     time = np.arange(n_out) / sensors.sample_rate
     nq = model.n_coordinates
@@ -267,7 +251,14 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
             "highest_natural_frequency": f_max,
         },
         energy=energy,
+        truth=truth,
     )
+
+
+def _truth_from_record(raw: np.ndarray) -> dict[str, np.ndarray]:
+    """Truth signals by name from the kernel's record, whose columns (layout ``C_*``) are the
+    truth signals in contract order (prsm_health.channels.TRUTH_CHANNELS)."""
+    return {name: raw[:, k] for k, name in enumerate(TRUTH_NAMES)}
 
 
 def _integrate(

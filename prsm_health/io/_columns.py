@@ -1,5 +1,5 @@
-"""What the column-table readers (CSV, Parquet) share: picking the contract channels and the
-sample rate from the time axis."""
+"""What the column-table readers (CSV, Parquet) share: picking the measured channels and the
+truth columns, and the sample rate from the time axis."""
 
 from __future__ import annotations
 
@@ -8,20 +8,33 @@ from pathlib import Path
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES
+from ..channels import CHANNEL_NAMES, TRUTH_NAMES, TRUTH_PREFIX, truth_column
 from ..errors import PRSMHealthError
 
 
 def contract_channels(path: Path, columns: Iterable[str], column: Callable) -> dict:
-    """Every column named like a contract channel, as float arrays (SI); none is an error."""
+    """Every column named like a measured contract channel, as float arrays (SI); none is an
+    error (``truth_*`` columns are simulator truth, never channels)."""
     columns = list(columns)
     channels = {c: np.asarray(column(c), dtype=float) for c in CHANNEL_NAMES if c in columns}
     if not channels:
+        truth = any(str(c).startswith(TRUTH_PREFIX) for c in columns)
         raise PRSMHealthError(
             f"{path}: no usable channels (expected contract names such as nut_axial_accel; "
             f"found {', '.join(map(str, columns[:8]))})"
+            + ("; truth_* columns are simulator truth, not measurements" if truth else "")
         )
     return channels
+
+
+def truth_columns(columns: Iterable[str], column: Callable) -> dict:
+    """The ``truth_<name>`` columns of the contract's truth signals, keyed by ``name``."""
+    columns = set(columns)
+    return {
+        name: np.asarray(column(truth_column(name)), dtype=float)
+        for name in TRUTH_NAMES
+        if truth_column(name) in columns
+    }
 
 
 def rate_from_time(path: Path, time: np.ndarray) -> float:

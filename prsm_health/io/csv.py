@@ -1,7 +1,8 @@
 """CSV recordings: a header row of contract channel names, ``time`` in seconds (docs/formats.md).
 
-Every column named like a contract channel (:mod:`prsm_health.channels`) is read as that channel
-in its SI unit; other columns are ignored. Sampling must be uniform; the sample rate is
+Every column named like a measured contract channel (:mod:`prsm_health.channels`) is read as
+that channel in its SI unit, a ``truth_<name>`` column of a truth signal into
+:attr:`Run.truth <prsm_health.run.Run.truth>` (never a channel); other columns are ignored. Sampling must be uniform; the sample rate is
 1/median(Δt). A time column in milliseconds is the usual mistake: name it ``time_ms`` and it is
 converted, and a time axis that implies a sample rate below 100 Hz gets a hint.
 """
@@ -13,7 +14,7 @@ from pathlib import Path
 
 from ..errors import PRSMHealthError
 from ..run import Run, ms_hint
-from ._columns import contract_channels, rate_from_time
+from ._columns import contract_channels, rate_from_time, truth_columns
 
 
 def read_csv(path: str | Path) -> Run:
@@ -34,8 +35,9 @@ def read_csv(path: str | Path) -> Run:
     else:
         raise PRSMHealthError(f"{path}: no 'time' column [s] (or 'time_ms' [ms])")
     channels = contract_channels(path, frame.columns, lambda c: frame[c].to_numpy())
+    truth = truth_columns(frame.columns, lambda c: frame[c].to_numpy())
     rate = rate_from_time(path, time)
     hint = ms_hint(rate)
     if hint:
         warnings.warn(f"{path}: {hint.lstrip(' —')}", UserWarning, stacklevel=2)
-    return Run(time, channels, rate)
+    return Run(time, channels, rate, truth=truth)

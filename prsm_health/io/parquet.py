@@ -1,6 +1,6 @@
-"""One run as a single Parquet file: ``time`` and the contract channels as columns, with the
-units, sample rate, labels and scenario in the schema metadata (docs/formats.md), so pandas,
-pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.dataset`.
+"""One run as a single Parquet file: ``time``, the measured channels, then ``truth_<name>`` for
+each truth signal as columns, with the units, sample rate, labels and scenario in the schema
+metadata (docs/formats.md), so pandas, pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.dataset`.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from ..channels import UNITS
 from ..errors import PRSMHealthError
 from ..jsonable import dumps
 from ..run import Run
-from ._columns import contract_channels, rate_from_time
+from ._columns import contract_channels, rate_from_time, truth_columns
 
 
 def write_run_parquet(run: Run, path: str | Path) -> Path:
@@ -37,7 +37,7 @@ def write_run_parquet(run: Run, path: str | Path) -> Path:
 
 def read_run_parquet(path: str | Path) -> Run:
     """Read a run written by :func:`write_run_parquet`, or any Parquet file with a ``time``
-    column [s] and contract channel columns."""
+    column [s] and measured channel columns; ``truth_<name>`` columns go to ``Run.truth``."""
     import pyarrow.parquet as pq
 
     path = Path(path)
@@ -51,6 +51,7 @@ def read_run_parquet(path: str | Path) -> Run:
     if "time" not in table.column_names:
         raise PRSMHealthError(f"{path}: no 'time' column")
     channels = contract_channels(path, table.column_names, lambda c: table.column(c).to_numpy())
+    truth = truth_columns(table.column_names, lambda c: table.column(c).to_numpy())
     time = table.column("time").to_numpy().astype(float)
     if b"prsm_health.sample_rate" in meta:
         rate = float(meta[b"prsm_health.sample_rate"])
@@ -58,4 +59,4 @@ def read_run_parquet(path: str | Path) -> Run:
         rate = rate_from_time(path, time)
     labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
     scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
-    return Run(time, channels, rate, labels, scenario)
+    return Run(time, channels, rate, labels, scenario, truth=truth)

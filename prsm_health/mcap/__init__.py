@@ -6,11 +6,12 @@ channel with no custom code:
 - JSON schema encoding (``jsonschema``, draft-07) and JSON message encoding, one message per
   sample and topic, each message a flat object of numbers;
 - topics and fields from the channel contract (:mod:`prsm_health.channels`,
-  :data:`TOPIC_FIELDS`): :data:`TOPIC_NUT_ACCEL` (fields ``axial``, ``tangential``,
-  ``radial_x``, ``radial_y``), :data:`TOPIC_DRIVE` (``screw_angle``, ``screw_speed``,
-  ``carrier_speed``, ``nut_position``, ``drive_torque``, ``friction_torque``, ``axial_load``)
-  and :data:`TOPIC_DIAGNOSIS` (written by :class:`DiagnosisWriter`); SI units, given in each
-  field's schema description;
+  :data:`TOPIC_FIELDS`): the measured channels on :data:`TOPIC_NUT_ACCEL` (fields ``axial``,
+  ``tangential``, ``radial_x``, ``radial_y``) and :data:`TOPIC_DRIVE` (``screw_angle``,
+  ``screw_speed``, ``nut_position``, ``drive_torque``, ``axial_load``), each with the fields
+  of the channels the run has; the simulator's truth signals on :data:`TOPIC_TRUTH` (one field
+  per truth signal, named like it; only in simulated runs); and :data:`TOPIC_DIAGNOSIS`
+  (written by :class:`DiagnosisWriter`); SI units, given in each field's schema description;
 - ``log_time`` = ``publish_time`` = run start + sample time, in nanoseconds;
 - zstd-compressed chunks, message indexes, and a summary section (schemas, channels,
   statistics, chunk/attachment/metadata indexes, summary offsets) with its CRC;
@@ -32,7 +33,7 @@ The tests read the files back with :mod:`mcap`'s own readers.
 
 from __future__ import annotations
 
-from ..channels import TOPIC_DIAGNOSIS, TOPIC_DRIVE, TOPIC_FIELDS, TOPIC_NUT_ACCEL
+from ..channels import TOPIC_DIAGNOSIS, TOPIC_DRIVE, TOPIC_FIELDS, TOPIC_NUT_ACCEL, TOPIC_TRUTH
 from ..errors import TruncatedRecordingWarning
 from ._container import DEFAULT_CHUNK_SIZE
 from .diagnosis_topic import DiagnosisWriter, write_diagnosis_mcap
@@ -46,6 +47,7 @@ __all__ = [
     "TOPIC_DRIVE",
     "TOPIC_FIELDS",
     "TOPIC_NUT_ACCEL",
+    "TOPIC_TRUTH",
     "DiagnosisWriter",
     "TruncatedRecordingWarning",
     "Window",

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES, TOPIC_FIELDS
+from ..channels import CHANNEL_NAMES, TOPIC_FIELDS, TOPIC_TRUTH, TRUTH_NAMES
 from ..errors import PRSMHealthError
 
 
@@ -59,8 +59,11 @@ def _merge_topic(batches: list[_Batch]) -> _Batch:
     return _Batch(batches[0].topic, log_time, fields, values).sorted()
 
 
-def _align(batches: dict[str, _Batch], *, trim: bool) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Common log-time grid of several topics and each contract channel on it (NaN: no sample).
+def _align(
+    batches: dict[str, _Batch], *, trim: bool
+) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Common log-time grid of several topics, and on it each measured contract channel and
+    each truth signal (of :data:`TOPIC_TRUTH`), NaN where a topic has no sample.
 
     With ``trim``, the grid stops at the last time every topic reached (a truncated tail is
     incomplete).
@@ -70,8 +73,9 @@ def _align(batches: dict[str, _Batch], *, trim: bool) -> tuple[np.ndarray, dict[
     grid = grids[0] if same else np.unique(np.concatenate(grids))
     if trim and not same:
         grid = grid[grid <= min(g[-1] for g in grids if len(g))]
-    channels = {}
+    channels, truth = {}, {}
     for topic, batch in batches.items():
+        into = truth if topic == TOPIC_TRUTH else channels
         names = dict(TOPIC_FIELDS[topic])
         if same:
             placed = batch.values
@@ -80,9 +84,9 @@ def _align(batches: dict[str, _Batch], *, trim: bool) -> tuple[np.ndarray, dict[
             keep = batch.log_time <= grid[-1] if len(grid) else np.zeros(0, bool)
             placed[:, np.searchsorted(grid, batch.log_time[keep])] = batch.values[:, keep]
         for row, name in enumerate(batch.fields):
-            channels[names[name]] = np.ascontiguousarray(placed[row])
+            into[names[name]] = np.ascontiguousarray(placed[row])
     ordered = {name: channels[name] for name in CHANNEL_NAMES if name in channels}
-    return grid, ordered
+    return grid, ordered, {name: truth[name] for name in TRUTH_NAMES if name in truth}
 
 
 def _sample_rate(info: dict, grid: np.ndarray, path: Path) -> float:

@@ -29,7 +29,8 @@ def read_mcap(path: str | os.PathLike) -> Run:
     Returns
     -------
     Run
-        Channels of the topics present; labels from the ``labels`` metadata, scenario from its
+        Measured channels of the topics present, truth signals of ``/prsm/truth`` (if any) in
+        ``Run.truth``; labels from the ``labels`` metadata, scenario from its
         attachment, sample rate and energy from the ``prsm_health`` metadata (the sample rate
         is estimated from the log-time spacing when that record is missing).
 
@@ -64,7 +65,7 @@ def read_mcap(path: str | os.PathLike) -> Run:
         if not batches:
             where = f": {source.damage}" if source.damage else ""
             raise PRSMHealthError(f"{source.path}: no samples could be read{where}")
-        grid, channels = _align(batches, trim=source.damage is not None)
+        grid, channels, truth = _align(batches, trim=source.damage is not None)
         info = source.info()
         rate = _sample_rate(info, grid, source.path)
         start = _start_ns(info, grid)
@@ -73,7 +74,7 @@ def read_mcap(path: str | os.PathLike) -> Run:
             energy = json.loads(info.get("energy", "{}"))
         except ValueError:
             energy = {}
-        run = Run(time, channels, rate, source.labels(), source.scenario(), energy)
+        run = Run(time, channels, rate, source.labels(), source.scenario(), energy, truth)
         if source.damage:
             warnings.warn(
                 f"{source.path}: {source.damage}; read {len(time)} samples "

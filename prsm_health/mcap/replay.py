@@ -41,10 +41,13 @@ class Window:
     time : ndarray [s]
         Sample times from the run start.
     channels : dict of name → ndarray
-        Contract channels, SI; NaN where a topic has no sample at a time another has.
+        Measured contract channels, SI; NaN where a topic has no sample at a time another has.
     labels : dict
         Run labels of the recording.
     sample_rate : float [Hz]
+    truth : dict of name → ndarray
+        Truth signals of ``/prsm/truth``, when replayed (simulated recordings); never an input
+        of the diagnosis.
     """
 
     index: int
@@ -56,6 +59,7 @@ class Window:
     channels: dict[str, np.ndarray]
     labels: dict = field(default_factory=dict)
     sample_rate: float = 0.0
+    truth: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.time)
@@ -315,7 +319,7 @@ class WindowStream(Iterator[Window]):
             parts = {t: p for t, p in parts.items() if len(p.log_time)}
             if not parts:
                 continue
-            grid, channels = _align(parts, trim=False)
+            grid, channels, truth = _align(parts, trim=False)
             rate = self._rate_hz
             if rate is None:
                 rate = 1e9 / float(np.median(np.diff(grid))) if len(grid) > 1 else 0.0
@@ -330,6 +334,7 @@ class WindowStream(Iterator[Window]):
                 channels=channels,
                 labels=self._source.labels(),
                 sample_rate=rate,
+                truth=truth,
             )
 
     def _pace(self, end_ns: int) -> None:
@@ -366,7 +371,9 @@ def iter_windows(
         Real-time factor: windows are released as log time advances ``rate`` times faster than
         wall time (``1`` = real time). None: as fast as possible.
     topics : iterable of str, optional
-        Signal topics to replay (default both, :data:`TOPIC_NUT_ACCEL` and :data:`TOPIC_DRIVE`).
+        Signal topics to replay: default all of them, the measured :data:`TOPIC_NUT_ACCEL` and
+        :data:`TOPIC_DRIVE` and, in a simulated recording, :data:`TOPIC_TRUTH`
+        (:data:`~prsm_health.channels.MEASURED_TOPICS` replays the measurements only).
     partial : bool
         Also yield the last, incomplete window.
 

@@ -2,7 +2,9 @@
 contract (:mod:`prsm_health.channels`), the diagnosis topic's schema, and the metadata records.
 
 Schemas are JSON Schema draft-07 (MCAP schema encoding ``jsonschema``), one per topic; each
-signal field's description gives the channel's meaning and SI unit from the contract.
+signal field's description gives the channel's meaning and SI unit from the contract. The
+measured channels are on :data:`TOPIC_NUT_ACCEL` and :data:`TOPIC_DRIVE`, the simulator's truth
+signals on :data:`TOPIC_TRUTH` (one field per truth signal, named like it).
 
 Metadata: MCAP metadata values are strings. A label that is a string is stored as is, unless it
 would itself parse as JSON (``"1.5"``, ``"true"``, ``"null"``, ``'"x"'``), in which case it is
@@ -23,7 +25,7 @@ import json
 
 import numpy as np
 
-from ..channels import TOPIC_DRIVE, TOPIC_NUT_ACCEL, UNITS, channel
+from ..channels import TOPIC_DRIVE, TOPIC_NUT_ACCEL, TOPIC_TRUTH, channel, truth_channel
 from ..jsonable import dumps
 
 __all__ = [
@@ -47,7 +49,11 @@ INFO_METADATA = "prsm_health"
 FORMAT_VERSION = "1"
 
 #: Schema name of each signal topic.
-SCHEMA_NAMES = {TOPIC_NUT_ACCEL: "prsm_health.NutAccel", TOPIC_DRIVE: "prsm_health.Drive"}
+SCHEMA_NAMES = {
+    TOPIC_NUT_ACCEL: "prsm_health.NutAccel",
+    TOPIC_DRIVE: "prsm_health.Drive",
+    TOPIC_TRUTH: "prsm_health.Truth",
+}
 #: Schema name of the diagnosis topic.
 DIAGNOSIS_SCHEMA_NAME = "prsm_health.Diagnosis"
 
@@ -62,19 +68,23 @@ def encode_schema(schema: dict) -> bytes:
 
 
 def topic_schema(topic: str, pairs: list[tuple[str, str]]) -> dict:
-    """JSON schema of a signal topic whose messages have the (field, channel) ``pairs``."""
+    """JSON schema of a signal topic whose messages have the (field, name) ``pairs``: measured
+    channels, or truth signals on :data:`TOPIC_TRUTH`."""
+    truth = topic == TOPIC_TRUTH
+    entries = [(field, (truth_channel if truth else channel)(name)) for field, name in pairs]
     properties = {
         field: {
             "type": "number",
-            "description": f"{channel(name).meaning} [{UNITS[name]}] (channel {name}); "
-            "null when the sample is not finite",
+            "description": f"{c.meaning} [{c.unit}] ({'truth' if truth else 'channel'} "
+            f"{c.name}); null when the sample is not finite",
         }
-        for field, name in pairs
+        for field, c in entries
     }
+    what = "simulator truth, not a measurement; " if truth else ""
     return {
         "$schema": _DRAFT_07,
         "title": SCHEMA_NAMES[topic],
-        "description": f"One sample of {topic}, SI units (prsm_health MCAP contract)",
+        "description": f"One sample of {topic}, {what}SI units (prsm_health MCAP contract)",
         "type": "object",
         "properties": properties,
         "required": [field for field, _ in pairs],

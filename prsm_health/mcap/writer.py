@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES, TOPIC_FIELDS, UNITS
+from ..channels import CHANNEL_NAMES, TOPIC_FIELDS, TOPIC_TRUTH, TRUTH_NAMES, UNITS
 from ..errors import PRSMHealthError
 from ..jsonable import dumps
 from ..run import Run
@@ -34,7 +34,8 @@ from .schema import (
 
 __all__ = ["write_mcap"]
 
-# Samples formatted at a time by write_mcap (~10 MB of JSON for both topics).
+# Samples formatted at a time by write_mcap (~10 MB of JSON for the measured topics, ~30 MB
+# with the truth topic).
 _WRITE_BLOCK = 1 << 16
 
 
@@ -65,7 +66,9 @@ def write_mcap(
     ----------
     run : Run
         Only the contract channels present in ``run.channels`` are written (a recording may
-        lack some); other channels are ignored.
+        lack some), each measured topic with the fields of those channels; other channels are
+        ignored. The truth signals of ``run.truth`` go to :data:`TOPIC_TRUTH`, which is left
+        out when the run has none.
     path : str or path-like
         Destination. Written atomically: a temporary file in the same directory, renamed onto
         ``path`` once complete, so an interrupted write never leaves a half file under it.
@@ -105,24 +108,32 @@ def write_mcap(
         raise PRSMHealthError("scenario_name must be a non-empty string")
     if float(time[-1]) * 1e9 + start_time_ns >= 2**63 or float(time[0]) * 1e9 + start_time_ns < 0:
         raise PRSMHealthError("start_time_ns + time does not fit the MCAP 64-bit ns clock")
-    for name, values in run.channels.items():
-        if name in CHANNEL_NAMES and np.shape(values) != (n,):
-            raise PRSMHealthError(
-                f"channel {name!r} has shape {np.shape(values)}; expected ({n},) like time"
-            )
+    for kind, signals, names in (
+        ("channel", run.channels, CHANNEL_NAMES),
+        ("truth", run.truth, TRUTH_NAMES),
+    ):
+        for name, values in signals.items():
+            if name in names and np.shape(values) != (n,):
+                raise PRSMHealthError(
+                    f"{kind} {name!r} has shape {np.shape(values)}; expected ({n},) like time"
+                )
+
+    def source(topic: str) -> dict:
+        return run.truth if topic == TOPIC_TRUTH else run.channels
+
     topics = {}
     for topic, pairs in TOPIC_FIELDS.items():
-        present = [(name, channel) for name, channel in pairs if channel in run.channels]
+        present = [(field, name) for field, name in pairs if name in source(topic)]
         if present:
             topics[topic] = present
-    if not topics:
+    if not set(topics) - {TOPIC_TRUTH}:
         raise PRSMHealthError(
             f"run has none of the contract channels ({', '.join(CHANNEL_NAMES)}); nothing to write"
         )
 
     log_time = start_time_ns + _to_ns(time)
     columns = {
-        topic: [np.asarray(run.channels[channel], dtype=np.float64) for _, channel in pairs]
+        topic: [np.asarray(source(topic)[name], dtype=np.float64) for _, name in pairs]
         for topic, pairs in topics.items()
     }
 

@@ -143,7 +143,8 @@ def read_upload(upload: Upload, limits: ServiceLimits) -> tuple[Run, list[str]]:
         for w in caught
         if issubclass(w.category, TruncatedRecordingWarning)
     ]
-    return run, notes
+    # The service diagnoses measurements: a simulated file's truth is neither checked nor used.
+    return run.without_truth(), notes
 
 
 def diagnose_upload(upload: Upload, bundle, limits: ServiceLimits):

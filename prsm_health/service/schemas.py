@@ -22,7 +22,7 @@ from pydantic import (
 )
 from pydantic_core import PydanticKnownError
 
-from ..channels import CHANNEL_NAMES, CHANNELS
+from ..channels import CHANNEL_NAMES, CHANNELS, TRUTH_NAMES, TRUTH_PREFIX
 from ..design import PRESETS
 from .limits import ServiceLimits
 from .responses import HTTPError
@@ -33,11 +33,14 @@ _DEFAULT_LIMITS = ServiceLimits()
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 
-# One optional array per contract channel; any other name is an error (extra="forbid").
+# One optional array per measured contract channel; any other name is an error
+# (extra="forbid"), simulator truth included: a diagnosis reads measurements only, and a truth
+# signal silently dropped would hide a client's mistake.
 Channels = create_model(
     "Channels",
     __config__=ConfigDict(strict=True, extra="forbid"),
-    __doc__="Contract channels (docs/formats.md): equal-length arrays, SI units.",
+    __doc__="Measured contract channels (docs/formats.md): equal-length arrays, SI units. "
+    "Simulator truth (truth_* columns, carrier_speed, friction_torque) is not accepted.",
     **{
         c.name: (list[Finite], Field(None, description=f"{c.meaning} [{c.unit}]")) for c in CHANNELS
     },
@@ -210,7 +213,15 @@ def format_errors(errors: list[dict], prefix: str = "") -> str:
     parts = []
     if unknown_channels:
         names = ", ".join(repr(n) for n in unknown_channels)
-        parts.append(f"unknown channel(s) {names}; contract channels: {', '.join(CHANNEL_NAMES)}")
+        truth = [n for n in unknown_channels if n in TRUTH_NAMES or n.startswith(TRUTH_PREFIX)]
+        hint = (
+            f" ({', '.join(truth)}: simulator truth, not a measurement; leave it out)"
+            if truth
+            else ""
+        )
+        parts.append(
+            f"unknown channel(s) {names}; contract channels: {', '.join(CHANNEL_NAMES)}{hint}"
+        )
     others = [
         e for e in errors if not (e["type"] == "extra_forbidden" and e["loc"][:1] == ("channels",))
     ]

@@ -13,7 +13,7 @@ import anyio
 from python_multipart.multipart import MultipartParser, parse_options_header
 from starlette.requests import Request
 
-from ..channels import CHANNEL_NAMES
+from ..channels import UNITS
 from .limits import ServiceLimits
 from .responses import HTTPError
 from .schemas import ASSET_ID_PATTERN
@@ -32,9 +32,11 @@ def precheck_upload(path: Path, suffix: str, limits: ServiceLimits) -> None:
         except Exception:
             return  # not readable: the library's reader reports it with its own message
         decoded = sum(meta.row_group(i).total_byte_size for i in range(meta.num_row_groups))
-        if meta.num_columns > 4 * len(CHANNEL_NAMES):
+        if meta.num_columns > 4 * len(UNITS):
             raise HTTPError(
-                422, f"Parquet file has {meta.num_columns} columns; a recording has time + channels"
+                422,
+                f"Parquet file has {meta.num_columns} columns; a recording has time, channels "
+                "and (simulated) truth columns",
             )
         if meta.num_rows > limits.max_upload_samples:
             raise HTTPError(

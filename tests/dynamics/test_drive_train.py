@@ -18,11 +18,12 @@ from prsm_health import (
     preset,
     simulate,
 )
+from prsm_health.channels import TRUTH_NAMES
 from prsm_health.drive_train import DriveTrain
 from prsm_health.dynamics import layout as L
 from prsm_health.dynamics._kernels import screw_motion
 from prsm_health.dynamics.model import build_model, initial_state
-from prsm_health.dynamics.simulate import TRUTH_ORDER, _integrate, choose_step, linearised_modes
+from prsm_health.dynamics.simulate import _integrate, choose_step, linearised_modes
 from prsm_health.errors import ParameterError
 from prsm_health.states import LEAD_GRADES
 
@@ -33,7 +34,7 @@ def truth(profile, drive_train=DriveTrain(), health=HealthState(), options=Simul
     h, _ = choose_step(options.max_step, 20_000.0)
     raw = _integrate(model, initial_state(model), h, int(round(profile.duration / h)), False)
     half = len(raw) // 2
-    return {name: raw[half:, k] for k, name in enumerate(TRUTH_ORDER)}
+    return {name: raw[half:, k] for k, name in enumerate(TRUTH_NAMES)}
 
 
 def test_static_deflections_of_coupling_bearing_and_linkage():

@@ -60,7 +60,7 @@ def test_carrier_speed_ratio_matches_rigid_body(speed):
     # and waviness (≈ 0.3 % of the lead) would modulate the ratio.
     r = run(speed=speed, duration=0.2, options=IDEAL)
     half = len(r) // 2
-    ratio = np.mean(r["carrier_speed"][half:]) / np.mean(r["screw_speed"][half:])
+    ratio = np.mean(r.truth["carrier_speed"][half:]) / np.mean(r.truth["screw_speed"][half:])
     assert ratio == pytest.approx(speed_ratios(preset("paper01")).carrier, rel=5e-3)
 
 
@@ -253,7 +253,7 @@ def test_friction_torque_is_paper02_reduction():
     mu, beta = 0.1, d.contact_angle
     for load in (100.0, 500.0):
         r = run(load=load, duration=0.2, options=SimulationOptions(rolling_friction=0.0))
-        t_f = np.mean(r["friction_torque"][len(r) // 2 :])
+        t_f = np.mean(r.truth["friction_torque"][len(r) // 2 :])
         assert t_f == pytest.approx(load * mu * p_eff / (np.sin(beta) - mu), rel=0.03)
 
 
@@ -268,9 +268,9 @@ def test_torque_signal_follows_load_lubricant_and_wear():
         1,
     )
     half = len(base) // 2
-    t0 = np.mean(base["friction_torque"][half:])
-    assert np.mean(heavier["friction_torque"][half:]) > 2.5 * t0
-    assert np.mean(worn_oil["friction_torque"][half:]) > 1.5 * t0
+    t0 = np.mean(base.truth["friction_torque"][half:])
+    assert np.mean(heavier.truth["friction_torque"][half:]) > 2.5 * t0
+    assert np.mean(worn_oil.truth["friction_torque"][half:]) > 1.5 * t0
     assert np.mean(worn_oil["drive_torque"][half:]) > np.mean(base["drive_torque"][half:])
     # Wear: at motion reversals a larger clearance lets the nut lag (lost motion) and the
     # drive torque swings harder when the threads re-engage.

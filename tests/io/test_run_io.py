@@ -1,4 +1,5 @@
-"""Run → Parquet → Run, read back by independent readers; damaged files give clear errors."""
+"""Run → Parquet (and CSV) → Run, read back by independent readers; truth kept apart from the
+channels; damaged files give clear errors."""
 
 import json
 
@@ -8,8 +9,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from prsm_health import HealthState, OperatingProfile, SensorModel, simulate
-from prsm_health.channels import CHANNEL_NAMES, UNITS
+from prsm_health.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
 from prsm_health.errors import PRSMHealthError
+from prsm_health.io.csv import read_csv
 from prsm_health.io.parquet import read_run_parquet, write_run_parquet
 
 
@@ -25,16 +27,56 @@ def test_round_trip_exact(tmp_path, run):
     assert np.array_equal(back.time, run.time)
     for name in CHANNEL_NAMES:
         assert np.array_equal(back[name], run[name]), name
+    assert list(back.truth) == list(TRUTH_NAMES)
+    for name in TRUTH_NAMES:
+        assert np.array_equal(back.truth[name], run.truth[name]), name
     assert back.labels == json.loads(json.dumps(run.labels))
 
 
 def test_independent_readers(tmp_path, run):
     path = write_run_parquet(run, tmp_path / "run.parquet")
     frame = pd.read_parquet(path)
-    assert list(frame.columns) == ["time", *CHANNEL_NAMES]
+    truth_columns = [truth_column(n) for n in TRUTH_NAMES]
+    assert list(frame.columns) == ["time", *CHANNEL_NAMES, *truth_columns]
+    table = pq.read_table(path)
+    assert np.array_equal(table.column("truth_friction_torque"), run.truth["friction_torque"])
+    assert np.array_equal(table.column("truth_motor_angle"), run.truth["motor_angle"])
     meta = pq.read_schema(path).metadata
-    assert json.loads(meta[b"prsm_health.units"])["nut_axial_accel"] == UNITS["nut_axial_accel"]
+    units = json.loads(meta[b"prsm_health.units"])
+    assert units["nut_axial_accel"] == UNITS["nut_axial_accel"]
+    assert units["truth_friction_torque"] == "N*m" and units["truth_payload_position"] == "m"
+    assert set(units) == set(frame.columns)
     assert float(meta[b"prsm_health.sample_rate"]) == run.sample_rate
+
+
+def test_simulated_truth_is_the_physics_without_sensor_errors(run):
+    # The transitional model: the motor is the screw and the load acts on the nut; the sensors
+    # of the default SensorModel add no noise, so the readings equal the true values.
+    assert list(run.truth) == list(TRUTH_NAMES)
+    assert "carrier_speed" not in run.channels and "friction_torque" not in run.channels
+    assert np.array_equal(run.truth["motor_angle"], run.channels["screw_angle"])
+    assert np.array_equal(run.truth["motor_torque"], run.channels["drive_torque"])
+    assert np.array_equal(run.truth["load_force"], run.truth["axial_load"])
+    assert not np.any(run.truth["screw_axial_position"])
+    assert all(len(v) == len(run) for v in run.truth.values())
+
+
+def test_files_without_truth_and_truth_columns_in_csv(tmp_path, run):
+    plain = run.without_truth()
+    path = write_run_parquet(plain, tmp_path / "plain.parquet")
+    assert pq.read_schema(path).names == ["time", *CHANNEL_NAMES]
+    back = read_run_parquet(path)
+    assert back.truth == {} and list(back.channels) == list(CHANNEL_NAMES)
+    # A CSV export of a simulated run: truth_* columns go to the truth, never to the channels;
+    # a truth column alone is no recording.
+    run.to_frame().to_csv(tmp_path / "run.csv", index=False)
+    csv = read_csv(tmp_path / "run.csv")
+    assert list(csv.channels) == list(CHANNEL_NAMES) and list(csv.truth) == list(TRUTH_NAMES)
+    assert np.allclose(csv.truth["carrier_speed"], run.truth["carrier_speed"], rtol=1e-15)
+    only_truth = run.to_frame()[["time", "truth_nut_axial_accel", "truth_friction_torque"]]
+    only_truth.to_csv(tmp_path / "truth.csv", index=False)
+    with pytest.raises(PRSMHealthError, match="truth_\\* columns are simulator truth"):
+        read_csv(tmp_path / "truth.csv")
 
 
 def test_damaged_files(tmp_path):

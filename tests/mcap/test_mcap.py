@@ -13,13 +13,14 @@ from mcap.records import Chunk, Footer, MessageIndex, SummaryOffset
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, IndexType, Writer
 
-from prsm_health.channels import CHANNEL_NAMES, UNITS
+from prsm_health.channels import CHANNEL_NAMES, MEASURED_TOPICS, TRUTH_NAMES, UNITS
 from prsm_health.errors import PRSMHealthError
 from prsm_health.mcap import (
     TOPIC_DIAGNOSIS,
     TOPIC_DRIVE,
     TOPIC_FIELDS,
     TOPIC_NUT_ACCEL,
+    TOPIC_TRUTH,
     DiagnosisWriter,
     TruncatedRecordingWarning,
     Window,
@@ -50,26 +51,28 @@ LABELS = {
 }
 
 
-def make_run(n=2000, channels=CHANNEL_NAMES, seed=0):
-    """Known signals on every requested channel, plus values that stress float printing."""
+def make_run(n=2000, channels=CHANNEL_NAMES, seed=0, truth=False):
+    """Known signals on every requested channel, plus values that stress float printing; with
+    ``truth``, every truth signal too, each unlike the channel of the same name."""
     t = np.arange(n) / FS
     rng = np.random.default_rng(seed)
     w = 2 * np.pi * 5.0
     signals = {
         "screw_angle": w * t,
         "screw_speed": w + 0.1 * np.sin(2 * np.pi * 50 * t),
-        "carrier_speed": 0.4 * w + 0.01 * rng.standard_normal(n),
         "nut_position": 1e-3 * t,
         "nut_axial_accel": 3.0 * np.sin(2 * np.pi * 1234.5 * t) + rng.standard_normal(n),
         "nut_tangential_accel": rng.standard_normal(n) * 1e-7,
         "nut_radial_x_accel": rng.standard_normal(n) * 1e12,
         "nut_radial_y_accel": np.cos(2 * np.pi * 700 * t),
         "drive_torque": 0.5 + 0.05 * rng.standard_normal(n),
-        "friction_torque": np.full(n, 0.1),
         "axial_load": np.full(n, 2000.0),
     }
     x = signals["nut_radial_x_accel"]
     x[:6] = [-0.0, 5e-324, 1e300, 0.1, 1 / 3, 2.0**-1074 * 3]
+    true = {name: k + rng.standard_normal(n) for k, name in enumerate(TRUTH_NAMES)}
+    true["carrier_speed"] = 0.4 * w + 0.01 * rng.standard_normal(n)
+    true["friction_torque"] = np.full(n, 0.1)
     return Run(
         time=t,
         channels={name: signals[name] for name in channels},
@@ -77,6 +80,7 @@ def make_run(n=2000, channels=CHANNEL_NAMES, seed=0):
         labels=dict(LABELS),
         scenario={"design": "paper01", "health": {"clearance_screw": 1.25e-5}, "seed": 7},
         energy={"drive": 1.5, "load": 0.25, "dissipated": 1.0, "friction": 0.25},
+        truth=true if truth else {},
     )
 
 
@@ -138,6 +142,76 @@ def test_only_one_topic(tmp_path):
     back = read_mcap(write_mcap(run, tmp_path / "one.mcap"))
     assert list(back.channels) == ["nut_axial_accel"]
     assert_same_bits(back["nut_axial_accel"], run["nut_axial_accel"])
+
+
+def test_truth_topic_round_trip_read_by_the_mcap_library(tmp_path):
+    run = make_run(n=500, truth=True)
+    path = write_mcap(run, tmp_path / "truth.mcap", chunk_size=16_384)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        back = read_mcap(path)
+    assert list(back.channels) == list(CHANNEL_NAMES) and list(back.truth) == list(TRUTH_NAMES)
+    for name in CHANNEL_NAMES:  # truth of the same name (screw_angle …) stays out
+        assert_same_bits(back.channels[name], run.channels[name])
+    for name in TRUTH_NAMES:
+        assert_same_bits(back.truth[name], run.truth[name])
+    # mcap's own reader: one /prsm/truth message per sample, one field per truth signal.
+    with open(path, "rb") as f:
+        reader = make_reader(f, validate_crcs=True)
+        summary = reader.get_summary()
+        (channel,) = [c for c in summary.channels.values() if c.topic == TOPIC_TRUTH]
+        schema = summary.schemas[channel.schema_id]
+        body = json.loads(schema.data)
+        assert schema.name == "prsm_health.Truth" and schema.encoding == "jsonschema"
+        assert list(body["properties"]) == list(TRUTH_NAMES) == body["required"]
+        friction = body["properties"]["friction_torque"]["description"]
+        assert "[N*m] (truth friction_torque)" in friction
+        assert "not a measurement" in body["description"]
+        assert summary.statistics.channel_message_counts[channel.id] == len(run)
+        messages = [json.loads(m.data) for _, _, m in reader.iter_messages(topics=[TOPIC_TRUTH])]
+    assert [m["motor_torque"] for m in messages] == run.truth["motor_torque"].tolist()
+    assert [m["screw_angle"] for m in messages] == run.truth["screw_angle"].tolist()
+    # Cut: channels and truth end together.
+    data = path.read_bytes()
+    (tmp_path / "cut.mcap").write_bytes(data[: len(data) // 2])
+    with pytest.warns(TruncatedRecordingWarning):
+        cut = read_mcap(tmp_path / "cut.mcap")
+    assert 0 < len(cut) < len(run)
+    assert all(len(v) == len(cut) for v in [*cut.channels.values(), *cut.truth.values()])
+    assert_same_bits(cut.truth["load_force"], run.truth["load_force"][: len(cut)])
+
+
+def test_truth_only_when_present_and_with_foreign_writers(tmp_path):
+    plain = make_run(n=100, channels=("nut_axial_accel", "drive_torque"))
+    with open(write_mcap(plain, tmp_path / "plain.mcap"), "rb") as f:
+        topics = {c.topic for c in make_reader(f).get_summary().channels.values()}
+    assert topics == {TOPIC_NUT_ACCEL, TOPIC_DRIVE}
+    assert read_mcap(tmp_path / "plain.mcap").truth == {}
+    # A run with truth but no measured channel is not a recording.
+    no_channels = make_run(n=100, channels=(), truth=True)
+    with pytest.raises(PRSMHealthError, match="none of the contract channels"):
+        write_mcap(no_channels, tmp_path / "x.mcap")
+    # mcap's Writer, schemas without property lists, no summary: truth read from the messages.
+    run = make_run(n=300, channels=("nut_axial_accel",), truth=True)
+    back = read_mcap(write_with_mcap_writer(tmp_path / "other.mcap", run, summary=False))
+    assert list(back.channels) == ["nut_axial_accel"] and list(back.truth) == list(TRUTH_NAMES)
+    for name in TRUTH_NAMES:
+        assert_same_bits(back.truth[name], run.truth[name])
+
+
+def test_replay_reads_truth_apart_and_only_when_asked(tmp_path):
+    run = make_run(n=4000, truth=True)
+    path = write_mcap(run, tmp_path / "truth.mcap", chunk_size=16_384)
+    windows = list(iter_windows(path, 0.05))
+    assert len(windows) == 4
+    for k, w in enumerate(windows):
+        assert list(w.channels) == list(CHANNEL_NAMES) and list(w.truth) == list(TRUTH_NAMES)
+        assert_same_bits(w.truth["carrier_speed"], run.truth["carrier_speed"][1000 * k :][:1000])
+        assert_same_bits(w["screw_angle"], run.channels["screw_angle"][1000 * k :][:1000])
+    measured = list(iter_windows(path, 0.05, topics=MEASURED_TOPICS))
+    assert [w.truth for w in measured] == [{}] * 4
+    for a, b in zip(windows, measured):
+        assert all(np.array_equal(a[c], b[c]) for c in CHANNEL_NAMES)
 
 
 def test_non_finite_samples_are_null(tmp_path):
@@ -435,14 +509,15 @@ def write_with_mcap_writer(path, run, *, summary=True, chunking=True, finish=Tru
     writer.start()
     ids = {}
     for topic, pairs in TOPIC_FIELDS.items():
-        pairs = [(name, ch) for name, ch in pairs if ch in run.channels]
+        source = run.truth if topic == TOPIC_TRUTH else run.channels
+        pairs = [(name, source[ch]) for name, ch in pairs if ch in source]
         if pairs:  # a schema without a property list: fields come from the messages
             sid = writer.register_schema(topic, "jsonschema", b'{"type": "object"}')
             ids[topic] = (writer.register_channel(topic, "json", sid), pairs)
     writer.add_metadata("labels", {"design": "paper01", "seed": "7"})
     for i, t in enumerate(run.time):
         for cid, pairs in ids.values():
-            body = {name: float(run.channels[ch][i]) for name, ch in pairs}
+            body = {name: float(values[i]) for name, values in pairs}
             writer.add_message(cid, round(t * 1e9), json.dumps(body).encode(), round(t * 1e9))
     if finish:
         writer.finish()

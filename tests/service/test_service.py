@@ -215,6 +215,10 @@ def _mutate(run, kind):
     ch = body["channels"]
     if kind == "unknown channel":
         ch["nut_temperature"] = ch["nut_axial_accel"]
+    elif kind == "truth column":
+        ch["truth_friction_torque"] = ch["drive_torque"]
+    elif kind == "truth-only signal":
+        ch["carrier_speed"] = ch["screw_speed"]
     elif kind == "lengths differ":
         ch["screw_speed"] = ch["screw_speed"][:-1]
     elif kind == "string sample":
@@ -256,6 +260,8 @@ def _mutate(run, kind):
 
 INVALID = [
     ("unknown channel", 422, "unknown channel(s) 'nut_temperature'"),
+    ("truth column", 422, "'truth_friction_torque'; contract channels: screw_angle"),
+    ("truth-only signal", 422, "(carrier_speed: simulator truth, not a measurement"),
     ("lengths differ", 422, "equal lengths"),
     ("string sample", 422, "channels.nut_axial_accel.5"),
     ("bool sample", 422, "channels.nut_axial_accel.5"),
@@ -382,6 +388,7 @@ def test_file_upload(client, files, kind, bundle):
     assert len(body["windows"]) == 1
     assert body["windows"][0]["window"]["index"] == 0
     assert body["recording"]["samples"] == 8000
+    assert body["recording"]["channels"] == list(CHANNEL_NAMES)  # the file's truth is not used
     assert body["recording"]["filename"] == path.name
     assert body["warnings"] == []
     assert _upload_dirs() <= before  # the temporary directory is gone
