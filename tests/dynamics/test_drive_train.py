@@ -28,9 +28,12 @@ from prsm_health.errors import ParameterError
 from prsm_health.states import LEAD_GRADES
 
 
-def truth(profile, drive_train=DriveTrain(), health=HealthState(), options=SimulationOptions()):
+def truth(profile, drive_train=None, health=None, options=None):
     """Truth signals at the integration rate (the kernel's record), steady second half."""
-    model = build_model(preset("paper01"), health, profile, options, 1, drive_train)
+    options = options or SimulationOptions()
+    model = build_model(
+        preset("paper01"), health or HealthState(), profile, options, 1, drive_train
+    )
     h, _ = choose_step(options.max_step, 20_000.0)
     raw = _integrate(model, initial_state(model), h, int(round(profile.duration / h)), False)
     half = len(raw) // 2
