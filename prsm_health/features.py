@@ -84,6 +84,7 @@ def _feature_table() -> dict[str, str]:
             "drive_torque_ripple": "N·m",
             "efficiency": "-",
             "lost_motion": "m",
+            "torque_rattle_rate": "1/s",
             "speed_mean": "rad/s",
             "load_mean": "N",
             "load_range": "N",
@@ -110,6 +111,7 @@ GROUPS = {
     "classic": [k for k in FEATURES if k.split("_")[0] in SHORT.values() and "_mesh_" not in k],
     "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
     "lost_motion": ["lost_motion"],
+    "torque_rattle": ["torque_rattle_rate"],
     "operating": ["speed_mean", "load_mean", "load_range"],
 }
 
@@ -320,16 +322,48 @@ def extract_features(
             p_out = float(np.mean(load * v_nut))
             out["efficiency"] = p_out / p_in if p_in > 0 else np.nan
 
-    # ---- lost motion at reversals: nut lag behind the rigid kinematics across a reversal
+    # ---- reversals: of the motion, of the load (load cell), or of the drive torque when no
+    # load cell is fitted (the motor current reverses with the load it carries)
+    torque = ch.get("drive_torque")
+    reversal = (
+        (speed is not None and np.min(speed) < 0 < np.max(speed))
+        or (load is not None and np.min(load) < 0 < np.max(load))
+        or (load is None and torque is not None and _reverses(torque))
+    )
+    if reversal and torque is not None:
+        out["torque_rattle_rate"] = _rattle_rate(torque, rate)
+    # lost motion: nut lag behind the rigid kinematics across a reversal
     if "nut_position" in ch and "screw_angle" in ch:
-        reversal = (speed is not None and np.min(speed) < 0 < np.max(speed)) or (
-            load is not None and np.min(load) < 0 < np.max(load)
-        )
         if reversal:
             residual = ch["nut_position"] - ratios.nut * ch["screw_angle"]
             residual = residual - np.mean(residual)
             out["lost_motion"] = float(np.percentile(residual, 99) - np.percentile(residual, 1))
     return out
+
+
+def _reverses(x: np.ndarray) -> bool:
+    # A sign change beyond the noise: both signs reached by a tenth of the range or more.
+    margin = 0.1 * float(np.ptp(x))
+    return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
+
+
+def _rattle_rate(torque: np.ndarray, rate: float) -> float:
+    """Crossings per second of the drive torque's mid level, with ±10 % hysteresis [1/s].
+
+    Across a reversal the nut crosses the 2b gap and strikes the other flanks; each bounce
+    unloads and reloads the screw, so the motor torque swings through its mid level once per
+    bounce. More clearance, faster impacts, more bounces (docs/validation.md, clearance-
+    signature map). The hysteresis (10 % of the 5–95 % range) keeps sensor noise from counting.
+    """
+    lo, hi = np.percentile(torque, [5, 95])
+    mid, band = 0.5 * (lo + hi), 0.1 * (hi - lo)
+    above = torque > mid + band
+    below = torque < mid - band
+    # the state after each sample that leaves the band: +1 above, −1 below
+    state = np.where(above, 1, np.where(below, -1, 0))
+    state = state[state != 0]
+    crossings = np.count_nonzero(np.diff(state) != 0)
+    return crossings / (len(torque) / rate)
 
 
 def windows(run: Run, length: float, hop: float | None = None):
