@@ -1,4 +1,4 @@
-"""Run orchestration: step choice, step guard, chunked RK4 integration, sensors, Run.
+"""Run orchestration: step choice, step guard, chunked RK4 integration, instrumentation, Run.
 
 :func:`simulate` is the public entry point (re-exported as ``prsm_health.simulate``).
 """
@@ -10,11 +10,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES
+from ..channels import CHANNEL_NAMES, TRUTH_NAMES
 from ..design import DEFAULT_PRESET, PRSMDesign
 from ..errors import SimulationError, require
+from ..instrumentation import DEFAULT_PROFILE, Instrumentation
 from ..run import Run
-from ..sensors import SensorModel, measure
+from ..sensors import decimate
 from ..states import HealthState, OperatingProfile
 from . import _kernels
 from . import layout as L
@@ -119,20 +120,21 @@ def simulate(
     design: PRSMDesign | str | None = None,
     health: HealthState | None = None,
     profile: OperatingProfile | None = None,
-    sensors: SensorModel | None = None,
+    instrumentation: Instrumentation | str | None = None,
     seed: int = 0,
     *,
     options: SimulationOptions | None = None,
     progress: bool = False,
 ) -> Run:
-    """Simulate a PRSM run and return its sampled sensor channels.
+    """Simulate a PRSM run and return what its instrumentation measures.
 
     Parameters
     ----------
     design : PRSMDesign or preset name, default "paper01"
     health : HealthState, default HealthState()
     profile : OperatingProfile, default OperatingProfile()
-    sensors : SensorModel, default SensorModel()
+    instrumentation : Instrumentation, profile name or profile TOML file, default "flight-ema"
+        The sensors fitted and the sample rate (:mod:`prsm_health.instrumentation`).
     seed : int
         Seeds manufacturing variation, uneven wear and sensor noise: same seed, same run
         (bit-identical).
@@ -143,7 +145,9 @@ def simulate(
     Returns
     -------
     Run
-        Contract channels at ``sensors.sample_rate``; ``run.energy`` holds the energy book.
+        The fitted measured channels (and, until runs carry their truth, the truth-only
+        contract channels) at ``instrumentation.sample_rate``; ``run.energy`` holds the energy
+        book.
 
     Raises
     ------
@@ -162,7 +166,7 @@ def simulate(
         design=design or DEFAULT_PRESET,
         health=health or HealthState(),
         profile=profile or OperatingProfile(),
-        sensors=sensors or SensorModel(),
+        instrumentation=instrumentation or DEFAULT_PROFILE,
         options=options or SimulationOptions(),
         seed=int(seed),
     )
@@ -172,9 +176,9 @@ def simulate(
 def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     """Simulate a :class:`~prsm_health.scenario.Scenario`; see :func:`simulate`."""
     design, health, profile = scenario.design, scenario.health, scenario.profile
-    sensors, options, seed = scenario.sensors, scenario.options, scenario.seed
+    instrumentation, options, seed = scenario.instrumentation, scenario.options, scenario.seed
     model = build_model(design, health, profile, options, seed)
-    h, factor = choose_step(options.max_step, sensors.sample_rate)
+    h, factor = choose_step(options.max_step, instrumentation.sample_rate)
     h_stable, f_max = max_stable_step(model)
     if h > h_stable:
         raise SimulationError(
@@ -190,15 +194,17 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
             0.0  # energy book starts at t = 0
         )
-    raw = _integrate(model, y, h, n_steps, progress)
-    channels = measure(
-        {name: raw[:, k] for k, name in enumerate(CHANNEL_NAMES)},
+    truth = _truth_raw(_integrate(model, y, h, n_steps, progress))
+    channels = instrumentation.measure(
+        truth,
         1.0 / h,
-        sensors,
-        np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
+        np.random.default_rng([seed, 0x53454E53]),  # "SENS": this seed's sensors
     )
-    n_out = len(channels["screw_angle"])
-    time = np.arange(n_out) / sensors.sample_rate
+    # The truth-only contract channels stay in the run, free of sensor error, until runs carry
+    # their truth separately.
+    channels.update({name: decimate(truth[name], factor) for name in TRUTH_NAMES})
+    n_out = len(next(iter(channels.values())))
+    time = np.arange(n_out) / instrumentation.sample_rate
     nq = model.n_coordinates
     energy = {
         "drive": float(y[2 * nq + L.X_W_DRIVE]),
@@ -209,7 +215,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     return Run(
         time=time,
         channels=channels,
-        sample_rate=sensors.sample_rate,
+        sample_rate=instrumentation.sample_rate,
         labels=scenario.labels(),
         scenario={
             **scenario.to_dict(),
@@ -219,6 +225,18 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         },
         energy=energy,
     )
+
+
+def _truth_raw(raw: np.ndarray) -> dict[str, np.ndarray]:
+    """Truth signals by name from the kernel's record (interim: the kernel records the screw
+    side, driven rigidly by the motor, so the motor's angle, speed and torque are the screw's)."""
+    truth = {name: raw[:, k] for k, name in enumerate(CHANNEL_NAMES)}
+    truth.update(
+        motor_angle=truth["screw_angle"],
+        motor_speed=truth["screw_speed"],
+        motor_torque=truth["drive_torque"],
+    )
+    return truth
 
 
 def _integrate(

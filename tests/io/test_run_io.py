@@ -7,7 +7,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from prsm_health import HealthState, OperatingProfile, SensorModel, simulate
+from prsm_health import HealthState, OperatingProfile, simulate
 from prsm_health.channels import CHANNEL_NAMES, UNITS
 from prsm_health.errors import PRSMHealthError
 from prsm_health.io.parquet import read_run_parquet, write_run_parquet
@@ -15,7 +15,7 @@ from prsm_health.io.parquet import read_run_parquet, write_run_parquet
 
 @pytest.fixture(scope="module")
 def run():
-    return simulate("paper01", HealthState(), OperatingProfile(duration=0.02), SensorModel(), 4)
+    return simulate("paper01", HealthState(), OperatingProfile(duration=0.02), "ideal", 4)
 
 
 def test_round_trip_exact(tmp_path, run):
