@@ -560,10 +560,7 @@ def _cmd_instrumentation_show(args) -> int:
     ]
     for channel, sensor in info["sensors"].items():
         rows.append((channel, f"{sensor['kind']}, reads {sensor['reads']}", ""))
-        rows += [
-            (f"  {p['name']}", _listed(p["value"]), p["unit"] if p["value"] != "" else "")
-            for p in sensor["parameters"]
-        ]
+        rows += [(f"  {p['name']}", _listed(p["value"]), p["unit"]) for p in sensor["parameters"]]
     _print_table(rows)
     return 0
 

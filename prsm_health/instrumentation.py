@@ -5,16 +5,13 @@ motor_torque, nut_position, nut_*_accel, axial_load, …: the channel contract).
 :class:`Instrumentation` fits at most one sensor per measured channel and turns the truth into
 the fitted channels at its sample rate f_s = f_int / m (m an integer):
 
-======================  ===================  =========================================
-measured channel        sensor               reads (truth)
-======================  ===================  =========================================
-screw_angle             :class:`AngleSensor`   motor_angle (motor encoder or resolver)
-screw_speed             :class:`SpeedEstimate` the measured screw_angle (drive estimate)
-nut_position            :class:`PositionSensor` nut_position (LVDT or linear scale)
-nut_*_accel             :class:`Accelerometer` nut_*_accel of its axis (+ transverse axes)
-drive_torque            :class:`TorqueEstimate` motor_torque (phase current × nominal k_t)
-axial_load              :class:`LoadCell`      axial_load
-======================  ===================  =========================================
+- ``screw_angle``: :class:`AngleSensor` (motor encoder or resolver) reads motor_angle;
+- ``screw_speed``: :class:`SpeedEstimate`, the drive's estimate from the measured screw_angle;
+- ``nut_position``: :class:`PositionSensor` (LVDT or linear scale) reads nut_position;
+- ``nut_*_accel``: :class:`Accelerometer` reads the nut acceleration of its axis (and, through
+  its transverse sensitivity, the two across it);
+- ``drive_torque``: :class:`TorqueEstimate` (phase current × nominal k_t) reads motor_torque;
+- ``axial_load``: :class:`LoadCell` reads axial_load.
 
 Order of operations inside every sensor: what the sensor does to the continuous signal —
 gain error, cross-axis coupling, nonlinearity, drift, bandwidth, mounting resonance,
@@ -119,6 +116,14 @@ def _harmonics(angle: np.ndarray, orders, amplitudes, phases) -> np.ndarray:
     return sum(a * np.sin(k * angle + p) for k, a, p in zip(orders, amplitudes, phases))
 
 
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _truth(truth: dict, name: str, channel: str) -> np.ndarray:
     try:
         return np.asarray(truth[name], dtype=float)
@@ -153,43 +158,37 @@ class _Sensor:
     def _integer(self, name: str, low: int, high: int) -> None:
         value = getattr(self, name)
         require(
-            isinstance(value, int) and not isinstance(value, bool) and low <= value <= high,
+            _is_int(value) and low <= value <= high,
             name,
             value,
             f"must be an integer in [{low}, {high}]",
         )
 
-    def _harmonic_pairs(self, orders: str, amplitudes: str, high: float) -> None:
-        """Two equally long lists: integer orders ≥ 1 and amplitudes in [0, high]."""
-        for name in (orders, amplitudes):
+    def _harmonic_pairs(self, orders_name: str, amplitudes_name: str, high: float) -> None:
+        """Two equally long lists (stored as tuples): integer orders ≥ 1, amplitudes in [0, high]."""
+        for name in (orders_name, amplitudes_name):
             value = getattr(self, name)
-            require(
-                isinstance(value, (list, tuple)),
-                name,
-                value,
-                "must be a list (TOML array)",
-            )
+            require(isinstance(value, (list, tuple)), name, value, "must be a list (TOML array)")
             object.__setattr__(self, name, tuple(value))
+        orders, amplitudes = getattr(self, orders_name), getattr(self, amplitudes_name)
+        unit = self.UNITS.get(amplitudes_name, "")
         require(
-            all(
-                isinstance(k, int) and not isinstance(k, bool) and k >= 1
-                for k in getattr(self, orders)
-            ),
-            orders,
-            list(getattr(self, orders)),
+            all(_is_int(k) and k >= 1 for k in orders),
+            orders_name,
+            list(orders),
             "must be integers ≥ 1",
         )
         require(
-            all(isinstance(a, (int, float)) and 0 <= a <= high for a in getattr(self, amplitudes)),
-            amplitudes,
-            list(getattr(self, amplitudes)),
-            f"must be numbers in [0, {high:g}] {self.UNITS.get(amplitudes, '')}".rstrip(),
+            all(_is_number(a) and 0 <= a <= high for a in amplitudes),
+            amplitudes_name,
+            list(amplitudes),
+            f"must be numbers in [0, {high:g}] {unit}".rstrip(),
         )
         require(
-            len(getattr(self, orders)) == len(getattr(self, amplitudes)),
-            amplitudes,
-            list(getattr(self, amplitudes)),
-            f"needs one amplitude per entry of {orders} ({len(getattr(self, orders))})",
+            len(orders) == len(amplitudes),
+            amplitudes_name,
+            list(amplitudes),
+            f"needs one amplitude per entry of {orders_name} ({len(orders)})",
         )
 
     def to_dict(self) -> dict:
@@ -228,10 +227,10 @@ class _Sensor:
                     f"give either {key} or {name}, not both",
                 )
                 if isinstance(value, list):
-                    ok = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+                    ok = all(_is_number(v) for v in value)
                     converted = [v * factor for v in value] if ok else value
                 else:
-                    ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+                    ok = _is_number(value)
                     converted = value * factor if ok else value
                 require(ok, f"{where}.{key}", value, "must be a number (or a list of numbers)")
                 values[name] = converted
