@@ -25,7 +25,7 @@ demo: $(STAMP)
 	$(BIN)/prsm-health train $(DEMO)/dataset --out $(DEMO)/model.skops --cv 3
 	$(BIN)/prsm-health simulate --clearance 22e-6 --speed 90 --load 50 --load-profile reversing \
 		--load-amplitude 300 --load-frequency 10 --accel-time 0.002 --contact-law hertz \
-		--accel-noise 0.05 --duration 2 --seed 99 --out $(DEMO)/recording.mcap --plot $(DEMO)/recording.png
+		--duration 2 --seed 99 --out $(DEMO)/recording.mcap --plot $(DEMO)/recording.png
 	$(BIN)/prsm-health diagnose $(DEMO)/recording.mcap --model $(DEMO)/model.skops --plot $(DEMO)/diagnosis.png
 	$(BIN)/prsm-health replay $(DEMO)/recording.mcap --model $(DEMO)/model.skops --out $(DEMO)/recording-diagnosed.mcap
 	@echo "demo outputs in $(DEMO)/ (validation.txt, recording.png, diagnosis.png, recording-diagnosed.mcap)"

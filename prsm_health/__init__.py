@@ -3,9 +3,11 @@
 Public API (SI units throughout), imported lazily so ``import prsm_health`` stays fast:
 
 - designs and states: :func:`preset`, :class:`PRSMDesign`, :class:`HealthState`,
-  :class:`OperatingProfile`, :class:`SensorModel`, :class:`SimulationOptions`, :class:`Scenario`
+  :class:`OperatingProfile`, :class:`SimulationOptions`, :class:`Scenario`
+- instrumentation: :class:`Instrumentation`, :func:`load_instrumentation`,
+  :func:`list_profiles` (built-in sensor profiles: ideal, lab-rig, flight-ema, minimal)
 - kinematics: :func:`speed_ratios`, :func:`characteristic_frequencies`
-- simulation: :func:`simulate` (design, health, profile, sensors, seed) → :class:`Run`
+- simulation: :func:`simulate` (design, health, profile, instrumentation, seed) → :class:`Run`
 - data: :class:`Dataset`, :func:`read_mcap`, :func:`write_mcap`, :func:`read_recording`
 - diagnostics: :func:`extract_features`, :func:`load_model` (a diagnosis model bundle),
   :func:`diagnose` → :class:`Diagnosis`
@@ -29,7 +31,9 @@ _EXPORTS = {
     "HealthState": ".states",
     "ManufacturingVariation": ".states",
     "OperatingProfile": ".states",
-    "SensorModel": ".sensors",
+    "Instrumentation": ".instrumentation",
+    "list_profiles": ".instrumentation",
+    "load_instrumentation": ".instrumentation",
     "SimulationOptions": ".dynamics.model",
     "Scenario": ".scenario",
     "simulate": ".dynamics.simulate",

@@ -473,7 +473,8 @@ def _cmd_simulate(args) -> int:
                 "load_amplitude": args.load_amplitude,
                 "load_frequency": args.load_frequency,
             },
-            "sensors": {"sample_rate": args.sample_rate, "accel_noise": args.accel_noise},
+            "instrumentation": {"profile": args.instrumentation}
+            | ({} if args.sample_rate is None else {"sample_rate": args.sample_rate}),
             "options": {
                 "max_step": args.max_step,
                 "contact_law": args.contact_law,
@@ -499,6 +500,8 @@ def _cmd_simulate(args) -> int:
         plot_run(run, args.plot, mesh_frequency=mesh)
     summary = {
         "out": str(out),
+        "instrumentation": scenario.instrumentation.name,
+        "channels": list(run.channels),
         "samples": len(run),
         "sample_rate": run.sample_rate,
         "duration": profile.duration,
@@ -514,6 +517,8 @@ def _cmd_simulate(args) -> int:
         _print_table(
             [
                 ("wrote", str(out), ""),
+                ("instrumentation", scenario.instrumentation.name, ""),
+                ("channels", ", ".join(run.channels), ""),
                 ("samples", len(run), f"at {run.sample_rate:g} Hz"),
                 ("gear mesh frequency", mesh, "Hz"),
                 ("integration step", run.scenario["integration_step"], "s"),
@@ -522,6 +527,49 @@ def _cmd_simulate(args) -> int:
             ]
         )
     return 0
+
+
+# ----------------------------------------------------------------------------- instrumentation
+def _cmd_instrumentation_list(args) -> int:
+    from .instrumentation import list_profiles, load_instrumentation
+
+    profiles = [load_instrumentation(name) for name in list_profiles()]
+    if args.json:
+        _print_json(
+            [
+                {"name": p.name, "description": p.description, "channels": list(p.fitted)}
+                for p in profiles
+            ]
+        )
+    else:
+        _print_table([(p.name, p.description, "") for p in profiles])
+    return 0
+
+
+def _cmd_instrumentation_show(args) -> int:
+    from .instrumentation import load_instrumentation
+
+    info = load_instrumentation(args.profile).describe()
+    if args.json:
+        _print_json(info)
+        return 0
+    rows = [
+        ("name", info["name"], ""),
+        ("description", info["description"], ""),
+        ("sample_rate", info["sample_rate"], "Hz"),
+    ]
+    for channel, sensor in info["sensors"].items():
+        rows.append((channel, f"{sensor['kind']}, reads {sensor['reads']}", ""))
+        rows += [(f"  {p['name']}", _listed(p["value"]), p["unit"]) for p in sensor["parameters"]]
+    _print_table(rows)
+    return 0
+
+
+def _listed(value):
+    """A parameter for the table: lists comma-separated, floats to 6 significant digits."""
+    if isinstance(value, list):
+        return "[" + ", ".join(f"{v:.6g}" if isinstance(v, float) else str(v) for v in value) + "]"
+    return value
 
 
 # ----------------------------------------------------------------------------- parser
@@ -552,6 +600,21 @@ def _design(text: str):
         return load_design(text)
     except PRSMHealthError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+PROFILE_HELP = (
+    "instrumentation profile: a built-in name (prsm-health instrumentation list) or a TOML file"
+)
+
+
+def _removed_option(replacement: str):
+    """The type of an option that no longer exists: using it is a one-line error saying what
+    replaced it."""
+
+    def reject(text: str):
+        raise argparse.ArgumentTypeError(f"this option was removed: {replacement}")
+
+    return reject
 
 
 def _add_json(p, what: str = "the result") -> None:
@@ -598,6 +661,20 @@ def build_parser() -> argparse.ArgumentParser:
     t = design("check", "validate a design file: 'ok: NAME', or one error line and exit 2")
     t.add_argument("file", help="design TOML file (or a preset name)")
     t.set_defaults(func=_cmd_design_check)
+
+    p = command("instrumentation", "instrumentation profiles: the sensors a run is measured with")
+    isub = p.add_subparsers(dest="action", required=True, parser_class=_Parser)
+
+    def instrumentation(name: str, text: str):
+        return isub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+
+    t = instrumentation("list", "the built-in profiles, one line each")
+    _add_json(t, "the profiles (name, description, channels)")
+    t.set_defaults(func=_cmd_instrumentation_list)
+    t = instrumentation("show", "every sensor of a profile with its parameters and units")
+    t.add_argument("profile", help=PROFILE_HELP)
+    _add_json(t, "the profile")
+    t.set_defaults(func=_cmd_instrumentation_show)
 
     p = command("kinematics", "speed ratios and characteristic frequencies of a design")
     p.add_argument("--design", type=_design, default=DEFAULT_PRESET, help=DESIGN_HELP)
@@ -744,6 +821,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_simulate_parser(command, default_preset) -> None:
+    from .instrumentation import DEFAULT_PROFILE
     from .states import LOADS, MOTIONS
 
     s = command("simulate", "simulate a PRSM run (paper 01 dynamics) and write it")
@@ -774,9 +852,23 @@ def _add_simulate_parser(command, default_preset) -> None:
         "--load-frequency", type=_finite_float, default=20.0, help="load swing frequency [Hz]"
     )
     s.add_argument("--duration", type=_finite_float, default=0.2, help="simulated time [s]")
-    s.add_argument("--sample-rate", type=_finite_float, default=20000.0, help="output rate [Hz]")
     s.add_argument(
-        "--accel-noise", type=_finite_float, default=0.0, help="RMS accelerometer noise [m/s²]"
+        "--instrumentation", default=DEFAULT_PROFILE, metavar="PROFILE", help=PROFILE_HELP
+    )
+    s.add_argument(
+        "--sample-rate",
+        type=_finite_float,
+        default=None,
+        help="output rate [Hz] (None: the profile's, 20 kHz for the built-ins)",
+    )
+    s.add_argument(
+        "--accel-noise",
+        type=_removed_option(
+            "accelerometer noise comes from the instrumentation profile (--instrumentation); "
+            'set it in a profile file: profile = "flight-ema" and '
+            "[nut_axial_accel] noise_density_ug = … (docs/instrumentation.md)"
+        ),
+        help=argparse.SUPPRESS,
     )
     s.add_argument(
         "--contact-law", choices=("linear", "hertz"), default="linear", help="thread flank law"

@@ -1,7 +1,8 @@
 """Labelled datasets from recipes: sweeps, parallel generation, resumable Parquet (and MCAP) output.
 
-A **recipe** (TOML, see datasets/*.toml and docs/formats.md) names a design, a run duration and
-sample rate, profile/sensor/option settings, a seed and a **sweep** over clearance, speed,
+A **recipe** (TOML, see datasets/*.toml and docs/formats.md) names a design, an instrumentation
+profile, a run duration and sample rate, profile/option settings, a seed and a **sweep** over
+clearance, speed,
 load, friction scale and per-roller wear spread — as a grid, or as random or Latin-hypercube
 samples over ranges — with repeats, a test split and the fault-class thresholds.
 
@@ -37,6 +38,7 @@ from .channels import CHANNEL_NAMES, TRUTH_PREFIX, UNITS
 from .design import PRESETS
 from .design_files import load_design
 from .errors import ParameterError, PRSMHealthError, RecipeError, require
+from .instrumentation import DEFAULT_PROFILE, list_profiles, load_instrumentation
 from .jsonable import dumps
 from .run import Run
 from .scenario import Scenario
@@ -71,7 +73,7 @@ class Recipe:
     seed: int
     sweep: dict
     profile: dict = field(default_factory=dict)
-    sensors: dict = field(default_factory=dict)
+    instrumentation: str | dict = DEFAULT_PROFILE
     options: dict = field(default_factory=dict)
     faults: FaultThresholds = field(default_factory=FaultThresholds)
     test_fraction: float = 0.2
@@ -87,12 +89,24 @@ class Recipe:
         ``base``, else the working directory) or the design's dict form: both are stored as the
         full design dict, so ``source`` (what workers rebuild the recipe from, and what the
         manifest and the fingerprint record) holds the design itself, not a path.
+        ``instrumentation`` likewise: a built-in profile name is kept, a profile file or an
+        ``[instrumentation]`` table (``profile = …`` plus overrides) is stored complete.
         """
         data = dict(data)
+        if "sensors" in data:
+            raise RecipeError(
+                "recipe: the [sensors] table was replaced by instrumentation profiles: write "
+                f'instrumentation = "{DEFAULT_PROFILE}" (built-ins: {", ".join(list_profiles())}) '
+                "or an [instrumentation] table with profile = … and sensor overrides, e.g. "
+                "[instrumentation.nut_axial_accel] noise_density_ug = 40 "
+                "(docs/instrumentation.md); sample_rate stays at the top level"
+            )
         for key in ("name", "design", "duration", "sample_rate", "seed", "sweep"):
             if key not in data:
                 raise RecipeError(f"recipe: missing key {key!r}")
         data["design"] = _recipe_design(data["design"], base)
+        if "instrumentation" in data:
+            data["instrumentation"] = _recipe_instrumentation(data["instrumentation"], base)
         known = {f.name for f in fields(cls)} - {"source"}
         unknown = sorted(set(data) - known)
         if unknown:
@@ -328,7 +342,7 @@ class RunSpec:
                     "design": r.design,
                     "health": health,
                     "profile": profile,
-                    "sensors": {"sample_rate": r.sample_rate, **r.sensors},
+                    "instrumentation": _with_sample_rate(r.instrumentation, r.sample_rate),
                     "options": r.options,
                     "seed": self.seed,
                 }
@@ -370,6 +384,34 @@ def _recipe_design(design, base: Path | None) -> str | dict:
         raise RecipeError(f"recipe: {exc}") from None
     except PRSMHealthError as exc:
         raise RecipeError(f"recipe: design: {exc}") from None
+
+
+def _recipe_instrumentation(instrumentation, base: Path | None) -> str | dict:
+    """A built-in profile name as is; a profile file or table as the profile's complete dict
+    (without its sample rate: the recipe's top-level ``sample_rate`` sets it, so a table may not
+    set it too)."""
+    if isinstance(instrumentation, str) and instrumentation in list_profiles():
+        return instrumentation
+    if isinstance(instrumentation, dict) and "sample_rate" in instrumentation:
+        raise RecipeError(
+            "recipe: instrumentation.sample_rate: the recipe's top-level sample_rate sets the "
+            "sample rate; remove it from the [instrumentation] table"
+        )
+    try:
+        complete = load_instrumentation(instrumentation, base=base).to_dict()
+    except ParameterError as exc:
+        raise RecipeError(f"recipe: {exc}") from None
+    except PRSMHealthError as exc:
+        raise RecipeError(f"recipe: instrumentation: {exc}") from None
+    del complete["sample_rate"]
+    return complete
+
+
+def _with_sample_rate(instrumentation: str | dict, sample_rate: float) -> dict:
+    """The dict form of the recipe's profile at the recipe's sample rate."""
+    if isinstance(instrumentation, str):
+        return {"profile": instrumentation, "sample_rate": sample_rate}
+    return {**instrumentation, "sample_rate": sample_rate}
 
 
 # ---------------------------------------------------------------------- generation

@@ -9,12 +9,11 @@ file's stem. See docs/formats.md → Design files.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from .design import PRESETS, GearGeometry, MassProperties, Material, PRSMDesign, preset
 from .errors import ParameterError
-from .tomlfile import read_toml
+from .tomlfile import read_toml, toml_value
 
 #: Unit and meaning of every design field, by dotted name below the design (``gear.module``);
 #: the material fields apply to each of the three ``*_material`` tables.
@@ -141,7 +140,7 @@ def design_toml_tables(design: PRSMDesign, prefix: str) -> list[str]:
 
 
 def _toml_lines(values: dict, table: str, comments: bool) -> list[str]:
-    rows = [(k, _toml_value(v)) for k, v in values.items() if v is not None]
+    rows = [(k, toml_value(v)) for k, v in values.items() if v is not None]
     width = max((len(f"{k} = {v}") for k, v in rows), default=0)
     out = []
     for key, text in rows:
@@ -152,16 +151,6 @@ def _toml_lines(values: dict, table: str, comments: bool) -> list[str]:
             line = f"{line:<{width}}  # {note}".rstrip(" #")
         out.append(line)
     return out
-
-
-def _toml_value(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return json.dumps(value, ensure_ascii=False)
-    if isinstance(value, (int, float)):
-        return repr(value)
-    raise TypeError(f"no TOML form for {value!r}")  # pragma: no cover
 
 
 def design_rows(design: PRSMDesign) -> list[tuple[str, object, str]]:

@@ -1,7 +1,7 @@
 """Scenario: the one object a simulated run is built from, and its labels.
 
 A :class:`Scenario` gathers the parameter groups by lifetime — design, health state, operating
-profile, sensors, simulation options — and the seed. The CLI (``prsm-health simulate``), dataset
+profile, instrumentation, simulation options — and the seed. The CLI (``prsm-health simulate``), dataset
 recipes (one scenario per run) and the Python API all build it here, from keyword objects or from
 a nested dict / TOML table, so defaults and validation live in one place; its :meth:`labels`
 are the run labels of the contract (docs/formats.md).
@@ -10,11 +10,17 @@ The dict form (and the TOML form, the same tables)::
 
     design = "paper01"                       # preset name or design TOML file (relative to the
                                              # scenario file), or a [design] table (design files)
+    instrumentation = "flight-ema"           # profile name or profile TOML file (relative to the
+                                             # scenario file), or an [instrumentation] table
     seed = 3
     [health]   clearance = 20e-6             # shorthand for screw, nut and gear; or each field
     [profile]  duration = 0.5, speed = 100.0, load = 100.0, …   (OperatingProfile fields)
-    [sensors]  sample_rate = 20000, accel_noise = 0.05, …       (SensorModel fields)
     [options]  contact_law = "hertz", ideal = true, …           (SimulationOptions fields)
+
+The ``[instrumentation]`` table holds ``profile = "flight-ema"`` plus overrides (``sample_rate``,
+``[instrumentation.nut_axial_accel] noise_density_ug = 40``, ``fitted = false``), or a complete
+profile (:func:`prsm_health.instrumentation.load_instrumentation`). TOML cannot give
+``instrumentation`` both as a string and as a table.
 """
 
 from __future__ import annotations
@@ -27,14 +33,19 @@ from .design_files import design_toml_tables, load_design
 from .drive_train import DriveTrain
 from .dynamics.model import SimulationOptions
 from .errors import ParameterError, require
-from .sensors import SensorModel
+from .instrumentation import (
+    DEFAULT_PROFILE,
+    Instrumentation,
+    instrumentation_ref,
+    list_profiles,
+    load_instrumentation,
+)
 from .states import HealthState, ManufacturingVariation, OperatingProfile
-from .tomlfile import read_toml
+from .tomlfile import read_toml, toml_value
 
 _GROUPS = {
     "health": HealthState,
     "profile": OperatingProfile,
-    "sensors": SensorModel,
     "options": SimulationOptions,
     "drive_train": DriveTrain,
 }
@@ -49,16 +60,18 @@ class Scenario:
     design : PRSMDesign, preset name, design TOML file or dict form, default "paper01"
     health : HealthState
     profile : OperatingProfile
-    sensors : SensorModel
+    instrumentation : Instrumentation, profile name, profile file or dict form, default "flight-ema"
     options : SimulationOptions
     seed : int
-        Seeds manufacturing variation, uneven wear and sensor noise (same seed, same run).
+        Seeds manufacturing variation, uneven wear and sensor errors (same seed, same run).
     """
 
     design: PRSMDesign = field(default_factory=preset)
     health: HealthState = field(default_factory=HealthState)
     profile: OperatingProfile = field(default_factory=OperatingProfile)
-    sensors: SensorModel = field(default_factory=SensorModel)
+    instrumentation: Instrumentation = field(
+        default_factory=lambda: load_instrumentation(DEFAULT_PROFILE)
+    )
     options: SimulationOptions = field(default_factory=SimulationOptions)
     seed: int = 0
     drive_train: DriveTrain = field(default_factory=DriveTrain)
@@ -66,6 +79,8 @@ class Scenario:
     def __post_init__(self):
         if not isinstance(self.design, PRSMDesign):
             object.__setattr__(self, "design", load_design(self.design))
+        if not isinstance(self.instrumentation, Instrumentation):
+            object.__setattr__(self, "instrumentation", load_instrumentation(self.instrumentation))
         require(
             isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0,
             "seed",
@@ -79,19 +94,34 @@ class Scenario:
         """Build from the nested dict form (module docstring); errors name the table and key.
 
         ``design`` is a preset name, a design TOML file (relative paths against ``base``, else
-        the working directory), the dict form of :meth:`PRSMDesign.to_dict` or a design.
+        the working directory), the dict form of :meth:`PRSMDesign.to_dict` or a design;
+        ``instrumentation`` likewise a profile name, a profile file or a table (module docstring).
         """
         data = dict(data)
-        unknown = sorted(set(data) - {"design", "seed", *_GROUPS})
+        if "sensors" in data:
+            raise ParameterError(
+                "scenario.sensors",
+                data["sensors"],
+                "the [sensors] table was replaced by instrumentation profiles: write "
+                f'instrumentation = "{DEFAULT_PROFILE}" (built-ins: '
+                f"{', '.join(list_profiles())}) or an [instrumentation] table with profile = … "
+                "and overrides (docs/instrumentation.md)",
+            )
+        unknown = sorted(set(data) - {"design", "instrumentation", "seed", *_GROUPS})
         if unknown:
             raise ParameterError(
                 "scenario",
                 ", ".join(unknown),
-                f"unknown key(s); allowed: design, seed, {', '.join(_GROUPS)}",
+                f"unknown key(s); allowed: design, instrumentation, seed, {', '.join(_GROUPS)}",
             )
         groups = {name: _group(name, kind, data.get(name, {})) for name, kind in _GROUPS.items()}
         design = load_design(data.get("design", DEFAULT_PRESET), base=base)
-        return cls(design=design, seed=data.get("seed", 0), **groups)
+        instrumentation = load_instrumentation(
+            data.get("instrumentation", DEFAULT_PROFILE), base=base
+        )
+        return cls(
+            design=design, instrumentation=instrumentation, seed=data.get("seed", 0), **groups
+        )
 
     @classmethod
     def from_toml(cls, path: str | Path) -> Scenario:
@@ -102,13 +132,14 @@ class Scenario:
     def to_dict(self) -> dict:
         """The nested dict form, as stored with every run (``Run.scenario``).
 
-        ``design`` is the preset name for an unmodified preset, else the design's full dict.
+        ``design`` and ``instrumentation`` are the built-in names when unmodified, else the
+        full dict forms.
         """
         return {
             "design": self.design_ref(),
+            "instrumentation": instrumentation_ref(self.instrumentation),
             "health": self.health.as_dict(),
             "profile": self.profile.as_dict(),
-            "sensors": self.sensors.as_dict(),
             "options": self.options.as_dict(),
             "drive_train": self.drive_train.as_dict(),
             "seed": self.seed,
@@ -125,18 +156,23 @@ class Scenario:
         """TOML text that :meth:`from_toml` reads back to an equal scenario."""
         data = self.to_dict()
         design = data.pop("design")
+        instrumentation = data.pop("instrumentation")
         lines = [f"seed = {data.pop('seed')}"]
+        if isinstance(instrumentation, str):
+            lines.insert(0, f"instrumentation = {toml_value(instrumentation)}")
         if isinstance(design, str):
-            lines.insert(0, f'design = "{design}"')
+            lines.insert(0, f"design = {toml_value(design)}")
         options = data["options"]
         variation = options.pop("variation")
         for table, values in data.items():
             lines.append(f"\n[{table}]")
-            lines += [f"{k} = {_toml_value(v)}" for k, v in values.items() if v is not None]
+            lines += [f"{k} = {toml_value(v)}" for k, v in values.items() if v is not None]
         lines.append("\n[options.variation]")
-        lines += [f"{k} = {_toml_value(v)}" for k, v in variation.items()]
+        lines += [f"{k} = {toml_value(v)}" for k, v in variation.items()]
         if not isinstance(design, str):
             lines += [""] + design_toml_tables(self.design, "design")
+        if not isinstance(instrumentation, str):
+            lines += [""] + self.instrumentation.toml_tables("instrumentation")
         return "\n".join(lines) + "\n"
 
     # ------------------------------------------------------------------ labels
@@ -197,11 +233,3 @@ def _group(name: str, kind: type, values) -> object:
             f"unknown key; allowed: {', '.join(allowed)}",
         )
     return kind(**values)
-
-
-def _toml_value(value) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return f'"{value}"'
-    return repr(value)

@@ -1,7 +1,9 @@
-"""Reading the package's TOML files (designs, scenarios, recipes) with one set of errors."""
+"""Reading the package's TOML files (designs, scenarios, recipes, instrumentation profiles) with
+one set of errors, and writing TOML values."""
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -27,3 +29,16 @@ def read_toml(path: str | Path, what: str, error: type[PRSMHealthError] = PRSMHe
         raise error(f"{path}: not a text file (expected a {what} in TOML)") from None
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{path}: not valid TOML ({exc})") from None
+
+
+def toml_value(value) -> str:
+    """TOML text of a value written by the package (bool, str, number, or a list of them)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)  # a JSON string is a valid TOML basic string
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
+    raise TypeError(f"no TOML form for {value!r}")

@@ -17,7 +17,6 @@ import pytest  # noqa: E402
 from prsm_health import (  # noqa: E402
     HealthState,
     OperatingProfile,
-    SensorModel,
     SimulationOptions,
     simulate,
 )
@@ -36,7 +35,7 @@ def _reversing_run(clearance, duration, seed, speed, sample_rate, overrides):
         "paper01",
         HealthState.uniform(clearance),
         OperatingProfile(duration=duration, speed=speed, **profile),
-        SensorModel(sample_rate=sample_rate),
+        {"profile": "ideal", "sample_rate": sample_rate},
         seed,
         options=SimulationOptions(contact_law="hertz"),
     )

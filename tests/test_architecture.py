@@ -27,6 +27,7 @@ LAYERS = {
     "friction": 1,
     "recirculating": 1,
     "sensors": 1,
+    "instrumentation": 1,
     "spectra": 1,
     "dynamics": 2,
     "scenario": 2,

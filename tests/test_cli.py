@@ -117,10 +117,12 @@ def test_simulate_writes_parquet_and_plot(tmp_path, capsys):
     assert code == 0
     summary = json.loads(stdout)
     assert summary["gear_mesh_frequency"] == pytest.approx(387.94, abs=0.01)
+    assert summary["instrumentation"] == "flight-ema"  # the default profile
     import pandas as pd
 
     frame = pd.read_parquet(out)
     assert len(frame) == summary["samples"] and "nut_axial_accel" in frame
+    assert "nut_tangential_accel" not in frame and "axial_load" not in frame  # not fitted
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
@@ -139,6 +141,73 @@ def test_simulate_bad_input(tmp_path, capsys, monkeypatch, extra, needle):
     code, _, err = run(capsys, "simulate", *extra)
     assert code == 2
     assert err.startswith("error: ") and needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_instrumentation_list_and_show(capsys, tmp_path):
+    code, out, _ = run(capsys, "instrumentation", "list")
+    assert code == 0
+    assert [line.split()[0] for line in out.strip().splitlines()] == [
+        "flight-ema",
+        "ideal",
+        "lab-rig",
+        "minimal",
+    ]
+    code, out, _ = run(capsys, "instrumentation", "list", "--json")
+    profiles = {p["name"]: p for p in json.loads(out)}
+    assert profiles["minimal"]["channels"] == ["screw_angle", "screw_speed", "drive_torque"]
+    code, out, _ = run(capsys, "instrumentation", "show", "flight-ema", "--json")
+    info = json.loads(out)
+    assert set(info["sensors"]) == {
+        "screw_angle",
+        "screw_speed",
+        "nut_position",
+        "nut_axial_accel",
+        "drive_torque",
+    }
+    code, out, _ = run(capsys, "instrumentation", "show", "lab-rig")
+    assert code == 0 and "noise_density" in out and "m/s^2/sqrt(Hz)" in out
+    path = tmp_path / "p.toml"
+    path.write_text('profile = "minimal"\n[drive_torque]\nnoise = 0.01\n')
+    code, out, _ = run(capsys, "instrumentation", "show", str(path), "--json")
+    assert json.loads(out)["name"] == "minimal"
+
+
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["instrumentation", "show", "flight-emma"], "lab-rig"),
+        (["simulate", "--out", "x.parquet", "--accel-noise", "0.05"], "removed"),
+        (["simulate", "--out", "x.parquet", "--sample-rate", "7"], "sample_rate"),
+    ],
+)
+def test_instrumentation_errors_are_one_line(capsys, argv, needle):
+    code, _, err = run(capsys, *argv)
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and lines[0].startswith("error: ")
+    assert needle in lines[0]
+
+
+def test_unknown_profile_through_the_console_script(tmp_path):
+    # The real entry point: exit 2, one line naming every built-in profile, no traceback.
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "prsm_health.cli",
+            "simulate",
+            "--instrumentation",
+            "flight-emma",
+            "--out",
+            str(tmp_path / "x.parquet"),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: instrumentation")
+    assert all(name in lines[0] for name in ("flight-ema", "ideal", "lab-rig", "minimal"))
 
 
 def test_kinematics_recirculating_and_friction_json(capsys):
@@ -188,6 +257,7 @@ def test_generate_warns_when_the_dataset_cannot_train(tmp_path, capsys):
     recipe = tmp_path / "small.toml"
     recipe.write_text(
         'name = "small"\ndesign = "paper01"\nduration = 0.02\nsample_rate = 20000\nseed = 1\n'
+        'instrumentation = "ideal"\n'
         "[sweep]\nclearance = [5e-6, 40e-6]\nspeed = [80.0]\nload = [100.0]\n"
     )
     assert main(["generate", str(recipe), "--out", str(tmp_path / "d"), "--workers", "1"]) == 0

@@ -23,6 +23,7 @@ TINY = textwrap.dedent(
     design = "paper01"
     duration = 0.02
     sample_rate = 20000
+    instrumentation = "ideal"
     seed = 11
     batch_size = 2
     test_fraction = 0.34
@@ -80,6 +81,39 @@ def test_latin_hypercube_and_bad_recipes():
             Recipe.from_dict(bad)
 
 
+def test_recipe_instrumentation(tmp_path):
+    from prsm_health.instrumentation import load_instrumentation
+
+    base = dict(name="x", design="paper01", duration=0.01, sample_rate=10000, seed=1, sweep={})
+    # a built-in by name, at the recipe's sample rate
+    named = Recipe.from_dict(dict(base, instrumentation="lab-rig")).runs()[0].scenario()
+    lab = load_instrumentation("lab-rig")
+    assert named.instrumentation.fitted == lab.fitted
+    assert named.instrumentation.sample_rate == 10000
+    # no instrumentation: the default, flight-ema
+    default = Recipe.from_dict(base).runs()[0].scenario()
+    assert default.instrumentation.name == "flight-ema"
+    # a table: a profile (here a file next to the recipe) plus overrides, stored complete so a
+    # worker rebuilds the same scenarios from the recipe's source alone
+    (tmp_path / "quiet.toml").write_text('profile = "flight-ema"\n[drive_torque]\nnoise = 0.0\n')
+    table = {"profile": "quiet.toml", "nut_axial_accel": {"noise_density_ug": 40.0}}
+    recipe = Recipe.from_dict(dict(base, instrumentation=table), base=tmp_path)
+    inst = recipe.runs()[0].scenario().instrumentation
+    assert inst.drive_torque.noise == 0.0 and inst.sample_rate == 10000
+    assert inst.nut_axial_accel.noise_density == pytest.approx(40e-6 * 9.80665)
+    rebuilt = Recipe.from_dict(recipe.source)
+    assert rebuilt.runs()[0].scenario() == recipe.runs()[0].scenario()
+    assert rebuilt.fingerprint == recipe.fingerprint
+    for bad, needle in [
+        (dict(base, sensors={"accel_noise": 0.05}), "replaced by instrumentation"),
+        (dict(base, instrumentation={"profile": "ideal", "sample_rate": 5e3}), "top-level"),
+        (dict(base, instrumentation="flight-emma"), "built-in profiles: flight-ema"),
+        (dict(base, instrumentation={"profile": "ideal", "axial_load": {"x": 1}}), "axial_load.x"),
+    ]:
+        with pytest.raises(RecipeError, match=needle):
+            Recipe.from_dict(bad)
+
+
 def test_workers_1_and_2_identical_and_readers(recipe_path, tmp_path):
     a = generate(recipe_path, tmp_path / "a", workers=1, progress=False)
     b = generate(recipe_path, tmp_path / "b", workers=2, progress=False)
@@ -122,7 +156,7 @@ def test_dataset_run_equals_simulation(recipe_path, tmp_path):
         scenario.design,
         scenario.health,
         scenario.profile,
-        scenario.sensors,
+        scenario.instrumentation,
         spec.seed,
         options=scenario.options,
     )

@@ -9,13 +9,25 @@ import pytest
 from prsm_health.dataset import load_recipe
 from prsm_health.diagnosis import DEFAULT_MODEL, diagnose, load_bundle
 from prsm_health.dynamics.simulate import simulate
-from prsm_health.sensors import SensorModel
 from prsm_health.states import HealthState, OperatingProfile
 
 # Simulates fourteen recordings for the shipped model.
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: The sensors the shipped model was trained with (the reference recipe before instrumentation
+#: profiles): every channel, 0.05 m/s² RMS accelerometer noise (5e-4 m/s²/√Hz over the 10 kHz
+#: band), a 4096-count screw encoder and a 0.1 µm linear encoder.
+TRAINING_SENSORS = {
+    "profile": "ideal",
+    **{
+        f"nut_{axis}_accel": {"noise_density": 5e-4}
+        for axis in ("axial", "tangential", "radial_x", "radial_y")
+    },
+    "screw_angle": {"counts_per_rev": 4096},
+    "nut_position": {"resolution": 1e-7},
+}
 
 
 @pytest.fixture(scope="module")
@@ -71,14 +83,13 @@ def test_off_grid_speeds_and_loads_with_noise(bundle):
             load_frequency=10.0,
             accel_time=0.002,
         )
-        sensors = SensorModel(accel_noise=0.05, encoder_counts=4096, linear_encoder_resolution=1e-7)
         from prsm_health.dynamics.model import SimulationOptions
 
         run = simulate(
             "paper01",
             HealthState.uniform(clearance),
             profile,
-            sensors,
+            TRAINING_SENSORS,
             1000 + k,
             options=SimulationOptions(contact_law="hertz"),
         )
@@ -95,7 +106,11 @@ def test_interval_widens_where_the_regime_hides_clearance(bundle):
             "paper01",
             HealthState.uniform(20e-6),
             profile,
-            SensorModel(accel_noise=0.05),
+            {
+                **TRAINING_SENSORS,
+                "screw_angle": {"counts_per_rev": 0},
+                "nut_position": {"resolution": 0.0},
+            },
             3,
             options=SimulationOptions(contact_law="hertz"),
         )

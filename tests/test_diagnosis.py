@@ -26,6 +26,7 @@ RECIPE = textwrap.dedent(
     design = "paper01"
     duration = 0.2
     sample_rate = 20000
+    instrumentation = "ideal"
     seed = 5
     test_fraction = 0.2
     [profile]

@@ -25,6 +25,7 @@ TINY = dict(
     design="paper01",
     duration=0.1,
     sample_rate=5000,
+    instrumentation="ideal",
     seed=7,
     test_fraction=0.25,
     profile=dict(

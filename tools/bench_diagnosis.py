@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import time
 
-from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOptions, simulate
+from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
 from prsm_health.diagnosis import diagnose_indicators, load_bundle
 from prsm_health.features import extract_features, windows
+
+AXES = ("axial", "tangential", "radial_x", "radial_y")
 
 
 def main() -> None:
@@ -27,7 +29,12 @@ def main() -> None:
             load_frequency=10.0,
             accel_time=0.002,
         ),
-        SensorModel(sample_rate=20_000, accel_noise=0.05),
+        # the shipped model's training sensors: all channels, 0.05 m/s² RMS accelerometer noise
+        # (5e-4 m/s²/√Hz over the 10 kHz band)
+        {
+            "profile": "ideal",
+            **{f"nut_{a}_accel": {"noise_density": 5e-4} for a in AXES},
+        },
         1,
         options=SimulationOptions(contact_law="hertz"),
     )

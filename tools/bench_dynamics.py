@@ -26,7 +26,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from prsm_health import HealthState, OperatingProfile, SensorModel, SimulationOptions, simulate
+from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
 from prsm_health.design import preset
 from prsm_health.dynamics import _kernels
 from prsm_health.dynamics import layout as L
@@ -37,7 +37,7 @@ PROFILE = dict(speed=100.0, load=100.0)
 
 def bench_kernel(duration: float) -> float:
     simulate(
-        "paper01", HealthState(), OperatingProfile(duration=0.005, **PROFILE), SensorModel()
+        "paper01", HealthState(), OperatingProfile(duration=0.005, **PROFILE), "ideal"
     )  # compile
     model = build_model(
         preset("paper01"),
@@ -152,9 +152,7 @@ def bench_startup() -> float:
 
 
 def _one_run(seed: int) -> int:
-    r = simulate(
-        "paper01", HealthState(), OperatingProfile(duration=0.2, **PROFILE), SensorModel(), seed
-    )
+    r = simulate("paper01", HealthState(), OperatingProfile(duration=0.2, **PROFILE), "ideal", seed)
     return len(r)
 
 

@@ -42,7 +42,6 @@ def _recording(window: float, sample_rate: float):
     from prsm_health import (
         HealthState,
         OperatingProfile,
-        SensorModel,
         SimulationOptions,
         simulate,
     )
@@ -58,7 +57,7 @@ def _recording(window: float, sample_rate: float):
             load_frequency=10.0,
             accel_time=0.002,
         ),
-        SensorModel(sample_rate=sample_rate),
+        {"profile": "ideal", "sample_rate": sample_rate},
         7,
         options=SimulationOptions(contact_law="hertz"),
     )

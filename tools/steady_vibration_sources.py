@@ -18,7 +18,6 @@ from prsm_health import (
     HealthState,
     ManufacturingVariation,
     OperatingProfile,
-    SensorModel,
     SimulationOptions,
     simulate,
 )
@@ -52,18 +51,18 @@ def level(variation: ManufacturingVariation) -> tuple[float, float, float, float
             "paper01",
             HealthState(),
             OperatingProfile(duration=0.3, speed=100.0, load=100.0),
-            SensorModel(sample_rate=20_000),
+            "ideal",
             seed,
             options=SimulationOptions(variation=variation),
         )
         steady = slice(len(r) // 3, None)
-        ax = r["nut_axial_accel"][steady]
+        ax = r.truth["nut_axial_accel"][steady]
         out.append(
             (
                 np.std(ax),
                 np.max(np.abs(ax - ax.mean())),
-                np.std(r["nut_tangential_accel"][steady]),
-                np.std(r["nut_radial_x_accel"][steady]),
+                np.std(r.truth["nut_tangential_accel"][steady]),
+                np.std(r.truth["nut_radial_x_accel"][steady]),
             )
         )
     return tuple(float(v) for v in np.mean(out, axis=0))

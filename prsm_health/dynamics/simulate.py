@@ -1,4 +1,4 @@
-"""Run orchestration: step choice, step guard, chunked RK4 integration, sensors, Run.
+"""Run orchestration: step choice, step guard, chunked RK4 integration, instrumentation, Run.
 
 :func:`simulate` is the public entry point (re-exported as ``prsm_health.simulate``).
 """
@@ -10,12 +10,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES, TRUTH_NAMES
+from ..channels import TRUTH_NAMES
 from ..design import DEFAULT_PRESET, PRSMDesign
 from ..drive_train import DriveTrain
 from ..errors import SimulationError, require
+from ..instrumentation import DEFAULT_PROFILE, Instrumentation
 from ..run import Run
-from ..sensors import SensorModel, decimate, measure
+from ..sensors import decimate
 from ..states import HealthState, OperatingProfile
 from . import _kernels
 from . import layout as L
@@ -138,21 +139,22 @@ def simulate(
     design: PRSMDesign | str | None = None,
     health: HealthState | None = None,
     profile: OperatingProfile | None = None,
-    sensors: SensorModel | None = None,
+    instrumentation: Instrumentation | str | None = None,
     seed: int = 0,
     *,
     options: SimulationOptions | None = None,
     drive_train: DriveTrain | None = None,
     progress: bool = False,
 ) -> Run:
-    """Simulate a PRSM run and return its sampled sensor channels.
+    """Simulate a PRSM run and return what its instrumentation measures.
 
     Parameters
     ----------
     design : PRSMDesign or preset name, default "paper01"
     health : HealthState, default HealthState()
     profile : OperatingProfile, default OperatingProfile()
-    sensors : SensorModel, default SensorModel()
+    instrumentation : Instrumentation, profile name or profile TOML file, default "flight-ema"
+        The sensors fitted and the sample rate (:mod:`prsm_health.instrumentation`).
     seed : int
         Seeds manufacturing variation, uneven wear and sensor noise: same seed, same run
         (bit-identical).
@@ -166,9 +168,9 @@ def simulate(
     Returns
     -------
     Run
-        Measured channels at ``sensors.sample_rate``; ``run.truth`` holds the truth signals on
-        the same time axis (anti-alias decimated, no sensor errors), ``run.energy`` the
-        energy book.
+        The fitted measured channels at ``instrumentation.sample_rate``; ``run.truth`` holds
+        the truth signals on the same time axis (anti-alias decimated, no sensor errors),
+        ``run.energy`` the energy book.
 
     Raises
     ------
@@ -187,7 +189,7 @@ def simulate(
         design=design or DEFAULT_PRESET,
         health=health or HealthState(),
         profile=profile or OperatingProfile(),
-        sensors=sensors or SensorModel(),
+        instrumentation=instrumentation or DEFAULT_PROFILE,
         options=options or SimulationOptions(),
         seed=int(seed),
         drive_train=drive_train or DriveTrain(),
@@ -198,9 +200,9 @@ def simulate(
 def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     """Simulate a :class:`~prsm_health.scenario.Scenario`; see :func:`simulate`."""
     design, health, profile = scenario.design, scenario.health, scenario.profile
-    sensors, options, seed = scenario.sensors, scenario.options, scenario.seed
+    instrumentation, options, seed = scenario.instrumentation, scenario.options, scenario.seed
     model = build_model(design, health, profile, options, seed, scenario.drive_train)
-    h, factor = choose_step(options.max_step, sensors.sample_rate)
+    h, factor = choose_step(options.max_step, instrumentation.sample_rate)
     h_stable, f_max = max_stable_step(model)
     if h > h_stable:
         raise SimulationError(
@@ -217,21 +219,14 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
             0.0  # energy book starts at t = 0
         )
     truth_raw = _truth_from_record(_integrate(model, y, h, n_steps, progress))
-    # What each sensor reads (contract): the drive's angle, speed and torque on the motor side.
-    sensed = {
-        "screw_angle": "motor_angle",
-        "screw_speed": "motor_speed",
-        "drive_torque": "motor_torque",
-    }
-    channels = measure(
-        {name: truth_raw[sensed.get(name, name)] for name in CHANNEL_NAMES},
+    channels = instrumentation.measure(
+        truth_raw,
         1.0 / h,
-        sensors,
-        np.random.default_rng([seed, 0x53454E53]),  # "SENS": noise stream of this seed
+        np.random.default_rng([seed, 0x53454E53]),  # "SENS": this seed's sensors
     )
     truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
-    n_out = len(channels["screw_angle"])
-    time = np.arange(n_out) / sensors.sample_rate
+    n_out = len(next(iter(truth.values())))
+    time = np.arange(n_out) / instrumentation.sample_rate
     nq = model.n_coordinates
     energy = {
         "drive": float(y[2 * nq + L.X_W_DRIVE]),
@@ -242,7 +237,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     return Run(
         time=time,
         channels=channels,
-        sample_rate=sensors.sample_rate,
+        sample_rate=instrumentation.sample_rate,
         labels={**scenario.labels(), **realised_clearances(model)},
         scenario={
             **scenario.to_dict(),

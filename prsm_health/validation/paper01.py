@@ -14,7 +14,6 @@ from ..drive_train import DriveTrain
 from ..dynamics.model import SimulationOptions
 from ..dynamics.simulate import simulate
 from ..kinematics import characteristic_frequencies, speed_ratios
-from ..sensors import SensorModel
 from ..spectra import amplitude_spectrum, dominant_frequency
 from ..states import HealthState, ManufacturingVariation, OperatingProfile
 from ..stiffness.thread import roller_side_stiffness
@@ -30,7 +29,7 @@ def _simulate(speed: float, clearance: float, duration: float = 0.4):
         "paper01",
         HealthState(clearance_screw=clearance, clearance_nut=clearance, clearance_gear=10e-6),
         OperatingProfile(duration=duration, speed=speed, load=100.0),
-        SensorModel(sample_rate=20_000),
+        "ideal",
         1,
         options=IDEAL,
         drive_train=DriveTrain.paper01(),

@@ -13,7 +13,6 @@ from prsm_health import (
     HealthState,
     ManufacturingVariation,
     OperatingProfile,
-    SensorModel,
     SimulationOptions,
     preset,
     simulate,
@@ -111,7 +110,7 @@ def test_energy_balance_with_drive_train_payload_and_excitation(drive_train, dri
         "paper01",
         HealthState(),
         OperatingProfile(duration=0.3, drive=drive),
-        SensorModel(sample_rate=20_000),
+        "ideal",
         3,
         drive_train=drive_train,
     )
@@ -153,7 +152,7 @@ def test_steady_vibration_is_in_the_documented_band(seed):
             "paper01",
             HealthState(),
             OperatingProfile(duration=0.3),
-            SensorModel(sample_rate=20_000),
+            "ideal",
             seed,
             options=SimulationOptions(variation=variation),
         )

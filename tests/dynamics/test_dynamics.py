@@ -11,7 +11,6 @@ from prsm_health import (
     HealthState,
     ManufacturingVariation,
     OperatingProfile,
-    SensorModel,
     SimulationError,
     SimulationOptions,
     characteristic_frequencies,
@@ -46,7 +45,7 @@ def run(
         "paper01",
         HealthState.uniform(clearance),
         OperatingProfile(duration=duration, speed=speed, load=load, **profile),
-        SensorModel(sample_rate=20_000),
+        "ideal",
         seed,
         options=options,
         drive_train=drive_train,
@@ -175,7 +174,7 @@ def test_clearance_invisible_while_preload_holds_contact():
             "paper01",
             health,
             OperatingProfile(duration=0.3, load=100.0),
-            SensorModel(),
+            "ideal",
             1,
             options=IDEAL,
         )
@@ -264,7 +263,7 @@ def test_torque_signal_follows_load_lubricant_and_wear():
         "paper01",
         HealthState.uniform(10e-6, friction_scale=2.0),
         OperatingProfile(duration=0.2),
-        SensorModel(),
+        "ideal",
         1,
     )
     half = len(base) // 2

@@ -11,7 +11,7 @@ SCRIPT = """
 import json, numpy as np
 from prsm_health import *
 r = simulate("paper01", HealthState(), OperatingProfile(duration=0.002, speed=50.0, load=200.0),
-             SensorModel(sample_rate=20000), 3, options=SimulationOptions(settle_time=0.0))
+             "ideal", 3, options=SimulationOptions(settle_time=0.0))
 print(json.dumps({k: v.tolist() for k, v in r.channels.items()}))
 """
 

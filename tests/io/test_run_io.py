@@ -8,7 +8,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from prsm_health import HealthState, OperatingProfile, SensorModel, simulate
+from prsm_health import HealthState, OperatingProfile, simulate
 from prsm_health.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
 from prsm_health.errors import PRSMHealthError
 from prsm_health.io.csv import read_csv
@@ -17,7 +17,7 @@ from prsm_health.io.parquet import read_run_parquet, write_run_parquet
 
 @pytest.fixture(scope="module")
 def run():
-    return simulate("paper01", HealthState(), OperatingProfile(duration=0.02), SensorModel(), 4)
+    return simulate("paper01", HealthState(), OperatingProfile(duration=0.02), "ideal", 4)
 
 
 def test_round_trip_exact(tmp_path, run):
@@ -50,7 +50,7 @@ def test_independent_readers(tmp_path, run):
 
 
 def test_simulated_truth_is_the_physics_without_sensor_errors(run):
-    # The default SensorModel adds no noise, so each reading equals the true value it reads:
+    # The ideal profile adds no sensor error, so each reading equals the true value it reads:
     # the motor side for angle and torque. With the default drive train the linkage force
     # (axial_load) differs from the applied force by the payload's vibration, and the screw
     # sits pushed back on its thrust bearing.
