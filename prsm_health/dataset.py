@@ -75,6 +75,7 @@ class Recipe:
     profile: dict = field(default_factory=dict)
     instrumentation: str | dict = DEFAULT_PROFILE
     options: dict = field(default_factory=dict)
+    drive_train: dict = field(default_factory=dict)
     faults: FaultThresholds = field(default_factory=FaultThresholds)
     test_fraction: float = 0.2
     batch_size: int = DEFAULT_BATCH
@@ -344,6 +345,7 @@ class RunSpec:
                     "profile": profile,
                     "instrumentation": _with_sample_rate(r.instrumentation, r.sample_rate),
                     "options": r.options,
+                    "drive_train": r.drive_train,
                     "seed": self.seed,
                 }
             )
