@@ -441,6 +441,7 @@ def _scaled(value, factor: float = 1.0):
 def _cmd_simulate(args) -> int:
     from pathlib import Path
 
+    from .drive_train import load_drive_train
     from .kinematics import characteristic_frequencies
     from .scenario import Scenario
 
@@ -472,7 +473,11 @@ def _cmd_simulate(args) -> int:
                 "load": args.load,
                 "load_amplitude": args.load_amplitude,
                 "load_frequency": args.load_frequency,
+                "load_ramp_time": args.load_ramp_time,
+                "load_ramp_shape": args.load_ramp_shape,
+                "drive": args.drive,
             },
+            "drive_train": load_drive_train(args.drive_train),
             "instrumentation": {"profile": args.instrumentation}
             | ({} if args.sample_rate is None else {"sample_rate": args.sample_rate}),
             "options": {
@@ -822,7 +827,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_simulate_parser(command, default_preset) -> None:
     from .instrumentation import DEFAULT_PROFILE
-    from .states import LOADS, MOTIONS
+    from .states import DRIVES, LOADS, MOTIONS, RAMP_SHAPES
 
     s = command("simulate", "simulate a PRSM run (paper 01 dynamics) and write it")
     s.add_argument("--design", type=_design, default=default_preset, help=DESIGN_HELP)
@@ -845,6 +850,32 @@ def _add_simulate_parser(command, default_preset) -> None:
     )
     s.add_argument("--period", type=_finite_float, default=0.1, help="reversing motion period [s]")
     s.add_argument("--load-profile", choices=LOADS, default="constant", help="axial load profile")
+    s.add_argument(
+        "--load-ramp-time",
+        type=_finite_float,
+        default=None,
+        help="duration of each reversal of the reversing load [s] (None: --accel-time)",
+    )
+    s.add_argument(
+        "--load-ramp-shape",
+        choices=RAMP_SHAPES,
+        default="linear",
+        help="reversals of the reversing load: straight ramp or raised cosine",
+    )
+    s.add_argument(
+        "--drive",
+        choices=DRIVES,
+        default="prescribed",
+        help="ideal servo (prescribed motor angle), PI speed loop, or position loop on it",
+    )
+    s.add_argument(
+        "--drive-train",
+        default="actuator",
+        metavar="NAME_OR_FILE",
+        help="motor, coupling, thrust bearing, linkage and payload: 'actuator' (a flight EMA), "
+        "'paper01' (rigid screw drive, ideal force on the nut) or a TOML file of DriveTrain "
+        "fields (docs/formats.md)",
+    )
     s.add_argument(
         "--load-amplitude", type=_finite_float, default=0.0, help="load swing around --load [N]"
     )

@@ -35,11 +35,14 @@ marked as such — replace them with your actuator's values.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
 
-from .errors import require, require_range
+from .errors import ParameterError, require, require_range
 
 LOAD_APPLICATIONS = ("payload", "nut")
+#: Named drive trains: the default flight-control actuator, and paper 01's idealisation.
+NAMED = ("actuator", "paper01")
 
 
 @dataclass(frozen=True)
@@ -153,3 +156,30 @@ class DriveTrain:
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+def load_drive_train(source: str | Path | dict | DriveTrain) -> DriveTrain:
+    """A drive train from a name (:data:`NAMED`), a TOML file of :class:`DriveTrain` fields
+    (SI, as named in the dataclass), or their dict; unknown keys are named."""
+    if isinstance(source, DriveTrain):
+        return source
+    if isinstance(source, str) and source in NAMED:
+        return DriveTrain.paper01() if source == "paper01" else DriveTrain()
+    if isinstance(source, (str, Path)):
+        from .tomlfile import read_toml
+
+        path = Path(source)
+        if path.suffix != ".toml":
+            raise ParameterError(
+                "drive_train", str(source), f"must be one of {', '.join(NAMED)} or a .toml file"
+            )
+        source = read_toml(path, "drive-train file")
+    allowed = [f.name for f in fields(DriveTrain)]
+    unknown = sorted(set(source) - set(allowed))
+    if unknown:
+        raise ParameterError(
+            f"drive_train.{unknown[0]}",
+            source[unknown[0]],
+            f"unknown key; allowed: {', '.join(allowed)}",
+        )
+    return DriveTrain(**source)

@@ -204,3 +204,36 @@ def test_cosine_load_reversal_is_smooth():
 def test_drive_train_errors_name_the_field(field, value):
     with pytest.raises(ParameterError, match=f"drive_train.{field}"):
         DriveTrain(**{field: value})
+
+
+def test_drive_train_from_names_files_scenarios_and_recipes(tmp_path):
+    from prsm_health.dataset import Recipe
+    from prsm_health.drive_train import load_drive_train
+    from prsm_health.scenario import Scenario
+
+    assert load_drive_train("paper01") == DriveTrain.paper01()
+    assert load_drive_train("actuator") == DriveTrain()
+    path = tmp_path / "ema.toml"
+    path.write_text("payload_mass = 25.0\nthrust_bearing_play = 2e-6\n")
+    assert load_drive_train(path) == DriveTrain(payload_mass=25.0, thrust_bearing_play=2e-6)
+    path.write_text("payload = 25.0\n")
+    with pytest.raises(ParameterError, match="drive_train.payload.*allowed: motor_inertia"):
+        load_drive_train(path)
+    with pytest.raises(ParameterError, match="actuator, paper01"):
+        load_drive_train("nope")
+    scenario = Scenario.from_dict({"drive_train": {"payload_mass": 25.0}})
+    (tmp_path / "s.toml").write_text(scenario.to_toml())
+    assert Scenario.from_toml(tmp_path / "s.toml") == scenario
+    recipe = Recipe.from_dict(
+        {
+            "name": "dt",
+            "design": "paper01",
+            "duration": 0.05,
+            "sample_rate": 20000,
+            "seed": 1,
+            "sweep": {"speed": [50.0]},
+            "drive_train": {"load_application": "nut", "payload_mass": 3.0},
+        }
+    )
+    spec = recipe.runs()[0]
+    assert spec.scenario().drive_train == DriveTrain(load_application="nut", payload_mass=3.0)
