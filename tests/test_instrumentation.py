@@ -311,3 +311,17 @@ def test_describe_gives_every_parameter_with_its_unit():
     units = {p["name"]: p["unit"] for p in accel["parameters"]}
     assert units["noise_density"] == "m/s^2/sqrt(Hz)" and units["range"] == "m/s^2"
     assert info["sensors"]["screw_speed"]["reads"] == "screw_angle (measured)"
+
+
+@pytest.mark.parametrize("name", sorted(EXPECTED))
+def test_a_simulated_run_keeps_every_truth_signal_out_of_its_measurements(name):
+    # Must-show of the instrumentation issue: whatever the profile, the run's channels are
+    # measured channels of the contract only; every truth signal is in run.truth, apart.
+    from prsm_health import OperatingProfile, simulate
+    from prsm_health.channels import CHANNEL_NAMES, TRUTH_NAMES
+
+    run = simulate(profile=OperatingProfile(duration=0.02), instrumentation=name, seed=1)
+    assert set(run.channels) == EXPECTED[name] and set(run.channels) <= set(CHANNEL_NAMES)
+    truth_only = set(TRUTH_NAMES) - set(CHANNEL_NAMES)
+    assert truth_only.isdisjoint(run.channels) and list(run.truth) == list(TRUTH_NAMES)
+    assert not any(k.startswith("truth_") for k in run.channels)
