@@ -435,7 +435,15 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     if problems:
         raise PRSMHealthError(f"{dataset_dir}: cannot train: " + "; ".join(problems))
     table = dataset_features(ds, progress=progress)
-    features = list(FEATURES)
+    # Indicators the dataset's instrumentation cannot give (all NaN: a channel it does not fit)
+    # carry no information and are left out of the model; diagnose() needs only the rest.
+    features = [name for name in FEATURES if table[name].notna().any()]
+    absent = [name for name in FEATURES if name not in features]
+    present_groups = {
+        group: kept
+        for group, members in GROUPS.items()
+        if (kept := [name for name in members if name in features])
+    }
     train_rows = table[table["split"] == "train"]
     test_rows = table[table["split"] == "test"]
     x_train, x_test = train_rows[features], test_rows[features]
@@ -445,6 +453,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         "dataset": str(dataset_dir),
         "recipe": ds.manifest["name"],
         "runs": {"train": len(train_rows), "test": len(test_rows)},
+        "indicators_absent": absent,
     }
     bundle: dict = {"feature_names": features, "clearance": None, "fault": None}
 
@@ -480,7 +489,12 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
             held_out["baseline_mae"] = constant_baseline_mae(y_test, y)[0]
             if len(y_test):
                 importance = permutation_importance_table(
-                    estimator, x_test, y_test, n_repeats=5, random_state=random_state, groups=GROUPS
+                    estimator,
+                    x_test,
+                    y_test,
+                    n_repeats=5,
+                    random_state=random_state,
+                    groups=present_groups,
                 )
                 metrics["clearance_importance"] = _importance_records(importance)
         metrics["clearance_test"] = held_out
@@ -513,7 +527,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
                     y_test,
                     n_repeats=5,
                     random_state=random_state,
-                    groups=GROUPS,
+                    groups=present_groups,
                 )
                 metrics["fault_importance"] = _importance_records(importance)
         notes += fault_warnings(

@@ -122,6 +122,16 @@ def test_lost_motion_of_a_lagging_nut():
     lag = 15e-6 * np.sign(np.sin(2 * math.pi * 10 * t) + 1e-12)
     r, _ = synthetic(n, load=load, extra={"nut_position": speed_ratios(D).nut * 100.0 * t - lag})
     assert extract_features(r)["lost_motion"] == pytest.approx(30e-6, rel=1e-6)
+    # An LVDT's S-shaped nonlinearity over the stroke (here 200 µm, 13× the lag) is a smooth
+    # function of position: removed, the lag still reads 30 µm (1 %: the S-curve is not exactly
+    # a 7th-degree polynomial). Without a load cell the load's sign comes from the torque.
+    pos = speed_ratios(D).nut * 100.0 * t
+    s_curve = 200e-6 * np.sin(2 * math.pi * (pos - pos.mean()) / np.ptp(pos))
+    r, _ = synthetic(n, load=load, extra={"nut_position": pos - lag + s_curve})
+    assert extract_features(r)["lost_motion"] == pytest.approx(30e-6, rel=0.01)
+    r.channels.pop("axial_load")
+    r.channels["drive_torque"] = 1e-3 * load(t)
+    assert extract_features(r)["lost_motion"] == pytest.approx(30e-6, rel=0.01)
     steady, _ = synthetic(n)
     assert math.isnan(extract_features(steady)["lost_motion"])  # no reversal: not computable
 

@@ -57,12 +57,12 @@ def evaluate(bundle, table) -> dict:
     rows = [{k: row[k] for k in bundle.feature_names} for _, row in table.iterrows()]
     results = diagnose_indicators(rows, bundle)
     y = clearance_target(table)
-    est = np.array([r["clearance"]["estimate"] for r in results], float)
-    lo = np.array([r["clearance"]["lower"] for r in results], float)
-    hi = np.array([r["clearance"]["upper"] for r in results], float)
+    est = np.array([r.clearance["estimate"] for r in results], float)
+    lo = np.array([r.clearance["lower"] for r in results], float)
+    hi = np.array([r.clearance["upper"] for r in results], float)
     from sklearn.metrics import f1_score
 
-    pred = [r["fault_class"] for r in results]
+    pred = [r.fault_class for r in results]
     return {
         "n": len(y),
         "clearance_mae": float(np.mean(np.abs(est - y))),
@@ -79,7 +79,9 @@ def ablation(work: Path) -> list[dict]:
     table = dataset_features(Dataset(work / "clearance-study"))
     train_rows, test_rows = table[table["split"] == "train"], table[table["split"] == "test"]
     y_train, y_test = clearance_target(train_rows), clearance_target(test_rows)
-    everything = [c for c in table.columns if c in set(sum(GROUPS.values(), []))]
+    # only the indicators this instrumentation gives (an absent channel's are all NaN)
+    given = {c for c in table.columns if table[c].notna().any()}
+    everything = [c for c in table.columns if c in set(sum(GROUPS.values(), [])) & given]
     subsets = {
         "all indicators": everything,
         "all but lost motion (vibration + torque only)": [
@@ -89,9 +91,13 @@ def ablation(work: Path) -> list[dict]:
         "mesh + operating": GROUPS["mesh"] + GROUPS["operating"],
         "classic + operating": GROUPS["classic"] + GROUPS["operating"],
         "lost motion + operating": GROUPS["lost_motion"] + GROUPS["operating"],
+        "torque rattle + operating": GROUPS["torque_rattle"] + GROUPS["operating"],
     }
     rows = []
     for label, cols in subsets.items():
+        cols = [c for c in cols if c in given]
+        if not cols:
+            continue
         model = ClearanceEstimator(**CLEARANCE_PARAMS)  # the settings train() uses
         model.fit(train_rows[cols], y_train)
         pred = model.predict(test_rows[cols])
