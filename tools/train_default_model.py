@@ -148,8 +148,13 @@ file and checked on load.
 **Data.** `datasets/clearance-study.toml`: paper-01 PRSM, {metrics["runs"]["train"]} training and
 {metrics["runs"]["test"]} held-out runs (random 20 % split), clearance drawn uniformly in 0–40 µm
 per run (screw = nut = gear), screw speed 50/80/110 rad/s, mean load 0/100/200 N with a ±300 N reversing load at
-10 Hz, lubricant friction scale 1.0/2.2, Hertzian flanks, manufacturing variation on,
-accelerometer noise 0.05 m/s², 4096-count encoder, 0.1 µm linear encoder. Target: thread
+10 Hz, lubricant friction scale 1.0/2.2, Hertzian flanks, manufacturing variation and
+geometric errors on (ISO 3408-3 grade 5), the default drive train (motor, coupling, thrust
+bearing, 10 kg payload on its linkage), measured by the `flight-ema` instrumentation (resolver,
+phase-current torque, LVDT on the rod, one axial accelerometer; docs/instrumentation.md) — no
+load cell, no friction or carrier truth. Indicators it cannot give (tangential and radial
+accelerations, load) are left out: {len(metrics["indicators_absent"])} of
+{len(metrics["feature_names"]) + len(metrics["indicators_absent"])}. Target: thread
 half-clearance b (mean of screw and nut sides) [m]; classes: healthy / wear (b ≥ 15 µm) /
 severe_wear (b ≥ 30 µm) / lubrication (friction scale ≥ 1.8), wear taking precedence.
 
@@ -181,13 +186,14 @@ Ablation (clearance estimator retrained on feature subsets, held-out split):
 |---|---|---|---|---|
 {ablation_rows}
 
-Groups: {", ".join(f"{k} ({len(v)})" for k, v in GROUPS.items())}. Lost motion at the load
-reversals (nut position against the screw angle) carries the clearance almost alone: it
+Groups (all indicators, before the instrumentation's): {", ".join(f"{k} ({len(v)})" for k, v in GROUPS.items())}.
+Lost motion at the load reversals (LVDT position against the resolver angle, the sensor's
+nonlinearity removed as a smooth function of position) carries the clearance almost alone: it
 measures the 4b of play directly, so given it the other groups add little (permutation
-importance). The ablation shows what the vibration indicators can do without it — the case of an
-actuator without a linear encoder: the shifted axial frequency alone (with the operating
-point) and the classic vibration indicators each estimate the clearance to about 1–2 µm, the
-gear-mesh lines much more weakly (they respond to clearance only through load sharing).
+importance). The ablation shows what the other indicators can do without it — an actuator
+without an output position sensor: the axial accelerometer's classic indicators reach about
+1.5–2 µm, the torque rattle (bounces across the gap seen in the motor current) and the shifted
+axial frequency much less.
 
 ## Limits
 
@@ -196,9 +202,13 @@ gear-mesh lines much more weakly (they respond to clearance only through load sh
   each roller on one flank); the diagnosis then reports the whole trained range 0–40 µm as the
   interval (regime gate on the lost-motion indicator).
 - Outside 0–40 µm, 50–110 rad/s, −300…500 N or friction scale 1–2.2 the model extrapolates.
-- Lubricant: trained on friction scales 1.0 and 2.2 only; off-grid scales near the 1.8
-  class threshold are where the classifier errs (off-grid macro-F1 above), between wear and
-  lubrication.
+- Lubricant: trained on friction scales 1.0 and 2.2 only, seen through the motor current
+  alone (no friction truth); off-grid scales near the 1.8 class threshold are where the
+  classifier errs (off-grid macro-F1 above), between wear and lubrication.
+- Interval coverage: held-out and off-grid coverage fall below the nominal 90 % (table):
+  the conformal calibration holds for exchangeable data and, with 79 and 60 runs, the binomial
+  spread is ±3–4 %; off-grid points are not exchangeable with the grid. Read the intervals as
+  ≈ 80–90 %.
 - Real recordings differ from the simulator (mounting, sensor placement, temperature): retrain
   or at least validate on measured data before trusting absolute numbers.
 - The split-conformal guarantee assumes exchangeable data (same distribution as training).
