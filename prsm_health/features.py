@@ -38,6 +38,7 @@ from functools import lru_cache
 
 import numpy as np
 from scipy import signal, stats
+from scipy.ndimage import uniform_filter1d
 
 from .channels import VIBRATION
 from .design import PRSMDesign, preset
@@ -325,10 +326,12 @@ def extract_features(
     # ---- reversals: of the motion, of the load (load cell), or of the drive torque when no
     # load cell is fitted (the motor current reverses with the load it carries)
     torque = ch.get("drive_torque")
+    # the motor torque averaged over 5 ms: current noise and ripple out, load reversals kept
+    slow_torque = None if torque is None else uniform_filter1d(torque, max(1, int(0.005 * rate)))
     reversal = (
         (speed is not None and np.min(speed) < 0 < np.max(speed))
         or (load is not None and np.min(load) < 0 < np.max(load))
-        or (load is None and torque is not None and _reverses(torque))
+        or (load is None and slow_torque is not None and _reverses(slow_torque))
     )
     if reversal and torque is not None:
         out["torque_rattle_rate"] = _rattle_rate(torque, rate)
@@ -338,7 +341,7 @@ def extract_features(
             if speed is not None and np.min(speed) < 0 < np.max(speed):
                 side = np.sign(speed)
             else:  # the load's sign, from the load cell or else the drive torque
-                force = load if load is not None else torque
+                force = load if load is not None else slow_torque
                 side = np.sign(force - 0.5 * (np.max(force) + np.min(force)))
             out["lost_motion"] = _lost_motion(
                 ch["nut_position"], ch["screw_angle"], ratios.nut, side
@@ -367,7 +370,8 @@ def _lost_motion(position: np.ndarray, angle: np.ndarray, lead: float, side: np.
 
 
 def _reverses(x: np.ndarray) -> bool:
-    # A sign change beyond the noise: both signs reached by a tenth of the range or more.
+    # A sign change beyond the noise: both signs reached by a tenth of the range or more (of a
+    # smoothed signal: a steady run's noise around a small mean must not count).
     margin = 0.1 * float(np.ptp(x))
     return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
 

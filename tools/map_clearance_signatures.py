@@ -85,8 +85,12 @@ def correlations(results) -> dict[tuple[str, float, float], dict[str, float]]:
         for name in INDICATORS:
             y = np.array([r[1][name] for r in rows], dtype=float)
             ok = np.isfinite(y)
-            usable = ok.sum() >= 6 and np.ptp(y[ok]) > 0
-            out[key][name] = float(stats.spearmanr(b[ok], y[ok])[0]) if usable else np.nan
+            if ok.sum() < 6:  # not computable in this regime (e.g. lost motion without reversal)
+                out[key][name] = np.nan
+            elif np.ptp(y[ok]) == 0:  # computable, but the same for every clearance
+                out[key][name] = 0.0
+            else:
+                out[key][name] = float(stats.spearmanr(b[ok], y[ok])[0])
     return out
 
 
@@ -101,7 +105,7 @@ def verdicts(rho) -> dict[str, dict[str, str]]:
                 [rho[(regime, s, lo)][name] for s, lo in itertools.product(SPEEDS, LOADS)]
             )
             if np.any(np.isnan(values)):
-                table[regime][name] = "n/a"
+                table[regime][name] = "not computable"
             elif np.all(values >= 0.8):
                 table[regime][name] = f"↑ ({values.min():.2f})"
             elif np.all(values <= -0.8):
