@@ -201,13 +201,15 @@ def test_diagnose_several_windows_and_time_start(client, recording):
 
 
 def test_diagnose_subset_of_channels(client, recording):
+    # The shipped model was trained on what flight-ema fits: a recording without those channels
+    # cannot be diagnosed by it, and the answer names what is missing (not a guess).
     body = {
         "sample_rate": recording.sample_rate,
         "channels": {"nut_axial_accel": recording["nut_axial_accel"].tolist()},
     }
     r = client.post("/v1/diagnose", json=body)
-    assert r.status_code == 200, r.text
-    assert r.json()["indicators"]["lost_motion"] is None  # missing channels: null indicators
+    assert r.status_code == 422
+    assert "lacks channel(s) screw_angle, screw_speed, nut_position, drive_torque" in r.text
 
 
 def _mutate(run, kind):
