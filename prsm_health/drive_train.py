@@ -38,7 +38,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
-from .errors import ParameterError, require, require_range
+from .errors import ParameterError, require, require_known_keys, require_range
 
 LOAD_APPLICATIONS = ("payload", "nut")
 #: Named drive trains: the default flight-control actuator, and paper 01's idealisation.
@@ -175,11 +175,5 @@ def load_drive_train(source: str | Path | dict | DriveTrain) -> DriveTrain:
             )
         source = read_toml(path, "drive-train file")
     allowed = [f.name for f in fields(DriveTrain)]
-    unknown = sorted(set(source) - set(allowed))
-    if unknown:
-        raise ParameterError(
-            f"drive_train.{unknown[0]}",
-            source[unknown[0]],
-            f"unknown key; allowed: {', '.join(allowed)}",
-        )
+    require_known_keys("drive_train", source, allowed)
     return DriveTrain(**source)

@@ -84,3 +84,15 @@ def require_range(
     brackets = ("[", "]") if inclusive else ("(", ")")
     suffix = f" {unit}" if unit else ""
     require(ok, field, value, f"must lie in {brackets[0]}{low:g}, {high:g}{brackets[1]}{suffix}")
+
+
+def require_known_keys(table: str, values: dict, allowed) -> None:
+    """Refuse a key of ``values`` not in ``allowed``, naming ``table.key`` and the allowed keys."""
+    allowed = list(allowed)
+    unknown = sorted(set(values) - set(allowed))
+    if unknown:
+        raise ParameterError(
+            f"{table}.{unknown[0]}",
+            values[unknown[0]],
+            f"unknown key; allowed: {', '.join(allowed)}",
+        )

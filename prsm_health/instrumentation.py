@@ -43,7 +43,7 @@ from typing import ClassVar
 import numpy as np
 from scipy import signal
 
-from .errors import ParameterError, require, require_range
+from .errors import ParameterError, require, require_known_keys, require_range
 from .sensors import decimate
 from .tomlfile import read_toml, toml_value
 
@@ -891,13 +891,7 @@ def _from_table(data: dict, base: Path | None, default_name: str) -> Instrumenta
     """A profile from its dict form: complete, or ``profile = …`` plus overrides."""
     data = dict(data)
     allowed = ["profile", *_TOP_KEYS, *SENSOR_CLASSES]
-    unknown = sorted(set(data) - set(allowed))
-    if unknown:
-        raise ParameterError(
-            f"instrumentation.{unknown[0]}",
-            data[unknown[0]],
-            f"unknown key; allowed: {', '.join(allowed)}",
-        )
+    require_known_keys("instrumentation", data, allowed)
     if "profile" in data:
         ref = data.pop("profile")
         require(

@@ -32,7 +32,7 @@ from .design import DEFAULT_PRESET, PRESETS, PRSMDesign, preset
 from .design_files import design_toml_tables, load_design
 from .drive_train import DriveTrain
 from .dynamics.model import SimulationOptions
-from .errors import ParameterError, require
+from .errors import ParameterError, require, require_known_keys
 from .instrumentation import (
     DEFAULT_PROFILE,
     Instrumentation,
@@ -225,11 +225,5 @@ def _group(name: str, kind: type, values) -> object:
         allowed.append("clearance")
     if kind is SimulationOptions:
         allowed.append("ideal")
-    unknown = sorted(set(values) - set(allowed))
-    if unknown:
-        raise ParameterError(
-            f"{name}.{unknown[0]}",
-            values[unknown[0]],
-            f"unknown key; allowed: {', '.join(allowed)}",
-        )
+    require_known_keys(name, values, allowed)
     return kind(**values)
