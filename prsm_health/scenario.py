@@ -16,6 +16,7 @@ The dict form (and the TOML form, the same tables)::
     [health]   clearance = 20e-6             # shorthand for screw, nut and gear; or each field
     [profile]  duration = 0.5, speed = 100.0, load = 100.0, …   (OperatingProfile fields)
     [options]  contact_law = "hertz", ideal = true, …           (SimulationOptions fields)
+    [drive_train]  payload_mass = 25.0, …                       (DriveTrain fields)
 
 The ``[instrumentation]`` table holds ``profile = "flight-ema"`` plus overrides (``sample_rate``,
 ``[instrumentation.nut_axial_accel] noise_density_ug = 40``, ``fitted = false``), or a complete
@@ -64,6 +65,8 @@ class Scenario:
     options : SimulationOptions
     seed : int
         Seeds manufacturing variation, uneven wear and sensor errors (same seed, same run).
+    drive_train : DriveTrain
+        Motor, coupling, thrust bearing, linkage and payload (default: a flight EMA).
     """
 
     design: PRSMDesign = field(default_factory=preset)
