@@ -6,7 +6,7 @@ Public API (SI units throughout), imported lazily so ``import prsm_health`` stay
   :class:`OperatingProfile`, :class:`SimulationOptions`, :class:`Scenario`
 - instrumentation: :class:`Instrumentation`, :func:`load_instrumentation`,
   :func:`list_profiles` (built-in sensor profiles: ideal, lab-rig, flight-ema, minimal)
-- kinematics: :func:`speed_ratios`, :func:`characteristic_frequencies`
+- kinematics: :func:`speed_ratios`, :func:`characteristic_frequencies`, :func:`defect_frequencies`
 - simulation: :func:`simulate` (design, health, profile, instrumentation, seed) → :class:`Run`
 - data: :class:`Dataset`, :func:`read_mcap`, :func:`write_mcap`, :func:`read_recording`
 - diagnostics: :func:`extract_features`, :func:`load_model` (a diagnosis model bundle),
@@ -39,6 +39,7 @@ _EXPORTS = {
     "simulate": ".dynamics.simulate",
     "Run": ".run",
     "characteristic_frequencies": ".kinematics",
+    "defect_frequencies": ".kinematics",
     "speed_ratios": ".kinematics",
     "ParameterError": ".errors",
     "PRSMHealthError": ".errors",

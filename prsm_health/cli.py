@@ -80,7 +80,7 @@ def _print_validation_text(rows, width: int = 100) -> None:
 
 # ----------------------------------------------------------------------------- kinematics
 def _cmd_kinematics(args) -> int:
-    from .kinematics import characteristic_frequencies, speed_ratios
+    from .kinematics import characteristic_frequencies, defect_frequencies, speed_ratios
 
     design = args.design
     ratios = speed_ratios(design)
@@ -97,6 +97,7 @@ def _cmd_kinematics(args) -> int:
         "effective_lead": ratios.effective_lead,
         "nut_speed": ratios.nut * args.speed,
         "frequencies": freqs.as_dict(),
+        "defect_frequencies": defect_frequencies(design, args.speed),
     }
     if args.json:
         _print_json(out)
@@ -109,6 +110,7 @@ def _cmd_kinematics(args) -> int:
         ("nut speed", out["nut_speed"], "m/s"),
     ]
     rows += [(f"f_{k}", v if v is not None else "–", "Hz") for k, v in out["frequencies"].items()]
+    rows += [(f"defect {k}", v, "Hz") for k, v in out["defect_frequencies"].items()]
     _print_table(rows)
     return 0
 

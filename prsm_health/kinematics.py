@@ -152,3 +152,41 @@ def characteristic_frequencies(design: PRSMDesign, screw_speed: float) -> Charac
         roller_pass_nut=design.n_rollers * f_c,
         roller_reset=reset,
     )
+
+
+def defect_frequencies(design: PRSMDesign, screw_speed: float) -> dict[str, float]:
+    """Rates [Hz] at which a localised defect at each location meets its mating part, by the
+    rolling-bearing reasoning of defect-passing frequencies (a fixed point is passed by every
+    rolling element; a point on a rolling element meets both races once per spin).
+
+    * ``screw_flank``: a point on a screw flank is rolled over by each roller, n_r·|f_s − f_c|;
+    * ``nut_flank``: a point on a nut flank, n_r·f_c;
+    * ``roller_flank``: a point on one roller's thread meets the screw and the nut once each per
+      spin relative to the carrier, 2·f_spin (the roller's orbit, f_c, modulates it);
+    * ``ring_gear_tooth``: a ring-gear tooth meshes with each roller once per carrier turn,
+      n_r·f_c (standard PRSM only);
+    * ``roller_gear_tooth``: a tooth of one roller's gear meshes once per spin relative to the
+      carrier, f_spin (standard PRSM only);
+    * ``carrier``: f_c, the rate at which a roller's load zone turns.
+
+    Parameters
+    ----------
+    design : PRSMDesign
+    screw_speed : float [rad/s]
+
+    References
+    ----------
+    Randall & Antoni, Rolling element bearing diagnostics — a tutorial, MSSP 25 (2011), §2
+    (defect frequencies); kinematics of paper 01 (speed ratios).
+    """
+    f = characteristic_frequencies(design, screw_speed)
+    out = {
+        "screw_flank": f.roller_pass_screw,
+        "nut_flank": f.roller_pass_nut,
+        "roller_flank": 2.0 * f.roller_spin,
+    }
+    if design.gear is not None and design.variant != "recirculating":
+        out["ring_gear_tooth"] = design.n_rollers * f.carrier
+        out["roller_gear_tooth"] = f.roller_spin
+    out["carrier"] = f.carrier
+    return out

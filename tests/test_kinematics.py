@@ -73,3 +73,43 @@ def test_frequencies_scale_with_speed_and_ignore_sign():
     for key, value in f1.items():
         if value is not None:
             assert f2[key] == pytest.approx(2 * value)
+
+
+def test_defect_frequencies_follow_the_rolling_kinematics():
+    import json
+    import subprocess
+    import sys
+
+    from prsm_health import defect_frequencies
+
+    d = preset("paper01")
+    f = characteristic_frequencies(d, 100.0)
+    r = speed_ratios(d)
+    f_s = 100.0 / (2 * math.pi)
+    got = defect_frequencies(d, 100.0)
+    # a fixed flank point is passed by every roller; a roller point meets screw and nut per spin
+    assert got["screw_flank"] == pytest.approx(7 * (1 - r.carrier) * f_s)
+    assert got["nut_flank"] == pytest.approx(7 * r.carrier * f_s)
+    assert got["roller_flank"] == pytest.approx(2 * abs(r.roller_spin_relative) * f_s)
+    assert got["ring_gear_tooth"] == pytest.approx(7 * f.carrier)
+    assert got["roller_gear_tooth"] == pytest.approx(f.roller_spin)
+    assert got["carrier"] == pytest.approx(f.carrier)
+    assert defect_frequencies(d, -100.0) == got  # magnitudes
+    assert "ring_gear_tooth" not in defect_frequencies(preset("paper03"), 100.0)  # no gears
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "prsm_health.cli",
+            "kinematics",
+            "--design",
+            "paper01",
+            "--speed",
+            "100",
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert json.loads(out.stdout)["defect_frequencies"] == pytest.approx(got)
