@@ -458,6 +458,7 @@ def _cmd_simulate(args) -> int:
         "clearance": args.clearance,
         "wear_spread": args.wear_spread,
         "friction_scale": args.friction_scale,
+        "preload": args.preload,
     }
     if args.gear_clearance is not None:
         health["clearance_gear"] = args.gear_clearance
@@ -843,6 +844,12 @@ def _add_simulate_parser(command, default_preset) -> None:
         help="gear backlash b_g [m] (None: --clearance)",
     )
     s.add_argument("--wear-spread", type=_finite_float, default=0.0, help="uneven roller wear [-]")
+    s.add_argument(
+        "--preload",
+        type=_finite_float,
+        default=0.0,
+        help="axial interference on each thread flank [m] (preloaded nut; 0: none or lost)",
+    )
     s.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
     s.add_argument("--speed", type=_finite_float, default=100.0, help="screw speed [rad/s]")
     s.add_argument("--load", type=_finite_float, default=100.0, help="resisting axial load [N]")

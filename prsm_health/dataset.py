@@ -58,6 +58,7 @@ SWEPT = {
     "load_amplitude": "N",
     "friction_scale": "-",
     "wear_spread": "-",
+    "preload": "m",
 }
 DEFAULT_BATCH = 8
 
@@ -328,7 +329,7 @@ class RunSpec:
         r, p = self.recipe, self.point
         health = {"clearance": p.get("clearance", 10e-6)}
         health.update({k: p[k] for k in SWEPT if k.startswith("clearance_") and k in p})
-        health.update({k: p[k] for k in ("wear_spread", "friction_scale") if k in p})
+        health.update({k: p[k] for k in ("wear_spread", "friction_scale", "preload") if k in p})
         profile = {
             "duration": r.duration,
             "speed": p.get("speed", 100.0),

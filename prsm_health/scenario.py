@@ -189,6 +189,7 @@ class Scenario:
             "clearance_gear": h.clearance_gear,
             "wear_spread": h.wear_spread,
             "friction_scale": h.friction_scale,
+            "preload": h.preload,
             "screw_speed": p.speed,
             "axial_load": p.load,
             "load_amplitude": p.load_amplitude,

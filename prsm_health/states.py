@@ -41,6 +41,11 @@ class HealthState:
         (1 + wear_spread·u_i), u_i uniform in [−1, 1] drawn from the run seed. 0 = even wear.
     friction_scale : float [-]
         Multiplies the thread friction coefficients; 1 = new lubricant, > 1 degraded.
+    preload : float [m]
+        Axial interference on each flank of every roller's screw and nut threads (oversize
+        rollers or a double nut): the realised half-clearance is b − preload, so with b = 0 and
+        a preload both flanks touch at rest and there is no play while the preload holds.
+        Preload loss is a lower preload (0: lost). Range 0–50 µm.
     """
 
     clearance_screw: float = 10e-6
@@ -48,12 +53,14 @@ class HealthState:
     clearance_gear: float = 10e-6
     wear_spread: float = 0.0
     friction_scale: float = 1.0
+    preload: float = 0.0
 
     def __post_init__(self):
         for name in ("clearance_screw", "clearance_nut", "clearance_gear"):
             require_range(f"health.{name}", getattr(self, name), 0.0, 500e-6, unit="m")
         require_range("health.wear_spread", self.wear_spread, 0.0, 1.0)
         require_range("health.friction_scale", self.friction_scale, 0.0, 20.0)
+        require_range("health.preload", self.preload, 0.0, 50e-6, unit="m")
 
     @classmethod
     def uniform(cls, clearance: float, **kw) -> HealthState:

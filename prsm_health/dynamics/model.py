@@ -462,8 +462,9 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     # clearance of zero but a parameter of its own.
     pitch = r[:, L.R_E_S] + r[:, L.R_E_N]
     take_up = 0.5 * np.abs(pitch - np.mean(pitch))
-    r[:, L.R_B_S] = health.clearance_screw * scale + take_up
-    r[:, L.R_B_N] = health.clearance_nut * scale + take_up
+    # a preload is interference on both flanks: a negative half-clearance
+    r[:, L.R_B_S] = health.clearance_screw * scale + take_up - health.preload
+    r[:, L.R_B_N] = health.clearance_nut * scale + take_up - health.preload
     r[:, L.R_B_G] = health.clearance_gear + np.abs(r[:, L.R_E_G] - np.mean(r[:, L.R_E_G]))
     r[:, L.R_MESH_PHASE] = 0.0
     r[:, L.R_MESH_SCALE] = np.clip(1.0 + variation.mesh_stiffness_spread * z[5], 0.5, 1.5)
@@ -474,7 +475,8 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
 
 def realised_clearances(model: Model) -> dict[str, float]:
     """Run labels of the as-built half-clearances [m]: mean, min and max over the rollers of
-    each engagement (uneven wear and the assembly's take-up of pitch errors included)."""
+    each engagement (uneven wear, the assembly's take-up of pitch errors and the preload
+    included: negative is interference)."""
     out = {}
     for name, column in (("screw", L.R_B_S), ("nut", L.R_B_N), ("gear", L.R_B_G)):
         values = model.rollers[:, column]

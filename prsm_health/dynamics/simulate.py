@@ -47,8 +47,9 @@ def linearised_modes(model: Model) -> tuple[np.ndarray, np.ndarray, list[int]]:
     """
     nq = model.n_coordinates
     rollers = model.rollers.copy()
-    rollers[:, L.R_B_S] = 0.0
-    rollers[:, L.R_B_N] = 0.0
+    # clearances closed, interference (preload) kept
+    rollers[:, L.R_B_S] = np.minimum(rollers[:, L.R_B_S], 0.0)
+    rollers[:, L.R_B_N] = np.minimum(rollers[:, L.R_B_N], 0.0)
     rollers[:, L.R_B_G] = 0.0
     operating = model.roller_load * model.n_rollers
     loaded = replace(
