@@ -30,6 +30,7 @@ _EXPORTS = {
     "preset": ".design",
     "HealthState": ".states",
     "ManufacturingVariation": ".states",
+    "Spall": ".states",
     "OperatingProfile": ".states",
     "Instrumentation": ".instrumentation",
     "list_profiles": ".instrumentation",

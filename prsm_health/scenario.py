@@ -26,6 +26,7 @@ profile (:func:`prsm_health.instrumentation.load_instrumentation`). TOML cannot 
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -167,11 +168,15 @@ class Scenario:
             lines.insert(0, f"design = {toml_value(design)}")
         options = data["options"]
         variation = options.pop("variation")
+        spalls = data["health"].pop("spalls")
         for table, values in data.items():
             lines.append(f"\n[{table}]")
             lines += [f"{k} = {toml_value(v)}" for k, v in values.items() if v is not None]
         lines.append("\n[options.variation]")
         lines += [f"{k} = {toml_value(v)}" for k, v in variation.items()]
+        for spall in spalls:
+            lines.append("\n[[health.spalls]]")
+            lines += [f"{k} = {toml_value(v)}" for k, v in spall.items()]
         if not isinstance(design, str):
             lines += [""] + design_toml_tables(self.design, "design")
         if not isinstance(instrumentation, str):
@@ -190,6 +195,8 @@ class Scenario:
             "wear_spread": h.wear_spread,
             "friction_scale": h.friction_scale,
             "preload": h.preload,
+            # a JSON text, so a dataset's labels table keeps one scalar per cell
+            "spalls": json.dumps([spall.as_dict() for spall in h.spalls]),
             "screw_speed": p.speed,
             "axial_load": p.load,
             "load_amplitude": p.load_amplitude,

@@ -16,7 +16,7 @@ from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 
-from .errors import require, require_positive, require_range
+from .errors import require, require_known_keys, require_positive, require_range
 
 MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
 LOADS = ("constant", "sinusoidal", "reversing")
@@ -24,6 +24,70 @@ DRIVES = ("prescribed", "speed_loop", "position_loop")
 RAMP_SHAPES = ("linear", "cosine")
 #: Fault classes of the taxonomy (run label ``fault_class``).
 FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
+
+
+SPALL_LOCATIONS = ("screw", "nut", "roller")
+
+
+@dataclass(frozen=True)
+class Spall:
+    """A localised flank defect (pit or spall) on a thread flank of the screw, the nut or one
+    roller: a profile depression that a rolling contact crossing it follows down and climbs out
+    of at its exit edge (Sawalhi & Randall, MSSP 22, 2008, Part I: the spall as a depression in
+    the contact path with a gradual entry and an abrupt exit).
+
+    Parameters
+    ----------
+    location : {"screw", "nut", "roller"}
+    depth : float [m]
+        Depth of the depression the contact follows (for a spall longer than the contact, its
+        depth; for a short one, ≈ ℓ²/8R with R the mating profile radius).
+    length : float [m]
+        Extent along the contact path (around the part).
+    angle : float [rad]
+        Angular position of its entry on the part (screw or nut surface; the roller's own spin
+        angle for a roller spall).
+    roller : int
+        Which roller carries a roller spall (0-based).
+
+    The depression acts on both flanks of that engagement (the loaded one makes the signature)
+    and lies within the nut's engaged threads throughout a run (a run shorter than the stroke
+    across it).
+    """
+
+    location: str = "screw"
+    depth: float = 20e-6
+    length: float = 1.5e-3
+    angle: float = 0.0
+    roller: int = 0
+
+    def __post_init__(self):
+        require(
+            self.location in SPALL_LOCATIONS,
+            "health.spalls.location",
+            self.location,
+            f"must be one of {', '.join(SPALL_LOCATIONS)}",
+        )
+        require_range("health.spalls.depth", self.depth, 0.0, 200e-6, unit="m")
+        require_range("health.spalls.length", self.length, 1e-5, 10e-3, unit="m")
+        require_range("health.spalls.angle", self.angle, -2 * math.pi, 2 * math.pi, unit="rad")
+        require(
+            isinstance(self.roller, int) and self.roller >= 0,
+            "health.spalls.roller",
+            self.roller,
+            "must be an integer ≥ 0",
+        )
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def _spall(value) -> Spall:
+    if isinstance(value, Spall):
+        return value
+    require(isinstance(value, dict), "health.spalls", value, "must be a list of tables")
+    require_known_keys("health.spalls", value, [f.name for f in fields(Spall)])
+    return Spall(**value)
 
 
 @dataclass(frozen=True)
@@ -46,6 +110,8 @@ class HealthState:
         rollers or a double nut): the realised half-clearance is b − preload, so with b = 0 and
         a preload both flanks touch at rest and there is no play while the preload holds.
         Preload loss is a lower preload (0: lost). Range 0–50 µm.
+    spalls : tuple of Spall
+        Localised flank defects (default none).
     """
 
     clearance_screw: float = 10e-6
@@ -54,8 +120,10 @@ class HealthState:
     wear_spread: float = 0.0
     friction_scale: float = 1.0
     preload: float = 0.0
+    spalls: tuple[Spall, ...] = ()
 
     def __post_init__(self):
+        object.__setattr__(self, "spalls", tuple(_spall(s) for s in self.spalls))
         for name in ("clearance_screw", "clearance_nut", "clearance_gear"):
             require_range(f"health.{name}", getattr(self, name), 0.0, 500e-6, unit="m")
         require_range("health.wear_spread", self.wear_spread, 0.0, 1.0)
@@ -70,7 +138,7 @@ class HealthState:
         )
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        return {**asdict(self), "spalls": [spall.as_dict() for spall in self.spalls]}
 
 
 @dataclass(frozen=True)

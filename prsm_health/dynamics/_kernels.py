@@ -250,15 +250,33 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         d_ax_dot = lead_local * (w_s - w_rev) - lead_r * (w_c - w_rev) - g1 * (vz_c - vz_s)
         approach = orbit - rho + e_rad - ro_c
         approach_dot = -rho_dot + de_rad * (w_rev - w_s) + ro_s * (w_c - w_rev)
+        # spalls: extra local clearance h on both flanks, its slope in the forces
+        h, dh = _wave(errors, L.ERR_SCREW_SPALL, u)
+        h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev + math.pi)
+        h_r *= rollers[i, L.R_SPALL]
+        dh_r *= rollers[i, L.R_SPALL]
+        # closure rate loses dh·u̇ (u̇ = w_rev − w_s) and dh_r·χ̇ (χ̇ = w_c − w_rev)
+        spall_rate = dh * (w_rev - w_s) + dh_r * (w_c - w_rev)
         f_plus, f_minus, diss = _thread_pair(
-            d_ax, d_ax_dot, approach, approach_dot, rollers[i, L.R_B_S], cot_b, k_ts, c_ts, expo
+            d_ax,
+            d_ax_dot,
+            approach,
+            approach_dot - spall_rate / cot_b,
+            rollers[i, L.R_B_S] + h + h_r,
+            cot_b,
+            k_ts,
+            c_ts,
+            expo,
         )
         p_diss += diss
         screw_contact = f_plus + f_minus > 0.0
         f_ax = f_plus - f_minus  # axial force of the screw on the roller (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller outward, screw inward
-        # along e_t of the roller, from θ_rev (helix, radial error slope, runout)
-        g_tan = (f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s) / orbit
+        # along e_t of the roller, from θ_rev (helix, radial error slope, runout, spall slopes)
+        f_sum = f_plus + f_minus
+        g_tan = (
+            f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s + f_sum * (dh - dh_r)
+        ) / orbit
         # Screw–roller traction: elastic tangential compliance k_t (Mindlin) that sticks up to
         # the Coulomb limit μN and slides beyond it (reset integrator, Haessig & Friedland
         # 1991), plus viscous drag. v_slide = 0 is rolling at both pitch circles.
@@ -291,7 +309,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         m_diff = mu_r * normal * math.tanh(w_rel / w_roll)
         p_fric += m_diff * w_rel
         friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
-        torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff
+        torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff - f_sum * dh
         force_screw_axial -= g1 * f_ax + f_axial
         # on the roller: radial push f_rad·e_r, helix reaction, traction and the reaction of the
         # differential-sliding torque along e_t
@@ -302,7 +320,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         dy[v0 + L.Q_YS] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric - f_rad * ro_s
+        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric - f_rad * ro_s + f_sum * dh_r
         dy[v0 + b + 3] += g1 * f_ax + f_axial
 
         # ---------------- roller–nut thread
@@ -325,12 +343,18 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         chi = th_c - th_rev + rollers[i, L.R_RUNOUT_PHASE]
         cos_chi, minus_sin_chi = _wave(errors, L.ERR_UNIT_COSINE, chi)
         ro_c, ro_s = runout * cos_chi, -runout * minus_sin_chi
+        u_n = th_rev + psi - th_n
+        h, dh = _wave(errors, L.ERR_NUT_SPALL, u_n)
+        h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev)
+        h_r *= rollers[i, L.R_SPALL]
+        dh_r *= rollers[i, L.R_SPALL]
+        spall_rate = dh * (w_rev - w_n) + dh_r * (w_c - w_rev)
         f_plus, f_minus, diss = _thread_pair(
             d_ax,
             d_ax_dot,
             rho - orbit + ro_c,
-            rho_dot - ro_s * (w_c - w_rev),
-            rollers[i, L.R_B_N],
+            rho_dot - ro_s * (w_c - w_rev) - spall_rate / cot_b,
+            rollers[i, L.R_B_N] + h + h_r,
             cot_b,
             k_tn,
             c_tn,
@@ -341,17 +365,18 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
             engaged += 1.0
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
-        g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s) / orbit
+        f_sum = f_plus + f_minus
+        g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s + f_sum * (dh - dh_r)) / orbit
         fx_r = -f_rad * c + g_tan * (-s)
         fy_r = -f_rad * s + g_tan * c
         dy[v0 + L.Q_XN] -= fx_r
         dy[v0 + L.Q_YN] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s
+        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s + f_sum * dh_r
         dy[v0 + b + 3] -= f_ax
         dy[v0 + L.Q_ZN] += f_ax
-        dy[v0 + L.Q_THN] += f_ax * lead_local
+        dy[v0 + L.Q_THN] += f_ax * lead_local - f_sum * dh
 
         # ---------------- roller gear – ring gear mesh (line of action n = cos α0 e_t − sin α0 e_r)
         phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, L.R_MESH_PHASE]

@@ -89,7 +89,12 @@ DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 # The last row is cos u over one turn: the roller runout's cos and −sin by one lookup, far
 # cheaper than two trigonometric calls per roller and side.
 ERR_SCREW_AXIAL, ERR_SCREW_RADIAL, ERR_NUT_AXIAL, ERR_GEAR, ERR_UNIT_COSINE = 0, 1, 2, 3, 4
-N_ERROR_KINDS = 5
+# Localised flank defects (spalls): the depth [m] of the flank's profile depression at the
+# contact coordinate, added to the local clearance of both flanks of that engagement. Screw:
+# u as screw axial; nut: u as nut axial; roller: the spin angle χ = θ_c − θ_rev of the roller
+# that carries it (R_SPALL), facing the nut at χ and the screw at χ + π.
+ERR_SCREW_SPALL, ERR_NUT_SPALL, ERR_ROLLER_SPALL = 5, 6, 7
+N_ERROR_KINDS = 8
 N_ERROR_POINTS = 16384
 
 # ----------------------------------------------------------------- per-roller parameters
@@ -102,7 +107,8 @@ R_MESH_PHASE = 9  # mesh phase error added to the geometric phase [cycles]
 R_MESH_SCALE = 10  # mesh stiffness scale (tooth-to-tooth variation) [-]
 R_PSI = 11  # angular position of the pocket [rad]
 R_RUNOUT, R_RUNOUT_PHASE = 12, 13  # roller thread runout about its spin axis [m], phase [rad]
-N_ROLLER_PARAMS = 14
+R_SPALL = 14  # 1 for the roller carrying the roller-flank spall, else 0
+N_ROLLER_PARAMS = 15
 
 # ----------------------------------------------------------------- recorded truth signals
 (

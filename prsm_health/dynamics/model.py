@@ -349,7 +349,7 @@ def build_model(
 
     rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
     rollers = _roller_params(design, health, options.variation, orbit, rng)
-    errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng)
+    errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng, health.spalls)
     return Model(
         design=design,
         health=health,
@@ -389,7 +389,7 @@ def _drive_train_params(p, drive_train, design, k_axial, restitution) -> None:
     p[L.P_C_LINK] = 2 * dt.linkage_damping_ratio * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
 
 
-def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:
+def _error_terms(design, variation, rng, spalls=()) -> tuple[np.ndarray, float]:
     """Geometric error tables (layout ``ERR_*`` rows) and the cumulative lead slope [-].
 
     Each kind is a sum of sinusoids of its contact coordinate, tabulated over its period: one
@@ -426,6 +426,9 @@ def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:
         L.ERR_NUT_AXIAL: 2 * math.pi * turns,
         L.ERR_GEAR: 2 * math.pi,
         L.ERR_UNIT_COSINE: 2 * math.pi,
+        L.ERR_SCREW_SPALL: 2 * math.pi,
+        L.ERR_NUT_SPALL: 2 * math.pi,
+        L.ERR_ROLLER_SPALL: 2 * math.pi,
     }
     terms[L.ERR_UNIT_COSINE].append((1.0, 1.0, math.pi / 2))
     tables = np.zeros((L.N_ERROR_KINDS, L.N_ERROR_POINTS + 1))
@@ -434,8 +437,24 @@ def _error_terms(design, variation, rng) -> tuple[np.ndarray, float]:
         tables[kind, 0] = periods[kind]
         for wave, amplitude, phase in rows:
             tables[kind, 1:] += amplitude * np.sin(wave * u + phase)
+    radius = {"screw": r_s, "nut": r_n, "roller": design.roller_diameter / 2}
+    kind = {"screw": L.ERR_SCREW_SPALL, "nut": L.ERR_NUT_SPALL, "roller": L.ERR_ROLLER_SPALL}
+    u = np.arange(L.N_ERROR_POINTS) * 2 * math.pi / L.N_ERROR_POINTS
+    for spall in spalls:
+        tables[kind[spall.location], 1:] += spall_profile(u, spall, radius[spall.location])
     lead_slope = 0.5 * v.lead_error_cumulative / 0.3 * float(draws[0])
     return tables, lead_slope
+
+
+def spall_profile(u: np.ndarray, spall, radius: float) -> np.ndarray:
+    """Depression [m] of a spall along the contact coordinate u [rad] of its part: the contact
+    follows it down over the first 30 % of its length, runs on its floor, and is lifted out by
+    the exit edge over the last 10 % (Sawalhi & Randall 2008: gradual entry, abrupt exit)."""
+    span = spall.length / radius
+    x = np.mod(u - spall.angle, 2 * math.pi) / span  # 0…1 across the spall
+    entry = np.clip(x / 0.3, 0.0, 1.0)
+    exit_ = np.clip((1.0 - x) / 0.1, 0.0, 1.0)
+    return spall.depth * np.where(x < 1.0, np.minimum(entry, exit_), 0.0)
 
 
 def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
@@ -470,6 +489,15 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     r[:, L.R_MESH_SCALE] = np.clip(1.0 + variation.mesh_stiffness_spread * z[5], 0.5, 1.5)
     r[:, L.R_RUNOUT] = variation.roller_runout * runout
     r[:, L.R_RUNOUT_PHASE] = runout_phase
+    for spall in health.spalls:
+        if spall.location == "roller":
+            require(
+                spall.roller < n,
+                "health.spalls.roller",
+                spall.roller,
+                f"must be below the design's {n} rollers",
+            )
+            r[spall.roller, L.R_SPALL] = 1.0
     return r
 
 
