@@ -205,10 +205,10 @@ axial frequency much less.
 - Lubricant: trained on friction scales 1.0 and 2.2 only, seen through the motor current
   alone (no friction truth); off-grid scales near the 1.8 class threshold are where the
   classifier errs (off-grid macro-F1 above), between wear and lubrication.
-- Interval coverage: held-out and off-grid coverage fall below the nominal 90 % (table):
-  the conformal calibration holds for exchangeable data and, with 79 and 60 runs, the binomial
-  spread is ±3–4 %; off-grid points are not exchangeable with the grid. Read the intervals as
-  ≈ 80–90 %.
+- Interval coverage can fall below the nominal 90 % (table: cross-validated and off-grid
+  rows): the conformal calibration holds for exchangeable data, the binomial spread with 60–79
+  runs is ±3–4 %, and off-grid points are not exchangeable with the grid. Read the intervals
+  as ≈ 85–90 %.
 - Real recordings differ from the simulator (mounting, sensor placement, temperature): retrain
   or at least validate on measured data before trusting absolute numbers.
 - The split-conformal guarantee assumes exchangeable data (same distribution as training).
