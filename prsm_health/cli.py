@@ -652,10 +652,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_validate)
 
     p = command("design", "design files: a template, a design's fields, a check")
-    dsub = p.add_subparsers(dest="action", required=True, parser_class=_Parser)
-
-    def design(name: str, text: str):
-        return dsub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+    design = _actions(p)
 
     t = design("template", "print a commented design TOML file to start from")
     t.add_argument(
@@ -671,10 +668,7 @@ def build_parser() -> argparse.ArgumentParser:
     t.set_defaults(func=_cmd_design_check)
 
     p = command("instrumentation", "instrumentation profiles: the sensors a run is measured with")
-    isub = p.add_subparsers(dest="action", required=True, parser_class=_Parser)
-
-    def instrumentation(name: str, text: str):
-        return isub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+    instrumentation = _actions(p)
 
     t = instrumentation("list", "the built-in profiles, one line each")
     _add_json(t, "the profiles (name, description, channels)")
@@ -826,6 +820,16 @@ def build_parser() -> argparse.ArgumentParser:
     _add_json(f)
     f.set_defaults(func=_cmd_friction)
     return parser
+
+
+def _actions(parser):
+    """A maker of ``parser``'s sub-actions (``design template``, ``instrumentation show`` …)."""
+    sub = parser.add_subparsers(dest="action", required=True, parser_class=_Parser)
+
+    def action(name: str, text: str):
+        return sub.add_parser(name, help=text, description=text, formatter_class=_HelpFormatter)
+
+    return action
 
 
 def _add_simulate_parser(command, default_preset) -> None:

@@ -198,6 +198,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     mu_r = p[L.P_MU_ROLL] * fscale
     v_axial, w_roll, lead_eff = p[L.P_V_AXIAL], p[L.P_W_ROLL], p[L.P_LEAD_EFF]
     g1 = 1.0 - p[L.P_LEAD_SLOPE]  # cumulative lead error: axial closure per axial travel
+    spalled = p[L.P_HAS_SPALLS] == 1.0
     s0 = 2 * nq + L.N_EXTRA  # offset of the traction states
     z_ring = p[L.P_Z_RING]
 
@@ -251,10 +252,12 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         approach = orbit - rho + e_rad - ro_c
         approach_dot = -rho_dot + de_rad * (w_rev - w_s) + ro_s * (w_c - w_rev)
         # spalls: extra local clearance h on both flanks, its slope in the forces
-        h, dh = _wave(errors, L.ERR_SCREW_SPALL, u)
-        h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev + math.pi)
-        h_r *= rollers[i, L.R_SPALL]
-        dh_r *= rollers[i, L.R_SPALL]
+        h = dh = h_r = dh_r = 0.0
+        if spalled:
+            h, dh = _wave(errors, L.ERR_SCREW_SPALL, u)
+            h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev + math.pi)
+            h_r *= rollers[i, L.R_SPALL]
+            dh_r *= rollers[i, L.R_SPALL]
         # closure rate loses dh·u̇ (u̇ = w_rev − w_s) and dh_r·χ̇ (χ̇ = w_c − w_rev)
         spall_rate = dh * (w_rev - w_s) + dh_r * (w_c - w_rev)
         f_plus, f_minus, diss = _thread_pair(
@@ -344,10 +347,12 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         cos_chi, minus_sin_chi = _wave(errors, L.ERR_UNIT_COSINE, chi)
         ro_c, ro_s = runout * cos_chi, -runout * minus_sin_chi
         u_n = th_rev + psi - th_n
-        h, dh = _wave(errors, L.ERR_NUT_SPALL, u_n)
-        h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev)
-        h_r *= rollers[i, L.R_SPALL]
-        dh_r *= rollers[i, L.R_SPALL]
+        h = dh = h_r = dh_r = 0.0
+        if spalled:
+            h, dh = _wave(errors, L.ERR_NUT_SPALL, u_n)
+            h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev)
+            h_r *= rollers[i, L.R_SPALL]
+            dh_r *= rollers[i, L.R_SPALL]
         spall_rate = dh * (w_rev - w_n) + dh_r * (w_c - w_rev)
         f_plus, f_minus, diss = _thread_pair(
             d_ax,

@@ -76,7 +76,8 @@ P_M_L, P_K_LINK, P_C_LINK = 66, 67, 68  # payload [kg], linkage [N/m], [N·s/m]
 P_C_FILM = 69  # lubricant squeeze-film damper, nut vs screw kinematics [N·s/m]
 P_KP_POS = 70  # position-loop gain [1/s]
 P_LEAD_SLOPE = 71  # cumulative lead error of the screw, axial error per axial travel [-]
-N_PARAMS = 72
+P_HAS_SPALLS = 72  # 1 when the health state has a spall: only then the spall tables are read
+N_PARAMS = 73
 
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 

@@ -350,6 +350,7 @@ def build_model(
     rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
     rollers = _roller_params(design, health, options.variation, orbit, rng)
     errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng, health.spalls)
+    p[L.P_HAS_SPALLS] = 1.0 if health.spalls else 0.0
     return Model(
         design=design,
         health=health,
