@@ -446,6 +446,7 @@ def _cmd_simulate(args) -> int:
     from .drive_train import load_drive_train
     from .kinematics import characteristic_frequencies
     from .scenario import Scenario
+    from .tomlfile import read_toml
 
     out = Path(args.out)
     if out.suffix not in (".parquet", ".mcap"):
@@ -454,14 +455,18 @@ def _cmd_simulate(args) -> int:
         )
     if not out.parent.exists():
         raise PRSMHealthError(f"--out {out}: directory {out.parent} does not exist")
-    health = {
-        "clearance": args.clearance,
+    # a health file gives the base state; the flags given on the command line override it
+    health = read_toml(args.health, "health file") if args.health else {}
+    if args.clearance is not None:
+        health.update(dict.fromkeys(("clearance_screw", "clearance_nut"), args.clearance))
+        health.setdefault("clearance_gear", args.clearance)
+    flags = {
+        "clearance_gear": args.gear_clearance,
         "wear_spread": args.wear_spread,
         "friction_scale": args.friction_scale,
         "preload": args.preload,
     }
-    if args.gear_clearance is not None:
-        health["clearance_gear"] = args.gear_clearance
+    health.update({k: v for k, v in flags.items() if v is not None})
     scenario = Scenario.from_dict(
         {
             "design": args.design,
@@ -839,22 +844,36 @@ def _add_simulate_parser(command, default_preset) -> None:
     s = command("simulate", "simulate a PRSM run (paper 01 dynamics) and write it")
     s.add_argument("--design", type=_design, default=default_preset, help=DESIGN_HELP)
     s.add_argument(
-        "--clearance", type=_finite_float, default=10e-6, help="thread half-clearance b [m]"
+        "--health",
+        default=None,
+        metavar="FILE",
+        help="health file (TOML: clearances, preload, lubricant and [[faults]], docs/faults.md); "
+        "the health flags below override its values",
+    )
+    s.add_argument(
+        "--clearance",
+        type=_finite_float,
+        default=None,
+        help="thread (and gear) half-clearance b [m] (default 10e-6)",
     )
     s.add_argument(
         "--gear-clearance",
         type=_finite_float,
         default=None,
-        help="gear backlash b_g [m] (None: --clearance)",
+        help="gear backlash b_g [m] (default: the thread clearance)",
     )
-    s.add_argument("--wear-spread", type=_finite_float, default=0.0, help="uneven roller wear [-]")
+    s.add_argument(
+        "--wear-spread", type=_finite_float, default=None, help="uneven roller wear [-] (0)"
+    )
     s.add_argument(
         "--preload",
         type=_finite_float,
-        default=0.0,
-        help="axial interference on each thread flank [m] (preloaded nut; 0: none or lost)",
+        default=None,
+        help="installed axial interference on each thread flank [m] (preloaded nut; 0: none)",
     )
-    s.add_argument("--friction-scale", type=_finite_float, default=1.0, help="lubricant state [-]")
+    s.add_argument(
+        "--friction-scale", type=_finite_float, default=None, help="friction multiplier [-] (1)"
+    )
     s.add_argument("--speed", type=_finite_float, default=100.0, help="screw speed [rad/s]")
     s.add_argument("--load", type=_finite_float, default=100.0, help="resisting axial load [N]")
     s.add_argument("--profile", choices=MOTIONS, default="constant", help="screw motion profile")

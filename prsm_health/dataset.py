@@ -38,11 +38,11 @@ from .channels import CHANNEL_NAMES, TRUTH_PREFIX, UNITS
 from .design import PRESETS
 from .design_files import load_design
 from .errors import ParameterError, PRSMHealthError, RecipeError, require
+from .faults import FAULT_CLASSES, FaultThresholds, fault_as_dict, fault_from_dict, scaled
 from .instrumentation import DEFAULT_PROFILE, list_profiles, load_instrumentation
 from .jsonable import dumps
 from .run import Run
 from .scenario import Scenario
-from .states import FAULT_CLASSES, FaultThresholds
 from .tomlfile import read_toml
 
 FORMATS = ("parquet", "mcap", "both")
@@ -59,7 +59,11 @@ SWEPT = {
     "friction_scale": "-",
     "wear_spread": "-",
     "preload": "m",
+    "severity": "-",
 }
+#: Swept by name: a list of ``fault_cases`` names (drawn uniformly in random and lhs mode).
+FAULT_CASE_KEY = "fault_case"
+NO_FAULT = "none"
 DEFAULT_BATCH = 8
 
 
@@ -78,6 +82,7 @@ class Recipe:
     options: dict = field(default_factory=dict)
     drive_train: dict = field(default_factory=dict)
     faults: FaultThresholds = field(default_factory=FaultThresholds)
+    fault_cases: dict = field(default_factory=dict)
     test_fraction: float = 0.2
     batch_size: int = DEFAULT_BATCH
     dtype: str = "float32"
@@ -173,13 +178,15 @@ class Recipe:
         check(isinstance(sweep, dict), "sweep", sweep, "must be a table")
         mode = sweep.get("mode", "grid")
         check(mode in SWEEP_MODES, "sweep.mode", mode, f"must be one of {', '.join(SWEEP_MODES)}")
-        unknown = sorted(set(sweep) - set(SWEPT) - {"mode", "repeats", "samples"})
+        unknown = sorted(set(sweep) - set(SWEPT) - {"mode", "repeats", "samples", FAULT_CASE_KEY})
         check(
             not unknown,
             "sweep",
             unknown,
-            f"unknown key(s); allowed: mode, repeats, samples, {', '.join(SWEPT)}",
+            f"unknown key(s); allowed: mode, repeats, samples, {FAULT_CASE_KEY}, "
+            f"{', '.join(SWEPT)}",
         )
+        self._validate_fault_cases(check)
         repeats = sweep.get("repeats", 1)
         check(
             isinstance(repeats, int) and repeats >= 1,
@@ -237,6 +244,32 @@ class Recipe:
         for spec in self.runs():
             spec.scenario()
 
+    def _validate_fault_cases(self, check) -> None:
+        cases = self.fault_cases
+        check(isinstance(cases, dict), "fault_cases", cases, "must be a table of named cases")
+        for name, faults in cases.items():
+            check(
+                isinstance(faults, list),
+                f"fault_cases.{name}",
+                faults,
+                "must be a list of fault tables, e.g. [{ kind = \"spall\", location = \"nut\" }]",
+            )
+            for fault in faults:
+                try:
+                    fault_from_dict(fault)
+                except ParameterError as exc:
+                    raise RecipeError(f"recipe: fault_cases.{name}: {exc}") from None
+        names = self.sweep.get(FAULT_CASE_KEY)
+        if names is None:
+            return
+        known = [NO_FAULT, *cases]
+        check(
+            isinstance(names, list) and names and all(n in known for n in names),
+            f"sweep.{FAULT_CASE_KEY}",
+            names,
+            f"must be a non-empty list of case names among: {', '.join(known)}",
+        )
+
     @property
     def fingerprint(self) -> str:
         """Stable hash of the recipe content (guards a dataset directory against another recipe)."""
@@ -272,8 +305,11 @@ class Recipe:
     def _points(self) -> list[dict]:
         keys = [k for k in SWEPT if k in self.sweep]
         mode = self.sweep.get("mode", "grid")
+        cases = self.sweep.get(FAULT_CASE_KEY)
         if mode == "grid":
             keys = [k for k in keys if not isinstance(self.sweep[k], dict)]
+            if cases:
+                keys.append(FAULT_CASE_KEY)
             values = [self.sweep[k] for k in keys]
             return [dict(zip(keys, combo)) for combo in itertools.product(*values)]
         n = self.sweep["samples"]
@@ -291,6 +327,9 @@ class Recipe:
             for j, k in enumerate(keys):
                 lo, hi = self.sweep[k]
                 point[k] = float(lo + row[j] * (hi - lo))
+            if cases:  # a categorical draw from its own stream, so the numeric draws stay put
+                pick = np.random.default_rng([self.seed, len(out), 0x46434153]).integers(len(cases))
+                point[FAULT_CASE_KEY] = cases[int(pick)]
             out.append(point)
         return out
 
@@ -330,6 +369,7 @@ class RunSpec:
         health = {"clearance": p.get("clearance", 10e-6)}
         health.update({k: p[k] for k in SWEPT if k.startswith("clearance_") and k in p})
         health.update({k: p[k] for k in ("wear_spread", "friction_scale", "preload") if k in p})
+        health["faults"] = self.faults()
         profile = {
             "duration": r.duration,
             "speed": p.get("speed", 100.0),
@@ -353,16 +393,28 @@ class RunSpec:
         except ParameterError as exc:
             raise RecipeError(f"recipe (run {self.run_id}): {exc}") from None
 
+    def faults(self) -> list[dict]:
+        """The faults of this run's case, their severities scaled by its ``severity``."""
+        name = self.point.get(FAULT_CASE_KEY, NO_FAULT)
+        factor = self.point.get("severity", 1.0)
+        try:
+            faults = [fault_from_dict(f) for f in self.recipe.fault_cases.get(name, [])]
+            return [fault_as_dict(scaled(f, factor)) for f in faults]
+        except ParameterError as exc:
+            raise RecipeError(
+                f"recipe (run {self.run_id}, fault case {name}, severity {factor:g}): {exc}"
+            ) from None
+
     def labels(self, run: Run | None = None) -> dict:
         """The run's labels: id, split, fault class, the scenario's labels (nominal values) and,
         given the simulated run, its realised clearances."""
         scenario = self.scenario()
-        health = scenario.health
-        clearance = max(health.clearance_screw, health.clearance_nut)
         out = {
             "run_id": self.run_id,
             "split": self.split,
-            "fault_class": self.recipe.faults.classify(clearance, health.friction_scale),
+            "fault_class": self.recipe.faults.classify(scenario.health),
+            "fault_case": self.point.get(FAULT_CASE_KEY, NO_FAULT),
+            "severity": self.point.get("severity", 1.0),
             **scenario.labels(),
         }
         if run is not None:
@@ -717,11 +769,7 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
         "formats": formats,
         "fault_taxonomy": {
             "classes": list(FAULT_CLASSES),
-            "thresholds": {
-                "wear": recipe.faults.wear,
-                "severe_wear": recipe.faults.severe_wear,
-                "lubrication": recipe.faults.lubrication,
-            },
+            "thresholds": recipe.faults.as_dict(),
             "rule": FaultThresholds.__doc__.split("\n\n")[1].strip().replace("\n    ", " "),
         },
         "counts": {

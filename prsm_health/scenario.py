@@ -14,6 +14,7 @@ The dict form (and the TOML form, the same tables)::
                                              # scenario file), or an [instrumentation] table
     seed = 3
     [health]   clearance = 20e-6             # shorthand for screw, nut and gear; or each field
+    [[health.faults]]  kind = "spall", location = "screw", depth = 20e-6   (prsm_health.faults)
     [profile]  duration = 0.5, speed = 100.0, load = 100.0, …   (OperatingProfile fields)
     [options]  contact_law = "hertz", ideal = true, …           (SimulationOptions fields)
     [drive_train]  payload_mass = 25.0, …                       (DriveTrain fields)
@@ -35,6 +36,7 @@ from .design_files import design_toml_tables, load_design
 from .drive_train import DriveTrain
 from .dynamics.model import SimulationOptions
 from .errors import ParameterError, require, require_known_keys
+from .faults import fault_as_dict
 from .instrumentation import (
     DEFAULT_PROFILE,
     Instrumentation,
@@ -168,15 +170,15 @@ class Scenario:
             lines.insert(0, f"design = {toml_value(design)}")
         options = data["options"]
         variation = options.pop("variation")
-        spalls = data["health"].pop("spalls")
+        faults = data["health"].pop("faults")
         for table, values in data.items():
             lines.append(f"\n[{table}]")
             lines += [f"{k} = {toml_value(v)}" for k, v in values.items() if v is not None]
         lines.append("\n[options.variation]")
         lines += [f"{k} = {toml_value(v)}" for k, v in variation.items()]
-        for spall in spalls:
-            lines.append("\n[[health.spalls]]")
-            lines += [f"{k} = {toml_value(v)}" for k, v in spall.items()]
+        for fault in faults:
+            lines.append("\n[[health.faults]]")
+            lines += [f"{k} = {toml_value(v)}" for k, v in fault.items()]
         if not isinstance(design, str):
             lines += [""] + design_toml_tables(self.design, "design")
         if not isinstance(instrumentation, str):
@@ -195,8 +197,11 @@ class Scenario:
             "wear_spread": h.wear_spread,
             "friction_scale": h.friction_scale,
             "preload": h.preload,
-            # a JSON text, so a dataset's labels table keeps one scalar per cell
-            "spalls": json.dumps([spall.as_dict() for spall in h.spalls]),
+            "preload_effective": h.effective_preload,
+            # kinds joined by "+" ("" for none) to group by, and the faults themselves as a
+            # JSON text, so a dataset's labels table keeps one scalar per cell
+            "fault_kinds": "+".join(sorted({f.kind for f in h.faults})),
+            "faults": json.dumps([fault_as_dict(f) for f in h.faults]),
             "screw_speed": p.speed,
             "axial_load": p.load,
             "load_amplitude": p.load_amplitude,
@@ -217,13 +222,11 @@ def _group(name: str, kind: type, values) -> object:
     """One parameter group from its table; unknown keys name the table and list the allowed."""
     if isinstance(values, kind):
         return values
+    if kind is HealthState:
+        return HealthState.from_dict(values, name)
     if not isinstance(values, dict):
         raise ParameterError(name, values, "must be a table of parameters")
     values = dict(values)
-    if kind is HealthState and "clearance" in values:
-        clearance = values.pop("clearance")
-        for key in ("clearance_screw", "clearance_nut", "clearance_gear"):
-            values.setdefault(key, clearance)
     if kind is SimulationOptions:
         if values.pop("ideal", False):
             values["variation"] = ManufacturingVariation.ideal()
@@ -232,8 +235,6 @@ def _group(name: str, kind: type, values) -> object:
                 "options.variation", ManufacturingVariation, values["variation"]
             )
     allowed = [f.name for f in fields(kind)]
-    if kind is HealthState:
-        allowed.append("clearance")
     if kind is SimulationOptions:
         allowed.append("ideal")
     require_known_keys(name, values, allowed)

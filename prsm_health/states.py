@@ -17,77 +17,13 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from .errors import require, require_known_keys, require_positive, require_range
+from .faults import fault_as_dict, fault_from_dict
+from .tomlfile import read_toml
 
 MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
 LOADS = ("constant", "sinusoidal", "reversing")
 DRIVES = ("prescribed", "speed_loop", "position_loop")
 RAMP_SHAPES = ("linear", "cosine")
-#: Fault classes of the taxonomy (run label ``fault_class``).
-FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication")
-
-
-SPALL_LOCATIONS = ("screw", "nut", "roller")
-
-
-@dataclass(frozen=True)
-class Spall:
-    """A localised flank defect (pit or spall) on a thread flank of the screw, the nut or one
-    roller: a profile depression that a rolling contact crossing it follows down and climbs out
-    of at its exit edge (Sawalhi & Randall, MSSP 22, 2008, Part I: the spall as a depression in
-    the contact path with a gradual entry and an abrupt exit).
-
-    Parameters
-    ----------
-    location : {"screw", "nut", "roller"}
-    depth : float [m]
-        Depth of the depression the contact follows (for a spall longer than the contact, its
-        depth; for a short one, ≈ ℓ²/8R with R the mating profile radius).
-    length : float [m]
-        Extent along the contact path (around the part).
-    angle : float [rad]
-        Angular position of its entry on the part (screw or nut surface; the roller's own spin
-        angle for a roller spall).
-    roller : int
-        Which roller carries a roller spall (0-based).
-
-    The depression acts on both flanks of that engagement (the loaded one makes the signature)
-    and lies within the nut's engaged threads throughout a run (a run shorter than the stroke
-    across it).
-    """
-
-    location: str = "screw"
-    depth: float = 20e-6
-    length: float = 1.5e-3
-    angle: float = 0.0
-    roller: int = 0
-
-    def __post_init__(self):
-        require(
-            self.location in SPALL_LOCATIONS,
-            "health.spalls.location",
-            self.location,
-            f"must be one of {', '.join(SPALL_LOCATIONS)}",
-        )
-        require_range("health.spalls.depth", self.depth, 0.0, 200e-6, unit="m")
-        require_range("health.spalls.length", self.length, 1e-5, 10e-3, unit="m")
-        require_range("health.spalls.angle", self.angle, -2 * math.pi, 2 * math.pi, unit="rad")
-        require(
-            isinstance(self.roller, int) and self.roller >= 0,
-            "health.spalls.roller",
-            self.roller,
-            "must be an integer ≥ 0",
-        )
-
-    def as_dict(self) -> dict:
-        return asdict(self)
-
-
-def _spall(value) -> Spall:
-    if isinstance(value, Spall):
-        return value
-    require(isinstance(value, dict), "health.spalls", value, "must be a list of tables")
-    require_known_keys("health.spalls", value, [f.name for f in fields(Spall)])
-    return Spall(**value)
 
 
 @dataclass(frozen=True)
@@ -106,12 +42,14 @@ class HealthState:
     friction_scale : float [-]
         Multiplies the thread friction coefficients; 1 = new lubricant, > 1 degraded.
     preload : float [m]
-        Axial interference on each flank of every roller's screw and nut threads (oversize
-        rollers or a double nut): the realised half-clearance is b − preload, so with b = 0 and
-        a preload both flanks touch at rest and there is no play while the preload holds.
-        Preload loss is a lower preload (0: lost). Range 0–50 µm.
-    spalls : tuple of Spall
-        Localised flank defects (default none).
+        Installed axial interference on each flank of every roller's screw and nut threads
+        (oversize rollers or a double nut): the realised half-clearance is b − preload, so with
+        b = 0 and a preload both flanks touch at rest and there is no play while the preload
+        holds. A :class:`~prsm_health.faults.PreloadLoss` fault takes a share of it away
+        (:attr:`effective_preload`). Range 0–50 µm.
+    faults : tuple
+        Faults of :mod:`prsm_health.faults` (spalls, preload loss, …), default none; dicts
+        with a ``kind`` key are converted.
     """
 
     clearance_screw: float = 10e-6
@@ -120,15 +58,63 @@ class HealthState:
     wear_spread: float = 0.0
     friction_scale: float = 1.0
     preload: float = 0.0
-    spalls: tuple[Spall, ...] = ()
+    faults: tuple = ()
 
     def __post_init__(self):
-        object.__setattr__(self, "spalls", tuple(_spall(s) for s in self.spalls))
+        require(
+            isinstance(self.faults, (list, tuple)),
+            "health.faults",
+            self.faults,
+            "must be a list of fault tables",
+        )
+        object.__setattr__(self, "faults", tuple(fault_from_dict(f) for f in self.faults))
         for name in ("clearance_screw", "clearance_nut", "clearance_gear"):
             require_range(f"health.{name}", getattr(self, name), 0.0, 500e-6, unit="m")
         require_range("health.wear_spread", self.wear_spread, 0.0, 1.0)
         require_range("health.friction_scale", self.friction_scale, 0.0, 20.0)
         require_range("health.preload", self.preload, 0.0, 50e-6, unit="m")
+        require(
+            self.preload > 0 or not self.of_kind("preload_loss"),
+            "faults.kind",
+            "preload_loss",
+            "needs a preload: set health.preload (the installed interference) > 0",
+        )
+
+    @classmethod
+    def from_dict(cls, values: dict, table: str = "health") -> HealthState:
+        """From a health table: the fields, ``clearance`` as shorthand for screw, nut and gear,
+        and ``faults`` as a list of tables (``[[faults]]``); unknown keys name the table."""
+        if isinstance(values, cls):
+            return values
+        require(isinstance(values, dict), table, values, "must be a table of parameters")
+        values = dict(values)
+        if "clearance" in values:
+            clearance = values.pop("clearance")
+            for key in ("clearance_screw", "clearance_nut", "clearance_gear"):
+                values.setdefault(key, clearance)
+        require_known_keys(table, values, ["clearance", *(f.name for f in fields(cls))])
+        return cls(**values)
+
+    @classmethod
+    def from_toml(cls, path) -> HealthState:
+        """Read a health file: the :meth:`from_dict` table at the top level (docs/faults.md)."""
+        return cls.from_dict(read_toml(path, "health file"))
+
+    def of_kind(self, kind: str) -> tuple:
+        """The faults of one kind (``"spall"``, ``"preload_loss"``, …)."""
+        return tuple(f for f in self.faults if f.kind == kind)
+
+    @property
+    def spalls(self) -> tuple:
+        return self.of_kind("spall")
+
+    @property
+    def effective_preload(self) -> float:
+        """Interference left after preload loss [m]."""
+        kept = 1.0
+        for fault in self.of_kind("preload_loss"):
+            kept *= 1.0 - fault.fraction
+        return self.preload * kept
 
     @classmethod
     def uniform(cls, clearance: float, **kw) -> HealthState:
@@ -138,7 +124,7 @@ class HealthState:
         )
 
     def as_dict(self) -> dict:
-        return {**asdict(self), "spalls": [spall.as_dict() for spall in self.spalls]}
+        return {**asdict(self), "faults": [fault_as_dict(f) for f in self.faults]}
 
 
 @dataclass(frozen=True)
@@ -412,28 +398,3 @@ class ManufacturingVariation:
 
     def as_dict(self) -> dict:
         return asdict(self)
-
-
-@dataclass(frozen=True)
-class FaultThresholds:
-    """Fault taxonomy thresholds (recipe ``[faults]``).
-
-    A run's class, in this order of precedence: ``severe_wear`` when its largest thread
-    clearance ≥ ``severe_wear`` [m]; ``wear`` when ≥ ``wear`` [m]; ``lubrication`` when its
-    friction scale ≥ ``lubrication`` [-]; else ``healthy``. Wear comes first because it is
-    irreversible and what maintenance acts on; a degraded lubricant on a worn actuator is
-    labelled by its wear.
-    """
-
-    wear: float = 15e-6
-    severe_wear: float = 30e-6
-    lubrication: float = 1.8
-
-    def classify(self, clearance: float, friction_scale: float) -> str:
-        if clearance >= self.severe_wear:
-            return "severe_wear"
-        if clearance >= self.wear:
-            return "wear"
-        if friction_scale >= self.lubrication:
-            return "lubrication"
-        return "healthy"

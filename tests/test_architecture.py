@@ -21,6 +21,7 @@ LAYERS = {
     "design": 1,
     "design_files": 1,
     "states": 1,
+    "faults": 1,
     "drive_train": 1,
     "kinematics": 1,
     "stiffness": 1,

@@ -18,6 +18,7 @@ from prsm_health.cli import main
 from prsm_health.dataset import Dataset, FaultThresholds, Recipe, generate
 from prsm_health.errors import PRSMHealthError
 from prsm_health.features import FEATURES
+from prsm_health.states import HealthState
 from prsm_health.training import calibration_minimums, train, training_problems
 
 TINY = dict(
@@ -55,7 +56,10 @@ def labels_table(n_train, n_test, *, seed=0, classes=None):
             "split": ["train"] * n_train + ["test"] * n_test,
             "fault_class": classes
             if classes is not None
-            else [faults.classify(c, f) for c, f in zip(clearance, friction)],
+            else [
+                faults.classify(HealthState.uniform(c, friction_scale=f))
+                for c, f in zip(clearance, friction)
+            ],
             "design": "paper01",
             "clearance_screw": clearance,
             "clearance_nut": clearance,

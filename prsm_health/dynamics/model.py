@@ -483,8 +483,9 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     pitch = r[:, L.R_E_S] + r[:, L.R_E_N]
     take_up = 0.5 * np.abs(pitch - np.mean(pitch))
     # a preload is interference on both flanks: a negative half-clearance
-    r[:, L.R_B_S] = health.clearance_screw * scale + take_up - health.preload
-    r[:, L.R_B_N] = health.clearance_nut * scale + take_up - health.preload
+    preload = health.effective_preload
+    r[:, L.R_B_S] = health.clearance_screw * scale + take_up - preload
+    r[:, L.R_B_N] = health.clearance_nut * scale + take_up - preload
     r[:, L.R_B_G] = health.clearance_gear + np.abs(r[:, L.R_E_G] - np.mean(r[:, L.R_E_G]))
     r[:, L.R_MESH_PHASE] = 0.0
     r[:, L.R_MESH_SCALE] = np.clip(1.0 + variation.mesh_stiffness_spread * z[5], 0.5, 1.5)
@@ -494,7 +495,7 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
         if spall.location == "roller":
             require(
                 spall.roller < n,
-                "health.spalls.roller",
+                "faults.roller",
                 spall.roller,
                 f"must be below the design's {n} rollers",
             )

@@ -17,6 +17,7 @@ from prsm_health.dynamics import layout as L
 from prsm_health.dynamics.model import build_model
 from prsm_health.dynamics.simulate import linearised_modes
 from prsm_health.errors import ParameterError
+from prsm_health.faults import PreloadLoss
 
 HERTZ_IDEAL = SimulationOptions(
     contact_law="hertz", variation=ManufacturingVariation.ideal(), operating_load=100.0
@@ -43,9 +44,10 @@ def test_axial_stiffness_rises_with_preload():
 
 
 def test_no_play_while_the_preload_holds():
-    # ±300 N reversing load, ideal geometry. Preloaded (b = 0, 10 µm interference): the lost
-    # motion is the elastic compliance of threads, bearing and coupling only (≈ 12 µm seen);
-    # with the preload lost and 10 µm of clearance it is the play, ≈ 4b + the same (≈ 70 µm).
+    # ±300 N reversing load, ideal geometry, a nut with 5 µm of worn clearance and 10 µm of
+    # installed interference. While interference remains (no loss, or 40 % lost: 1 µm left)
+    # the lost motion is the elastic compliance of threads, bearing and coupling only; with the
+    # preload lost the 5 µm of clearance is play, ≈ 4b = 20 µm more lost motion.
     reversing = OperatingProfile(
         duration=0.3,
         load=0.0,
@@ -56,14 +58,23 @@ def test_no_play_while_the_preload_holds():
     )
     options = SimulationOptions(contact_law="hertz", variation=ManufacturingVariation.ideal())
 
-    def lost_motion(health):
+    def lost_motion(fraction):
+        faults = (PreloadLoss(fraction=fraction),) if fraction else ()
+        health = HealthState.uniform(5e-6, preload=10e-6, faults=faults)
         run = simulate("paper01", health, reversing, "ideal", 2, options=options)
         return extract_features(run)["lost_motion"]
 
-    preloaded = lost_motion(HealthState(clearance_screw=0.0, clearance_nut=0.0, preload=10e-6))
-    lost = lost_motion(HealthState(clearance_screw=10e-6, clearance_nut=10e-6, preload=0.0))
-    assert preloaded < 0.3 * lost
-    assert lost - preloaded > 3 * 10e-6  # the 4b of play appears when the preload is gone
+    held, partly, lost = (lost_motion(f) for f in (0.0, 0.4, 1.0))
+    print(f"lost motion {held * 1e6:.1f}, {partly * 1e6:.1f}, {lost * 1e6:.1f} µm")
+    assert lost - held > 3 * 5e-6, (held, lost)  # the 4b of play appears (3b: margin)
+    assert partly - held < 0.5 * (lost - held), (held, partly, lost)
+
+
+def test_preload_loss_needs_a_preload():
+    with pytest.raises(ParameterError, match="faults.kind"):
+        HealthState(faults=(PreloadLoss(),))
+    with pytest.raises(ParameterError, match="faults.fraction"):
+        PreloadLoss(fraction=1.5)
 
 
 def test_energy_balance_with_preload():

@@ -13,7 +13,7 @@ from scipy import signal
 
 from prsm_health import HealthState, OperatingProfile, defect_frequencies, preset, simulate
 from prsm_health.errors import ParameterError
-from prsm_health.states import Spall
+from prsm_health.faults import Spall
 
 pytestmark = pytest.mark.slow  # six 1 s runs
 
@@ -32,7 +32,7 @@ def envelope_line(x, rate, f0):
 def line(location, depth):
     spalls = (Spall(location=location, depth=depth),) if depth else ()
     run = simulate(
-        "paper01", HealthState(spalls=spalls), OperatingProfile(duration=1.0, load=300.0), None, 4
+        "paper01", HealthState(faults=spalls), OperatingProfile(duration=1.0, load=300.0), None, 4
     )
     e = run.energy
     assert e["drive"] == pytest.approx(-e["load"] + e["dissipated"], rel=1e-2)
@@ -52,11 +52,11 @@ def test_spall_makes_a_line_at_its_defect_frequency_growing_with_severity(locati
 
 
 def test_spall_errors_name_the_field():
-    with pytest.raises(ParameterError, match="health.spalls.location"):
+    with pytest.raises(ParameterError, match="faults.location"):
         Spall(location="ring")
-    with pytest.raises(ParameterError, match="health.spalls.depth"):
+    with pytest.raises(ParameterError, match="faults.depth"):
         Spall(depth=-1e-6)
-    with pytest.raises(ParameterError, match="health.spalls.size"):
-        HealthState(spalls=({"size": 1.0},))
-    with pytest.raises(ParameterError, match="health.spalls.roller"):
-        simulate(health=HealthState(spalls=(Spall(location="roller", roller=9),)))
+    with pytest.raises(ParameterError, match="faults.size"):
+        HealthState(faults=({"kind": "spall", "size": 1.0},))
+    with pytest.raises(ParameterError, match="faults.roller"):
+        simulate(health=HealthState(faults=(Spall(location="roller", roller=9),)))
