@@ -143,6 +143,19 @@ def _wave(errors, kind, u):
     return a + (b - a) * (x - i0), (b - a) * n / period
 
 
+@njit(cache=True, inline="always")
+def _clamped(errors, kind, x):
+    # A non-periodic table of x ≥ 0 from 0 to errors[kind, 0], linearly interpolated, its last
+    # value beyond the end.
+    n = errors.shape[1] - 2
+    pos = x / errors[kind, 0] * n
+    if pos >= n:
+        return errors[kind, 1 + n]
+    i0 = int(pos)
+    a = errors[kind, 1 + i0]
+    return a + (errors[kind, 2 + i0] - a) * (pos - i0)
+
+
 @njit(cache=True)
 def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     """dy/dt of the full state at time t; auxiliary outputs (torques, powers) into ``aux``.
@@ -199,6 +212,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     v_axial, w_roll, lead_eff = p[L.P_V_AXIAL], p[L.P_W_ROLL], p[L.P_LEAD_EFF]
     g1 = 1.0 - p[L.P_LEAD_SLOPE]  # cumulative lead error: axial closure per axial travel
     spalled = p[L.P_HAS_SPALLS] == 1.0
+    toothed = p[L.P_HAS_TOOTH_DAMAGE] == 1.0
+    stribeck = p[L.P_STRIBECK] == 1.0
     s0 = 2 * nq + L.N_EXTRA  # offset of the traction states
     z_ring = p[L.P_Z_RING]
 
@@ -284,6 +299,9 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # the Coulomb limit μN and slides beyond it (reset integrator, Haessig & Friedland
         # 1991), plus viscous drag. v_slide = 0 is rolling at both pitch circles.
         v_slide = r_s * (w_s - w_rev) + r_r * (w_c - w_rev)
+        if stribeck:  # the lubrication regime at this contact's entrainment speed
+            u_e = 0.5 * abs(r_s * (w_s - w_rev) - r_r * (w_c - w_rev))
+            mu_c = _clamped(errors, L.ERR_COULOMB, u_e) * fscale
         cap = mu_c * (f_plus + f_minus) / sin_b
         aux[L.N_AUX + i] = cap
         slip = y[s0 + i]
@@ -386,6 +404,10 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # ---------------- roller gear – ring gear mesh (line of action n = cos α0 e_t − sin α0 e_r)
         phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, L.R_MESH_PHASE]
         k_mesh = _mesh_stiffness(mesh_table, phase) * rollers[i, L.R_MESH_SCALE]
+        if toothed:  # a damaged ring tooth meets every roller, a roller's own tooth its ring
+            ring, _ = _wave(errors, L.ERR_RING_TOOTH, phase)
+            own, _ = _wave(errors, L.ERR_ROLLER_TOOTH, phase)
+            k_mesh *= 1.0 + ring + rollers[i, L.R_TOOTH] * own
         e_g, de_g = _wave(errors, L.ERR_GEAR, phi - th_n)
         d_g = (
             rb_ring * th_n

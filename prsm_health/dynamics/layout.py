@@ -77,7 +77,9 @@ P_C_FILM = 69  # lubricant squeeze-film damper, nut vs screw kinematics [N·s/m]
 P_KP_POS = 70  # position-loop gain [1/s]
 P_LEAD_SLOPE = 71  # cumulative lead error of the screw, axial error per axial travel [-]
 P_HAS_SPALLS = 72  # 1 when the health state has a spall: only then the spall tables are read
-N_PARAMS = 73
+P_HAS_TOOTH_DAMAGE = 73  # 1 when a gear tooth is damaged: only then the tooth tables are read
+P_STRIBECK = 74  # 1: the Coulomb coefficient follows the lubrication regime (ERR_COULOMB)
+N_PARAMS = 75
 
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 
@@ -95,7 +97,15 @@ ERR_SCREW_AXIAL, ERR_SCREW_RADIAL, ERR_NUT_AXIAL, ERR_GEAR, ERR_UNIT_COSINE = 0,
 # u as screw axial; nut: u as nut axial; roller: the spin angle χ = θ_c − θ_rev of the roller
 # that carries it (R_SPALL), facing the nut at χ and the screw at χ + π.
 ERR_SCREW_SPALL, ERR_NUT_SPALL, ERR_ROLLER_SPALL = 5, 6, 7
-N_ERROR_KINDS = 8
+# Gear tooth damage: the mesh stiffness ratio − 1 (damaged over healthy) of the mesh as a
+# function of its phase [cycles], over one turn of the ring gear (z_ring cycles: which ring
+# tooth is in mesh) and over one turn of the roller gear (z_roller cycles: which of the roller's
+# teeth), the latter only for the roller that carries the damage (R_TOOTH).
+ERR_RING_TOOTH, ERR_ROLLER_TOOTH = 8, 9
+# Coulomb coefficient of the screw–roller contacts vs entrainment speed [m/s], not periodic:
+# column 0 holds the highest tabulated speed, beyond which the last value holds.
+ERR_COULOMB = 10
+N_ERROR_KINDS = 11
 N_ERROR_POINTS = 16384
 
 # ----------------------------------------------------------------- per-roller parameters
@@ -109,7 +119,8 @@ R_MESH_SCALE = 10  # mesh stiffness scale (tooth-to-tooth variation) [-]
 R_PSI = 11  # angular position of the pocket [rad]
 R_RUNOUT, R_RUNOUT_PHASE = 12, 13  # roller thread runout about its spin axis [m], phase [rad]
 R_SPALL = 14  # 1 for the roller carrying the roller-flank spall, else 0
-N_ROLLER_PARAMS = 15
+R_TOOTH = 15  # 1 for the roller whose gear carries the damaged tooth, else 0
+N_ROLLER_PARAMS = 16
 
 # ----------------------------------------------------------------- recorded truth signals
 (

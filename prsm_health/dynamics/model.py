@@ -430,6 +430,10 @@ def _error_terms(design, variation, rng, spalls=()) -> tuple[np.ndarray, float]:
         L.ERR_SCREW_SPALL: 2 * math.pi,
         L.ERR_NUT_SPALL: 2 * math.pi,
         L.ERR_ROLLER_SPALL: 2 * math.pi,
+        # tooth damage and the lubrication regime: filled by their own builders
+        L.ERR_RING_TOOTH: 1.0,
+        L.ERR_ROLLER_TOOTH: 1.0,
+        L.ERR_COULOMB: 1.0,
     }
     terms[L.ERR_UNIT_COSINE].append((1.0, 1.0, math.pi / 2))
     tables = np.zeros((L.N_ERROR_KINDS, L.N_ERROR_POINTS + 1))
