@@ -252,7 +252,7 @@ class Recipe:
                 isinstance(faults, list),
                 f"fault_cases.{name}",
                 faults,
-                "must be a list of fault tables, e.g. [{ kind = \"spall\", location = \"nut\" }]",
+                'must be a list of fault tables, e.g. [{ kind = "spall", location = "nut" }]',
             )
             for fault in faults:
                 try:

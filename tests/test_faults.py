@@ -38,9 +38,12 @@ def test_health_file_reads_faults_of_several_kinds(tmp_path):
 def test_scenario_toml_round_trip_and_labels():
     health = HealthState(faults=({"kind": "spall", "location": "roller", "roller": 2},))
     scenario = Scenario(health=health)
-    assert Scenario.from_dict(
-        {"health": {"faults": [{"kind": "spall", "location": "roller", "roller": 2}]}}
-    ).health == health
+    assert (
+        Scenario.from_dict(
+            {"health": {"faults": [{"kind": "spall", "location": "roller", "roller": 2}]}}
+        ).health
+        == health
+    )
     labels = scenario.labels()
     assert labels["fault_kinds"] == "spall"
     assert json.loads(labels["faults"]) == [
