@@ -41,6 +41,7 @@ from scipy.integrate import solve_ivp
 
 from .design import PRSMDesign
 from .errors import ConvergenceError, require, require_positive, require_range
+from .lubrication import StribeckCurve
 
 
 @dataclass(frozen=True)
@@ -225,19 +226,33 @@ class FrictionParameters:
         return d_s, d_r
 
 
-def steady_friction_torque(params: FrictionParameters, load: float) -> float:
+def steady_friction_torque(
+    params: FrictionParameters,
+    load: float,
+    speed: float = 1.0,
+    stribeck: StribeckCurve | None = None,
+) -> float:
     """Steady rolling friction torque F(μ2 p_s + μ3)/(cos ψ cos β)·scale + drag [N·m].
 
     At steady speed the roller rolls (tangential sliding 0) and the only sliding is the axial
     p_s·θ̇_s, so the Coulomb force of all contacts acts axially (closed form of the model).
+    With a ``stribeck`` curve, μ2 is its coefficient at the steady entrainment speed of screw
+    ``speed`` [rad/s].
     """
     require(load >= 0, "load", load, "must be ≥ 0 N")
     total_normal = params.contacts * params.normal_load(load)
-    s = params.friction_scale
-    return (
-        total_normal * s * (params.sliding * params.lead_per_radian + params.rolling)
-        + params.drag_torque
-    )
+    sliding = _sliding(params, stribeck, speed, params.rolling_ratio * speed)
+    rolling = params.rolling * params.friction_scale
+    return total_normal * (sliding * params.lead_per_radian + rolling) + params.drag_torque
+
+
+def _sliding(params: FrictionParameters, stribeck, w_s: float, w_r: float) -> float:
+    """μ2 (times the friction scale): constant, or the lubrication regime's coefficient at the
+    entrainment speed r_s·|θ̇_s − θ̇_R| of the screw–roller contacts (pure rolling)."""
+    if stribeck is None:
+        return params.sliding * params.friction_scale
+    u_e = params.screw_radius * abs(w_s - w_r)
+    return float(np.interp(u_e, stribeck.speed, stribeck.coefficient)) * params.friction_scale
 
 
 @dataclass(frozen=True)
@@ -287,6 +302,7 @@ def simulate_friction(
     accel_time: float = 0.02,
     duration: float | None = None,
     n_points: int = 2001,
+    stribeck: StribeckCurve | None = None,
 ) -> FrictionResult:
     """Start the screw from rest to ``speed`` over ``accel_time`` under a constant load.
 
@@ -304,6 +320,10 @@ def simulate_friction(
         t_acc + 0.1 s (the paper does not state its interval).
     n_points : int
         Output samples.
+    stribeck : StribeckCurve or None
+        The lubrication regime (:func:`prsm_health.lubrication.stribeck_curve`): μ2 follows
+        it at the contacts' entrainment speed, so the start-up crosses boundary and mixed
+        friction. None: paper 02's constant μ2.
 
     Returns
     -------
@@ -325,7 +345,7 @@ def simulate_friction(
     n = params.contacts
     f_n = params.normal_load(load)
     s = params.friction_scale
-    mu1, mu2, mu3 = params.viscous * s, params.sliding * s, params.rolling * s
+    mu1, mu3 = params.viscous * s, params.rolling * s
     eps = params.coulomb_velocity
     b_inertia = params.revolution_inertia
     a_inertia = params.screw_inertia_total
@@ -333,6 +353,7 @@ def simulate_friction(
 
     def friction_force(w_s, w_r):
         v = d_s * w_s + d_r * w_r
+        mu2 = _sliding(params, stribeck, w_s, w_r)
         return -(mu1 * n * v + mu2 * f_n * n * v / math.sqrt(float(v @ v) + eps * eps))
 
     def rhs(t, y):
@@ -379,7 +400,7 @@ def simulate_friction(
     )
     work_out = np.trapezoid(load * p_s * w_s, time)
     work_in = np.trapezoid(input_torque * w_s, time)
-    steady = steady_friction_torque(params, load)
+    steady = steady_friction_torque(params, load, speed, stribeck)
     out_steady = load * p_s
     return FrictionResult(
         time=time,

@@ -40,7 +40,13 @@ class HealthState:
         Uneven wear between rollers: roller i's thread clearances are scaled by
         (1 + wear_spread·u_i), u_i uniform in [−1, 1] drawn from the run seed. 0 = even wear.
     friction_scale : float [-]
-        Multiplies the thread friction coefficients; 1 = new lubricant, > 1 degraded.
+        Multiplies the thread friction coefficients (1: as the lubrication model gives them).
+    lubricant_degradation : float [-]
+        0 (new) … 1: additive depletion raises boundary friction towards unprotected steel's,
+        and the viscosity falls (:mod:`prsm_health.lubrication`).
+    lubricant_starvation : float [-]
+        0 (fully flooded) … 1: the inlet is no longer replenished and the film thins to
+        (1 − s) of the flooded one.
     preload : float [m]
         Installed axial interference on each flank of every roller's screw and nut threads
         (oversize rollers or a double nut): the realised half-clearance is b − preload, so with
@@ -57,6 +63,8 @@ class HealthState:
     clearance_gear: float = 10e-6
     wear_spread: float = 0.0
     friction_scale: float = 1.0
+    lubricant_degradation: float = 0.0
+    lubricant_starvation: float = 0.0
     preload: float = 0.0
     faults: tuple = ()
 
@@ -72,6 +80,8 @@ class HealthState:
             require_range(f"health.{name}", getattr(self, name), 0.0, 500e-6, unit="m")
         require_range("health.wear_spread", self.wear_spread, 0.0, 1.0)
         require_range("health.friction_scale", self.friction_scale, 0.0, 20.0)
+        require_range("health.lubricant_degradation", self.lubricant_degradation, 0.0, 1.0)
+        require_range("health.lubricant_starvation", self.lubricant_starvation, 0.0, 1.0)
         require_range("health.preload", self.preload, 0.0, 50e-6, unit="m")
         require(
             self.preload > 0 or not self.of_kind("preload_loss"),
@@ -165,6 +175,8 @@ class OperatingProfile:
         Proportional gain of the position loop (speed command per angle error).
     torque_limit : float [N·m]
         Motor torque limit of the speed loop.
+    temperature : float [K]
+        Lubricant temperature at the thread contacts (sets its viscosity; 223–473 K).
     """
 
     duration: float = 0.2
@@ -182,6 +194,7 @@ class OperatingProfile:
     speed_loop_bandwidth: float = 50.0
     position_loop_gain: float = 60.0
     torque_limit: float = 50.0
+    temperature: float = 313.15
 
     def __post_init__(self):
         require_range("profile.duration", self.duration, 1e-4, 3600.0, unit="s")
@@ -232,6 +245,7 @@ class OperatingProfile:
             f"must be one of {', '.join(RAMP_SHAPES)}",
         )
         require_positive("profile.torque_limit", self.torque_limit)
+        require_range("profile.temperature", self.temperature, 223.15, 473.15, unit="K")
 
     # ------------------------------------------------------------------ knots for the kernel
     def motion_knots(self) -> np.ndarray:

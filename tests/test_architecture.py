@@ -26,6 +26,7 @@ LAYERS = {
     "kinematics": 1,
     "stiffness": 1,
     "friction": 1,
+    "lubrication": 1,
     "recirculating": 1,
     "sensors": 1,
     "instrumentation": 1,

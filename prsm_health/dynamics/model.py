@@ -66,10 +66,12 @@ from ..drive_train import DriveTrain
 from ..errors import require, require_positive, require_range
 from ..friction import FrictionParameters
 from ..kinematics import speed_ratios
+from ..lubrication import DEFAULT_LUBRICANT, lubricant, stribeck_curve
 from ..states import HealthState, ManufacturingVariation, OperatingProfile
 from . import layout as L
 
 CONTACT_LAWS = ("linear", "hertz")
+LUBRICATION_MODELS = ("regime", "constant")
 
 #: Paper 02's friction table, the one source of the simulator's Coulomb and rolling defaults.
 _PAPER02_FRICTION = FrictionParameters.paper02()
@@ -98,9 +100,17 @@ class SimulationOptions:
         transient of the as-built rollers finding their load share is not in the run.
     support_damping_ratio : float [-]
         Damping ratio of bearings, guides and pockets.
+    lubrication : {"regime", "constant"}
+        "regime": the Coulomb coefficient of the screw–roller contacts follows the lubrication
+        regime at each contact's entrainment speed (:mod:`prsm_health.lubrication`: film
+        thickness, asperity load share, boundary and film friction; the health state's
+        lubricant degradation and starvation, the profile's temperature). "constant":
+        ``friction_coefficient`` throughout (papers 01 and 02's model).
+    lubricant : str
+        Built-in lubricant (:data:`prsm_health.lubrication.LUBRICANTS`) for "regime".
     friction_coefficient : float [-]
-        Coulomb coefficient of screw–roller sliding (paper 02: μ2 = 0.1), for the traction
-        limit and the axial sliding of the rollers on the screw.
+        Coulomb coefficient of screw–roller sliding with ``lubrication = "constant"`` (paper
+        02: μ2 = 0.1), for the traction limit and the axial sliding of the rollers on the screw.
     rolling_friction : float [m]
         Differential-sliding coefficient μ3 of paper 02 (1.5e-6 m).
     viscous_friction : float [N·s/m]
@@ -126,6 +136,8 @@ class SimulationOptions:
     contact_damping_ratio: float = 0.03
     contact_restitution: float = 0.6
     support_damping_ratio: float = 0.05
+    lubrication: str = "regime"
+    lubricant: str = DEFAULT_LUBRICANT
     friction_coefficient: float = _PAPER02_FRICTION.sliding
     rolling_friction: float = _PAPER02_FRICTION.rolling
     viscous_friction: float = 25.0
@@ -150,6 +162,13 @@ class SimulationOptions:
         require_range("options.contact_damping_ratio", self.contact_damping_ratio, 0.0, 1.0)
         require_range("options.contact_restitution", self.contact_restitution, 0.05, 1.0)
         require_range("options.support_damping_ratio", self.support_damping_ratio, 0.0, 1.0)
+        require(
+            self.lubrication in LUBRICATION_MODELS,
+            "options.lubrication",
+            self.lubrication,
+            f"must be one of {', '.join(LUBRICATION_MODELS)}",
+        )
+        lubricant(self.lubricant)  # a known name, or the error naming the choices
         require_range("options.friction_coefficient", self.friction_coefficient, 0.0, 1.0)
         require_range("options.rolling_friction", self.rolling_friction, 0.0, 1e-3, unit="m")
         require_range("options.viscous_friction", self.viscous_friction, 0.0, 1e5, unit="N·s/m")
@@ -351,6 +370,7 @@ def build_model(
     rollers = _roller_params(design, health, options.variation, orbit, rng)
     errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng, health.spalls)
     p[L.P_HAS_SPALLS] = 1.0 if health.spalls else 0.0
+    p[L.P_STRIBECK] = _coulomb_table(errors, design, health, profile, options)
     return Model(
         design=design,
         health=health,
@@ -449,6 +469,32 @@ def _error_terms(design, variation, rng, spalls=()) -> tuple[np.ndarray, float]:
         tables[kind[spall.location], 1:] += spall_profile(u, spall, radius[spall.location])
     lead_slope = 0.5 * v.lead_error_cumulative / 0.3 * float(draws[0])
     return tables, lead_slope
+
+
+def _coulomb_table(errors, design, health, profile, options) -> float:
+    """Fill the Coulomb coefficient vs entrainment speed (``ERR_COULOMB``) for the lubrication
+    regime; 1.0 when the kernel is to read it, 0.0 for a constant coefficient."""
+    if options.lubrication == "constant":
+        return 0.0
+    # Entrainment speed of the screw–roller contacts: ½|r_s(ω_s − ω_rev) − r_r(ω_c − ω_rev)|,
+    # r_s·|ω_s − ω_rev| in pure rolling; tabulated to twice its nominal peak (transients),
+    # beyond which the coefficient is flat anyway (full film).
+    ratios = speed_ratios(design)
+    peak = design.screw_diameter / 2 * abs(1.0 - ratios.carrier) * max(profile.speed, 1.0)
+    speeds = np.linspace(0.0, 2.0 * peak, L.N_ERROR_POINTS)
+    load = abs(profile.load) + profile.load_amplitude
+    curve = stribeck_curve(
+        design,
+        options.lubricant,
+        speeds,
+        axial_load=load,
+        temperature=profile.temperature,
+        degradation=health.lubricant_degradation,
+        starvation=health.lubricant_starvation,
+    )
+    errors[L.ERR_COULOMB, 0] = speeds[-1]
+    errors[L.ERR_COULOMB, 1:] = curve.coefficient
+    return 1.0
 
 
 def spall_profile(u: np.ndarray, spall, radius: float) -> np.ndarray:

@@ -19,7 +19,8 @@ from ..states import HealthState, ManufacturingVariation, OperatingProfile
 from ..stiffness.thread import roller_side_stiffness
 from . import Row, inconsistent, not_computable, reproduced
 
-IDEAL = SimulationOptions(variation=ManufacturingVariation.ideal())
+#: Paper 01's model: identical rollers and its constant friction coefficients.
+IDEAL = SimulationOptions(variation=ManufacturingVariation.ideal(), lubrication="constant")
 
 
 def _simulate(speed: float, clearance: float, duration: float = 0.4):

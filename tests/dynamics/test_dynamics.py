@@ -246,12 +246,14 @@ def test_friction_torque_is_paper02_reduction():
     # The kernel's friction: paper 02's Coulomb μ2·N against the rollers' axial sliding on the
     # screw plus μ3·N. With μ3 = 0, roller equilibrium f_screw − μN = F/n and N = f_screw/sin β
     # give T_f = F·μ·p_eff/(sin β − μ) (p_eff = nut travel per screw radian). Tolerance 3 %:
-    # the tangential traction that spins the carrier and the lead angle are left out.
+    # the tangential traction that spins the carrier and the lead angle are left out. Constant
+    # μ (paper 02's model; the lubrication regime is tests/test_lubrication.py's).
     d = preset("paper01")
     p_eff = speed_ratios(d).nut
     mu, beta = 0.1, d.contact_angle
     for load in (100.0, 500.0):
-        r = run(load=load, duration=0.2, options=SimulationOptions(rolling_friction=0.0))
+        options = SimulationOptions(rolling_friction=0.0, lubrication="constant")
+        r = run(load=load, duration=0.2, options=options)
         t_f = np.mean(r.truth["friction_torque"][len(r) // 2 :])
         assert t_f == pytest.approx(load * mu * p_eff / (np.sin(beta) - mu), rel=0.03)
 
