@@ -26,6 +26,13 @@ from dataclasses import asdict, dataclass, fields, replace
 from typing import ClassVar
 
 from .errors import require, require_known_keys, require_range
+from .stiffness.tooth_damage import (
+    crack_section,
+    pit_band,
+    pit_contact_share,
+    pit_section,
+    root_half_thickness,
+)
 
 SPALL_LOCATIONS = ("screw", "nut", "roller")
 
@@ -98,8 +105,117 @@ class PreloadLoss:
         require_range("faults.fraction", self.fraction, 0.0, 1.0)
 
 
+GEAR_LOCATIONS = ("ring_gear", "roller_gear")
+
+
+@dataclass(frozen=True)
+class ToothCrack:
+    """A root crack on one tooth of the ring gear or of one roller's gear: the tooth loses
+    section (:mod:`prsm_health.stiffness.tooth_damage`, Tian 2004; Wu, Zuo & Parey 2008), so the
+    mesh softens each time that tooth carries load — once per pass of a roller for a ring
+    tooth, once per roller spin for a roller tooth.
+
+    Parameters
+    ----------
+    location : {"ring_gear", "roller_gear"}
+    depth : float [m]
+        Crack length q from the root (the severity); q·sin(angle) must stay below the root
+        half-thickness (the crack does not cross the tooth centreline).
+    angle : float [rad]
+        Crack angle ν to the root surface (45° in both papers).
+    tooth : int
+        Which tooth of that gear (0-based; its position in the mesh cycle).
+    roller : int
+        Which roller's gear, for ``roller_gear``.
+    """
+
+    kind: ClassVar[str] = "tooth_crack"
+    severity_field: ClassVar[str] = "depth"
+    locations: ClassVar[tuple[str, ...]] = GEAR_LOCATIONS
+
+    location: str = "ring_gear"
+    depth: float = 0.4e-3
+    angle: float = math.radians(45.0)
+    tooth: int = 0
+    roller: int = 0
+
+    def __post_init__(self):
+        _require_location(self)
+        require_range("faults.depth", self.depth, 0.0, 5e-3, unit="m")
+        require_range("faults.angle", self.angle, math.radians(5), math.radians(85), unit="rad")
+        _require_index("faults.tooth", self.tooth)
+        _require_index("faults.roller", self.roller)
+
+    def section(self, tooth, zeta, h, w):
+        limit = root_half_thickness(tooth) / math.sin(self.angle)
+        require(
+            self.depth < limit,
+            "faults.depth",
+            self.depth,
+            f"must stay below {limit:.4g} m on this gear (a deeper crack crosses the tooth "
+            "centreline, outside the model)",
+        )
+        return crack_section(tooth, h, w, self.depth, self.angle)
+
+    def contact_share(self, tooth, radius):
+        return 1.0
+
+
+@dataclass(frozen=True)
+class ToothPit:
+    """A pit (spall) on the loaded flank of one tooth of the ring gear or of one roller's gear,
+    a radial band of the flank over part of the face width (Chaari et al. 2008; Liang, Zuo &
+    Hoseini 2015): less contact line and less section while the contact crosses it.
+
+    Parameters
+    ----------
+    location : {"ring_gear", "roller_gear"}
+    depth : float [m]
+        Pit depth (the severity).
+    width : float [-]
+        Share of the face width it covers, (0, 1).
+    length : float [m]
+        Radial extent on the flank.
+    offset : float [m]
+        Centre of the band from the pitch circle, towards the tooth tip (0: on the pitch line,
+        where pitting starts).
+    tooth, roller : int
+        As :class:`ToothCrack`.
+    """
+
+    kind: ClassVar[str] = "tooth_pit"
+    severity_field: ClassVar[str] = "depth"
+    locations: ClassVar[tuple[str, ...]] = GEAR_LOCATIONS
+
+    location: str = "ring_gear"
+    depth: float = 20e-6
+    width: float = 0.4
+    length: float = 0.2e-3
+    offset: float = 0.0
+    tooth: int = 0
+    roller: int = 0
+
+    def __post_init__(self):
+        _require_location(self)
+        require_range("faults.depth", self.depth, 0.0, 0.5e-3, unit="m")
+        require_range("faults.width", self.width, 0.0, 0.95)
+        require_range("faults.length", self.length, 0.0, 5e-3, unit="m")
+        require_range("faults.offset", self.offset, -5e-3, 5e-3, unit="m")
+        _require_index("faults.tooth", self.tooth)
+        _require_index("faults.roller", self.roller)
+
+    def band(self, tooth) -> tuple[float, float]:
+        return pit_band(tooth, self.offset, self.length)
+
+    def section(self, tooth, zeta, h, w):
+        return pit_section(tooth, zeta, h, w, self.band(tooth), self.width, self.depth)
+
+    def contact_share(self, tooth, radius):
+        return pit_contact_share(radius, self.band(tooth), self.width)
+
+
 #: Fault kinds by name (``kind`` of a ``[[faults]]`` table).
-FAULT_KINDS: dict[str, type] = {cls.kind: cls for cls in (Spall, PreloadLoss)}
+FAULT_KINDS: dict[str, type] = {cls.kind: cls for cls in (Spall, ToothCrack, ToothPit, PreloadLoss)}
 
 
 def _require_location(fault) -> None:
@@ -156,7 +272,15 @@ def scaled(fault, factor: float):
 
 # ------------------------------------------------------------------------------ taxonomy
 #: Fault classes of the taxonomy (run label ``fault_class``), in no particular order.
-FAULT_CLASSES = ("healthy", "wear", "severe_wear", "lubrication", "spall", "preload_loss")
+FAULT_CLASSES = (
+    "healthy",
+    "wear",
+    "severe_wear",
+    "lubrication",
+    "spall",
+    "tooth_damage",
+    "preload_loss",
+)
 
 
 @dataclass(frozen=True)
@@ -164,10 +288,11 @@ class FaultThresholds:
     """Fault taxonomy thresholds (recipe ``[faults]``).
 
     A run's class, in this order of precedence: ``spall`` when it has a spall deeper than
-    ``spall`` [m]; ``severe_wear`` when its largest thread clearance ≥ ``severe_wear`` [m];
+    ``spall`` [m]; ``tooth_damage`` when a gear tooth has a crack or pit deeper than
+    ``tooth_damage`` [m]; ``severe_wear`` when its largest thread clearance ≥ ``severe_wear`` [m];
     ``wear`` when ≥ ``wear`` [m]; ``preload_loss`` when it has lost a share ≥ ``preload_loss``
-    of a preload; ``lubrication`` when its friction scale ≥ ``lubrication`` [-]; else
-    ``healthy``. Localised damage comes first because it grows to the end of the unit fastest
+    of a preload; ``lubrication`` when its friction scale ≥ ``lubrication`` [-] or its
+    lubricant degradation or starvation ≥ ``lubricant`` [-]; else ``healthy``. Localised damage comes first because it grows to the end of the unit fastest
     and has a signature of its own; wear before preload loss and lubricant because it is
     irreversible and what maintenance acts on.
     """
@@ -176,7 +301,9 @@ class FaultThresholds:
     severe_wear: float = 30e-6
     lubrication: float = 1.8
     spall: float = 0.0
+    tooth_damage: float = 0.0
     preload_loss: float = 0.5
+    lubricant: float = 0.5
 
     def classify(self, health) -> str:
         """The primary class of a :class:`~prsm_health.states.HealthState`."""
@@ -186,13 +313,17 @@ class FaultThresholds:
         clearance = max(health.clearance_screw, health.clearance_nut)
         if by_kind.get("spall", 0.0) > self.spall:
             return "spall"
+        tooth = max(by_kind.get("tooth_crack", 0.0), by_kind.get("tooth_pit", 0.0))
+        if tooth > self.tooth_damage:
+            return "tooth_damage"
         if clearance >= self.severe_wear:
             return "severe_wear"
         if clearance >= self.wear:
             return "wear"
         if health.preload > 0 and by_kind.get("preload_loss", 0.0) >= self.preload_loss:
             return "preload_loss"
-        if health.friction_scale >= self.lubrication:
+        lubricant = max(health.lubricant_degradation, health.lubricant_starvation)
+        if health.friction_scale >= self.lubrication or lubricant >= self.lubricant:
             return "lubrication"
         return "healthy"
 

@@ -68,6 +68,7 @@ from ..friction import FrictionParameters
 from ..kinematics import speed_ratios
 from ..lubrication import DEFAULT_LUBRICANT, lubricant, stribeck_curve
 from ..states import HealthState, ManufacturingVariation, OperatingProfile
+from ..stiffness.tooth_damage import damaged_mesh
 from . import layout as L
 
 CONTACT_LAWS = ("linear", "hertz")
@@ -371,6 +372,7 @@ def build_model(
     errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng, health.spalls)
     p[L.P_HAS_SPALLS] = 1.0 if health.spalls else 0.0
     p[L.P_STRIBECK] = _coulomb_table(errors, design, health, profile, options)
+    p[L.P_HAS_TOOTH_DAMAGE] = _tooth_tables(errors, rollers, design, health, options)
     return Model(
         design=design,
         health=health,
@@ -494,6 +496,44 @@ def _coulomb_table(errors, design, health, profile, options) -> float:
     )
     errors[L.ERR_COULOMB, 0] = speeds[-1]
     errors[L.ERR_COULOMB, 1:] = curve.coefficient
+    return 1.0
+
+
+def _tooth_tables(errors, rollers, design, health, options) -> float:
+    """Fill the mesh-stiffness ratio tables of damaged gear teeth (``ERR_RING_TOOTH``,
+    ``ERR_ROLLER_TOOTH``, per-roller ``R_TOOTH``); 1.0 when there is one, else 0.0.
+
+    Each table spans one turn of its gear in mesh cycles (z teeth): the damaged tooth ``k``
+    enters contact at phase k and stays for the cycles of :func:`damaged_mesh`."""
+    faults = health.of_kind("tooth_crack") + health.of_kind("tooth_pit")
+    if not faults:
+        return 0.0
+    require(design.gear is not None, "faults.kind", faults[0].kind, "needs a design with gears")
+    teeth = {"ring_gear": design.gear.ring_teeth, "roller_gear": design.gear.roller_teeth}
+    rows = {"ring_gear": L.ERR_RING_TOOTH, "roller_gear": L.ERR_ROLLER_TOOTH}
+    damaged_rollers = {f.roller for f in faults if f.location == "roller_gear"}
+    require(
+        len(damaged_rollers) <= 1,
+        "faults.roller",
+        sorted(damaged_rollers),
+        "gear tooth damage on one roller's gear at most per run",
+    )
+    for fault in faults:
+        z, row = teeth[fault.location], rows[fault.location]
+        require(fault.tooth < z, "faults.tooth", fault.tooth, f"must be below the gear's {z} teeth")
+        mesh = damaged_mesh(design, fault, fault.location, threaded_tooth=options.threaded_tooth)
+        phase = (np.arange(L.N_ERROR_POINTS) * z / L.N_ERROR_POINTS - fault.tooth) % z
+        grid = np.arange(mesh.ratio.size) / (mesh.ratio.size / mesh.cycles)
+        errors[row, 0] = z
+        errors[row, 1:] += np.interp(phase, grid, mesh.ratio - 1.0, right=0.0)
+        if fault.location == "roller_gear":
+            require(
+                fault.roller < design.n_rollers,
+                "faults.roller",
+                fault.roller,
+                f"must be below the design's {design.n_rollers} rollers",
+            )
+            rollers[fault.roller, L.R_TOOTH] = 1.0
     return 1.0
 
 

@@ -610,11 +610,13 @@ class _Tooth:
         y, h, dy = self._involute(nodes)
         return y - self.y_root, h, self.width(self._radius(nodes)), dy * weights
 
-    def compliances(self, t_c):
+    def compliances(self, t_c, damage=None):
         """Bending, shear, axial and foundation compliances [m/N] at contact parameters t_c.
 
         Vectorised over contacts: every contact gets its own Gauss–Legendre panels on the
         involute (the upper limit is the contact point) and shares the fillet sections.
+        ``damage`` (:mod:`prsm_health.stiffness.tooth_damage`) replaces the sections' area and
+        second moment where a crack or pit removes material.
         """
         t_c = np.asarray(t_c, dtype=float)
         y_c, h_c, _ = self._involute(t_c)
@@ -632,8 +634,12 @@ class _Tooth:
             dz = np.concatenate([dz, np.broadcast_to(dzf, (n, dzf.size))], axis=1)
 
         arm = (zeta_c[:, None] - zeta) * cos1[:, None] - (h_c * sin1)[:, None]
-        inv_area = dz / (2.0 * h * w)
-        bending = np.sum(arm**2 * 12.0 * dz / (w * (2.0 * h) ** 3), axis=1) / self.E
+        if damage is None:
+            area, inertia = 2.0 * h * w, w * (2.0 * h) ** 3 / 12.0
+        else:
+            area, inertia = damage.section(self, zeta, h, w)
+        inv_area = dz / area
+        bending = np.sum(arm**2 * dz / inertia, axis=1) / self.E
         shear = _SHEAR_FACTOR * cos1**2 * np.sum(inv_area, axis=1) / self.G
         axial = sin1**2 * np.sum(inv_area, axis=1) / self.E
 
@@ -766,6 +772,8 @@ def mesh_stiffness(
     thread_crest_fraction: float = THREAD_CREST_FRACTION,
     thread_full_radius: float | None = None,
     thread_crest_radius: float | None = None,
+    pinion_damage=None,
+    gear_damage=None,
 ) -> MeshStiffness:
     """Time-varying mesh stiffness of a standard involute spur pair (potential energy method).
 
@@ -816,6 +824,11 @@ def mesh_stiffness(
         is the gear tip has its full land there).
     thread_crest_radius : float or None [m]
         x_A, radius of the other end of the linear law. None: the tip radius.
+    pinion_damage, gear_damage : ToothCrack, ToothPit or None
+        Damage of the pinion's or the gear's tooth (:mod:`prsm_health.stiffness.tooth_damage`):
+        every tooth of that member is damaged alike, so ``single_pair`` is the damaged pair;
+        :func:`~prsm_health.stiffness.tooth_damage.damaged_mesh` puts one damaged tooth into
+        the mesh cycle.
 
     Returns
     -------
@@ -960,10 +973,14 @@ def mesh_stiffness(
     s = s_start + xi * p_b
     t1, t2 = s / pinion.rb, t_gear(s)
 
-    kb1, ks1, ka1, kf1 = pinion.compliances(t1)
-    kb2, ks2, ka2, kf2 = gear.compliances(t2)
+    kb1, ks1, ka1, kf1 = pinion.compliances(t1, pinion_damage)
+    kb2, ks2, ka2, kf2 = gear.compliances(t2, gear_damage)
     r1 = pinion._radius(t1)
-    kh = hertz_compliance(width1(r1), e1, nu1, e2, nu2)
+    contact_width = width1(r1)
+    for tooth, damage, t in ((pinion, pinion_damage, t1), (gear, gear_damage, t2)):
+        if damage is not None:
+            contact_width = contact_width * damage.contact_share(tooth, tooth._radius(t))
+    kh = hertz_compliance(contact_width, e1, nu1, e2, nu2)
     comp = {
         "hertz": kh,
         "bending_pinion": kb1,
@@ -1021,6 +1038,8 @@ def design_mesh_stiffness(
     n_points: int = 400,
     thread_reading: str = "envelope",
     thread_crest_fraction: float = THREAD_CREST_FRACTION,
+    roller_damage=None,
+    ring_damage=None,
 ) -> MeshStiffness:
     """Mesh stiffness of a design's roller gear in its internal ring gear.
 
@@ -1039,6 +1058,9 @@ def design_mesh_stiffness(
     thread_reading : {"envelope", "literal"}
     thread_crest_fraction : float [-]
         See :func:`mesh_stiffness`.
+    roller_damage, ring_damage : ToothCrack, ToothPit or None
+        Damage of the roller-gear (pinion) or ring-gear tooth, :func:`mesh_stiffness`'s
+        ``pinion_damage`` and ``gear_damage``.
 
     Returns
     -------
@@ -1082,6 +1104,8 @@ def design_mesh_stiffness(
         thread_crest_fraction=thread_crest_fraction,
         thread_full_radius=r_r - half_land_depth,
         thread_crest_radius=r_r + half_land_depth,
+        pinion_damage=roller_damage,
+        gear_damage=ring_damage,
     )
 
 

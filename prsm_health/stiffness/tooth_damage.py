@@ -1,0 +1,174 @@
+"""Gear tooth damage in the potential-energy mesh stiffness: a root crack or a flank pit on one
+tooth of the ring gear or of one roller's gear.
+
+The damage changes the sections of the tooth's cantilever (:mod:`.gear_mesh`), so the bending,
+shear and axial energies of that tooth — and, for a pit, the Hertzian contact line — while it
+carries load:
+
+Root crack (Tian 2004, §3; Wu, Zuo & Parey 2008, case "crack not crossing the centreline")
+    A straight crack from the root on the loaded side, of length q at angle ν to the root
+    surface, leaves h_q = h_r − q·sin ν of the root half-thickness h_r on that side. Sections
+    keep their full thickness 2h_x where h_x ≤ h_q, else only h_x + h_q (the material beyond the
+    line from the crack tip parallel to the centreline carries no stress):
+    A_x = (h_x + min(h_x, h_q))·w, I_x = (h_x + min(h_x, h_q))³·w/12. The shift of the neutral
+    axis, the Hertzian and the fillet-foundation terms are left unchanged, as in both papers.
+Flank pit (Chaari, Baccar, Abbes & Haddar 2008; Liang, Zuo & Hoseini 2015)
+    A pit of depth d over a share f of the face width and a radial band of the flank: while
+    the contact lies on the band, the Hertzian contact line is (1 − f) of the face width; the
+    sections within the band lose the pit's material, A_x = 2h_x·w − f·w·d,
+    I_x = w(2h_x)³/12 − f·w·(d³/12 + d·(h_x − d/2)²) (parallel axes about the centreline; the
+    neutral-axis shift is neglected).
+
+:func:`damaged_mesh` puts one damaged tooth into the mesh cycle: the total stiffness while that
+tooth's pair is in contact, over the healthy total.
+
+References
+----------
+- X. Tian, "Dynamic simulation for system response of gearbox including localized gear
+  faults", MSc thesis, University of Alberta, 2004, §3.
+- S. Wu, M.J. Zuo, A. Parey, "Simulation of spur gear dynamics and estimation of fault growth",
+  J. Sound Vib. 317 (2008) 608–624.
+- F. Chaari, W. Baccar, M.S. Abbes, M. Haddar, "Effect of spalling or tooth breakage on
+  gearmesh stiffness and dynamic response of a one-stage spur gear transmission", Eur. J.
+  Mech. A/Solids 27 (2008) 691–705.
+- X. Liang, M.J. Zuo, M.R. Hoseini, "Vibration signal modeling of a planetary gear set for
+  tooth crack detection", Eng. Fail. Anal. 48 (2015) 185–200.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import require
+
+
+def root_half_thickness(tooth) -> float:
+    """Half thickness of a tooth at its root [m] (fillet root of an external tooth, root circle
+    of a ring tooth)."""
+    if tooth.internal:
+        return float(tooth._involute(tooth.t_root)[1])
+    return 0.5 * tooth.S_f
+
+
+def crack_section(tooth, h, w, depth: float, angle: float):
+    """(area [m²], second moment [m⁴]) of sections of half thickness ``h`` and width ``w`` of a
+    tooth with a root crack (module docstring)."""
+    h_q = root_half_thickness(tooth) - depth * math.sin(angle)
+    thickness = h + np.minimum(h, h_q)
+    return thickness * w, w * thickness**3 / 12.0
+
+
+def _zeta_of_radius(tooth, r: float) -> float:
+    """Distance from the root along the centreline of the flank point at radius r [m]."""
+    t = math.sqrt(max((r / tooth.rb) ** 2 - 1.0, 0.0))
+    y = float(tooth._involute(t)[0])
+    return tooth.y_root - y if tooth.internal else y - tooth.y_root
+
+
+def pit_band(tooth, offset: float, length: float) -> tuple[float, float]:
+    """Radii [m] of a pit band of radial ``length`` centred ``offset`` from the pitch circle
+    (towards the tip of an external tooth, the tip of a ring tooth too)."""
+    centre = tooth.rp - offset if tooth.internal else tooth.rp + offset
+    return centre - 0.5 * length, centre + 0.5 * length
+
+
+def pit_section(tooth, zeta, h, w, band, width_share: float, depth: float):
+    """(area, second moment) of sections with a flank pit on the radial ``band`` (module
+    docstring)."""
+    z1, z2 = sorted((_zeta_of_radius(tooth, band[0]), _zeta_of_radius(tooth, band[1])))
+    inside = (zeta >= z1) & (zeta <= z2)
+    area = 2.0 * h * w
+    inertia = w * (2.0 * h) ** 3 / 12.0
+    strip = width_share * w * depth
+    area = np.where(inside, area - strip, area)
+    inertia = np.where(
+        inside,
+        inertia - width_share * w * (depth**3 / 12.0 + depth * (h - depth / 2) ** 2),
+        inertia,
+    )
+    return area, inertia
+
+
+def pit_contact_share(radius, band, width_share: float):
+    """Share of the face width left to the Hertzian contact at flank radii ``radius``."""
+    r = np.asarray(radius, dtype=float)
+    return np.where((r >= band[0]) & (r <= band[1]), 1.0 - width_share, 1.0)
+
+
+@dataclass(frozen=True)
+class DamagedMesh:
+    """Mesh stiffness over the engagement of one damaged tooth.
+
+    Attributes
+    ----------
+    ratio : ndarray [-]
+        Total mesh stiffness with the damaged tooth over the healthy total, ``cycles``·n_points
+        samples, uniform in mesh phase; phase 0 is the damaged tooth's pair entering contact
+        at the start of the active path (the phase convention of
+        :class:`~prsm_health.stiffness.gear_mesh.MeshStiffness`); 1 outside its contact.
+    cycles : int
+        Mesh cycles covered (the damaged pair is in contact for ``contact_ratio`` of them).
+    healthy_single, damaged_single : ndarray [N/m]
+        Single-pair stiffness along the path of contact, healthy and damaged.
+    path_position : ndarray [m]
+        Roll distance along the line of action of each single-pair sample.
+    """
+
+    ratio: np.ndarray
+    cycles: int
+    healthy_single: np.ndarray
+    damaged_single: np.ndarray
+    path_position: np.ndarray
+
+    @property
+    def largest_loss(self) -> float:
+        """Largest relative loss of single-pair stiffness along the path [-]."""
+        return float(np.max(1.0 - self.damaged_single / self.healthy_single))
+
+
+def damaged_mesh(design, damage, member: str, *, threaded_tooth: bool = True, n_points: int = 400):
+    """The mesh of a design's roller gear in its ring with one damaged tooth.
+
+    Parameters
+    ----------
+    design : PRSMDesign
+    damage : object with ``section`` and ``contact_share`` (e.g.
+        :class:`prsm_health.faults.ToothCrack`, :class:`prsm_health.faults.ToothPit`)
+    member : {"ring_gear", "roller_gear"}
+        The gear that carries the damaged tooth.
+    threaded_tooth, n_points
+        As :func:`~prsm_health.stiffness.gear_mesh.design_mesh_stiffness`.
+
+    Returns
+    -------
+    DamagedMesh
+    """
+    from .gear_mesh import design_mesh_stiffness
+
+    require(
+        member in ("ring_gear", "roller_gear"),
+        "faults.location",
+        member,
+        "must be ring_gear or roller_gear for gear tooth damage",
+    )
+    healthy = design_mesh_stiffness(design, threaded_tooth=threaded_tooth, n_points=n_points)
+    key = "ring_damage" if member == "ring_gear" else "roller_damage"
+    damaged = design_mesh_stiffness(
+        design, threaded_tooth=threaded_tooth, n_points=n_points, **{key: damage}
+    )
+    n_samples = healthy.single_pair.size
+    cycles = -(-n_samples // n_points)
+    index = np.arange(cycles * n_points)
+    change = np.zeros(index.size)
+    change[:n_samples] = damaged.single_pair - healthy.single_pair
+    total = healthy.stiffness[index % n_points]
+    return DamagedMesh(
+        ratio=(total + change) / total,
+        cycles=int(cycles),
+        healthy_single=healthy.single_pair,
+        damaged_single=damaged.single_pair,
+        path_position=healthy.path_position,
+    )
