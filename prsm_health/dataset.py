@@ -59,6 +59,9 @@ SWEPT = {
     "friction_scale": "-",
     "wear_spread": "-",
     "preload": "m",
+    "lubricant_degradation": "-",
+    "lubricant_starvation": "-",
+    "temperature": "K",
     "severity": "-",
 }
 #: Swept by name: a list of ``fault_cases`` names (drawn uniformly in random and lhs mode).
@@ -368,7 +371,14 @@ class RunSpec:
         r, p = self.recipe, self.point
         health = {"clearance": p.get("clearance", 10e-6)}
         health.update({k: p[k] for k in SWEPT if k.startswith("clearance_") and k in p})
-        health.update({k: p[k] for k in ("wear_spread", "friction_scale", "preload") if k in p})
+        health_keys = (
+            "wear_spread",
+            "friction_scale",
+            "preload",
+            "lubricant_degradation",
+            "lubricant_starvation",
+        )
+        health.update({k: p[k] for k in health_keys if k in p})
         health["faults"] = self.faults()
         profile = {
             "duration": r.duration,
@@ -376,8 +386,9 @@ class RunSpec:
             "load": p.get("load", 100.0),
         }
         profile.update(r.profile)
-        if "load_amplitude" in p:
-            profile["load_amplitude"] = p["load_amplitude"]
+        for key in ("load_amplitude", "temperature"):
+            if key in p:
+                profile[key] = p[key]
         try:
             return Scenario.from_dict(
                 {

@@ -211,7 +211,8 @@ class ToothPit:
         return pit_section(tooth, zeta, h, w, self.band(tooth), self.width, self.depth)
 
     def contact_share(self, tooth, radius):
-        return pit_contact_share(radius, self.band(tooth), self.width)
+        width = self.width if self.depth > 0 else 0.0  # no depth, no pit
+        return pit_contact_share(radius, self.band(tooth), width)
 
 
 #: Fault kinds by name (``kind`` of a ``[[faults]]`` table).

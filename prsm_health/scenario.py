@@ -196,6 +196,8 @@ class Scenario:
             "clearance_gear": h.clearance_gear,
             "wear_spread": h.wear_spread,
             "friction_scale": h.friction_scale,
+            "lubricant_degradation": h.lubricant_degradation,
+            "lubricant_starvation": h.lubricant_starvation,
             "preload": h.preload,
             "preload_effective": h.effective_preload,
             # kinds joined by "+" ("" for none) to group by, and the faults themselves as a
@@ -208,6 +210,7 @@ class Scenario:
             "motion": p.motion,
             "load_profile": p.load_profile,
             "duration": p.duration,
+            "temperature": p.temperature,
             "seed": self.seed,
         }
 

@@ -9,7 +9,14 @@ from prsm_health import HealthState, Scenario
 from prsm_health.cli import main
 from prsm_health.dataset import Recipe
 from prsm_health.errors import ParameterError, RecipeError
-from prsm_health.faults import FaultThresholds, PreloadLoss, Spall, fault_from_dict, scaled
+from prsm_health.faults import (
+    FaultThresholds,
+    PreloadLoss,
+    Spall,
+    ToothCrack,
+    fault_from_dict,
+    scaled,
+)
 
 HEALTH_FILE = """
 clearance = 12e-6
@@ -64,6 +71,8 @@ def test_primary_class_precedence():
     assert t.classify(lost) == "preload_loss"
     partly = HealthState.uniform(5e-6, preload=10e-6, faults=(PreloadLoss(fraction=0.2),))
     assert t.classify(partly) == "healthy"
+    assert t.classify(HealthState.uniform(40e-6, faults=(ToothCrack(),))) == "tooth_damage"
+    assert t.classify(HealthState.uniform(5e-6, lubricant_starvation=0.6)) == "lubrication"
 
 
 def test_severity_scaling_names_the_field_out_of_range():
@@ -80,6 +89,9 @@ def test_severity_scaling_names_the_field_out_of_range():
         ({"kind": "spall", "depth": -1e-6}, "faults.depth"),
         ({"kind": "spall", "size": 1.0}, "faults.size"),
         ({"kind": "preload_loss", "fraction": 2.0}, "faults.fraction"),
+        ({"kind": "tooth_crack", "location": "nut"}, "faults.location"),
+        ({"kind": "tooth_pit", "depth": -1e-6}, "faults.depth"),
+        ({"kind": "tooth_crack", "tooth": -1}, "faults.tooth"),
     ],
 )
 def test_bad_fault_tables_name_the_field(table, field):

@@ -1,5 +1,8 @@
 """Figures of docs/faults.md: each fault's signature as the flight-ema instrumentation records it.
 
+Lubrication: the Stribeck curve of the thread contact and the drive torque flight-ema measures
+as the screw speeds up, new and degraded.
+
 Preload loss: the nut's lost motion through load reversals as the preload goes.
 
 Localised faults (spalls, gear tooth damage): the paper-01 design with the default drive train,
@@ -23,12 +26,14 @@ import numpy as np
 from prsm_health import (
     HealthState,
     OperatingProfile,
+    SimulationOptions,
     defect_frequencies,
     extract_features,
     preset,
     simulate,
 )
 from prsm_health.faults import fault_from_dict
+from prsm_health.lubrication import DEFAULT_LUBRICANT, stribeck_curve
 from prsm_health.spectra import envelope_spectrum
 
 OUT = Path(__file__).resolve().parents[1] / "docs" / "figures"
@@ -44,6 +49,21 @@ LOCALISED = {
     "screw-spall": ({"kind": "spall", "location": "screw"}, "screw_flank", "screw flank spall"),
     "nut-spall": ({"kind": "spall", "location": "nut"}, "nut_flank", "nut flank spall"),
     "roller-spall": ({"kind": "spall", "location": "roller"}, "roller_flank", "roller flank spall"),
+    "ring-tooth-crack": (
+        {"kind": "tooth_crack", "location": "ring_gear"},
+        "ring_gear_tooth",
+        "ring gear tooth crack",
+    ),
+    "roller-tooth-crack": (
+        {"kind": "tooth_crack", "location": "roller_gear"},
+        "roller_gear_tooth",
+        "roller gear tooth crack",
+    ),
+    "ring-tooth-pit": (
+        {"kind": "tooth_pit", "location": "ring_gear"},
+        "ring_gear_tooth",
+        "ring gear tooth pit",
+    ),
 }
 
 
@@ -55,7 +75,7 @@ def line_ratio(f: np.ndarray, p: np.ndarray, f0: float) -> float:
 
 def severity_text(fault) -> str:
     value = getattr(fault, fault.severity_field)
-    return f"{value * 1e6:g} µm" if fault.severity_field == "depth" else f"{value:g}"
+    return f"{value * 1e6:.4g} µm" if fault.severity_field == "depth" else f"{value:g}"
 
 
 def localised_figure(name: str, healthy_run) -> tuple[Path, float]:
@@ -151,13 +171,70 @@ def preload_figure() -> Path:
     return path
 
 
+def lubrication_figure() -> Path:
+    """Left: the screw–roller contact's Coulomb coefficient vs entrainment speed (the Stribeck
+    curve of :mod:`prsm_health.lubrication`) at three temperatures and for a degraded and a
+    starved lubricant. Right: the mean drive torque flight-ema measures at 300 N vs screw speed,
+    new and degraded lubricant, and with paper 02's constant coefficient."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    design = preset(DESIGN)
+    speeds = np.geomspace(1e-4, 5.0, 300)
+    fig, (ax_mu, ax_t) = plt.subplots(1, 2, figsize=(11, 4))
+    cases = [
+        ("new, 20 °C", {"temperature": 293.15}, "C0", "-"),
+        ("new, 40 °C", {"temperature": 313.15}, "C1", "-"),
+        ("new, 80 °C", {"temperature": 353.15}, "C3", "-"),
+        ("degraded 0.5, 40 °C", {"degradation": 0.5}, "C1", "--"),
+        ("starved 0.5, 40 °C", {"starvation": 0.5}, "C1", ":"),
+    ]
+    for label, kw, color, style in cases:
+        curve = stribeck_curve(design, DEFAULT_LUBRICANT, speeds, axial_load=300.0, **kw)
+        ax_mu.semilogx(speeds, curve.coefficient, color=color, ls=style, label=label)
+    ax_mu.set(
+        xlabel="entrainment speed [m/s]",
+        ylabel="Coulomb coefficient μ [-]",
+        title=f"Stribeck curve, screw–roller contact ({DEFAULT_LUBRICANT}, 300 N)",
+    )
+    ax_mu.legend(fontsize=8)
+    screw_speeds = [10.0, 30.0, 100.0, 300.0]
+    for label, health, options, color in (
+        ("new lubricant", HealthState(), None, "C1"),
+        ("degraded 0.5", HealthState(lubricant_degradation=0.5), None, "C3"),
+        ("constant μ = 0.1 (paper 02)", HealthState(), SimulationOptions(lubrication="constant"),
+         "0.5"),
+    ):  # fmt: skip
+        torque = []
+        for w in screw_speeds:
+            profile = OperatingProfile(duration=0.1, speed=w, load=300.0)
+            run = simulate(DESIGN, health, profile, "flight-ema", SEED, options=options)
+            torque.append(float(np.mean(run["drive_torque"])))
+        ax_t.semilogx(screw_speeds, torque, "o-", color=color, label=label)
+        print(f"  drive torque, {label}: " + ", ".join(f"{t:.3f}" for t in torque) + " N·m")
+    ax_t.set(
+        xlabel="screw speed [rad/s]",
+        ylabel="mean drive torque [N·m] (flight-ema)",
+        title="Measured drive torque at 300 N",
+    )
+    ax_t.legend(fontsize=8)
+    fig.tight_layout()
+    path = OUT / "fault-lubrication.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def main(names: list[str]) -> None:
     OUT.mkdir(parents=True, exist_ok=True)
-    names = names or [*LOCALISED, "preload-loss"]
+    names = names or [*LOCALISED, "preload-loss", "lubrication"]
     healthy = simulate(DESIGN, HealthState(), PROFILE, "flight-ema", SEED)
     for name in names:
-        if name == "preload-loss":
-            print(f"{name:14s} {preload_figure().relative_to(OUT.parents[1])}")
+        if name in ("preload-loss", "lubrication"):
+            maker = preload_figure if name == "preload-loss" else lubrication_figure
+            print(f"{name:14s} {maker().relative_to(OUT.parents[1])}")
             continue
         path, ratio = localised_figure(name, healthy)
         print(f"{name:14s} line/median {ratio:6.1f}×  {path.relative_to(OUT.parents[1])}")

@@ -50,7 +50,7 @@ def root_half_thickness(tooth) -> float:
     of a ring tooth)."""
     if tooth.internal:
         return float(tooth._involute(tooth.t_root)[1])
-    return 0.5 * tooth.S_f
+    return float(np.max(tooth._fillet_sections()[1]))
 
 
 def crack_section(tooth, h, w, depth: float, angle: float):
