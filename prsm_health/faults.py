@@ -35,6 +35,7 @@ from .stiffness.tooth_damage import (
 )
 
 SPALL_LOCATIONS = ("screw", "nut", "roller")
+SPALL_FLANKS = ("loaded", "unloaded", "both")
 
 
 @dataclass(frozen=True)
@@ -49,22 +50,31 @@ class Spall:
     location : {"screw", "nut", "roller"}
     depth : float [m]
         Depth of the depression the contact follows (for a spall longer than the contact, its
-        depth; for a short one, ≈ ℓ²/8R with R the mating profile radius). The severity.
+        depth; for a short one, ≈ ℓ²/8R with R the mating profile radius). Once deeper than the
+        turn's contact deflection (a few µm) the turn unloads completely, so depth saturates.
     length : float [m]
-        Extent along the contact path (around the part).
+        Extent along the contact path (around the part): how long the turn stays unloaded, the
+        severity (spalls grow in length).
     angle : float [rad]
         Angular position of its entry on the part (screw or nut surface; the roller's own spin
         angle for a roller spall).
     roller : int
         Which roller carries a roller spall (0-based).
+    position : float [m]
+        Axial position. Screw: along the screw from where the nut's centre is at t = 0, within
+        ± half the screw's threaded length (``design.screw_free_length``); the spall is met
+        only while the roller threads span it. Nut or roller: which thread turn, from the
+        middle of the engaged length (± n_t·pitch/2); every turn is alike in the model.
+    flank : {"loaded", "unloaded", "both"}
+        The thread flank it is on: the one that carries a positive (resisting) axial load, the
+        other one, or both. A roller spall is on both (its two flanks face screw and nut).
 
-    The depression acts on both flanks of that engagement (the loaded one makes the signature)
-    and lies within the nut's engaged threads throughout a run (a run shorter than the stroke
-    across it).
+    The depression is on one of the engagement's n_t thread turns: that turn's share 1/n_t of
+    the contact stiffness closes ``depth`` less while the contact crosses it.
     """
 
     kind: ClassVar[str] = "spall"
-    severity_field: ClassVar[str] = "depth"
+    severity_field: ClassVar[str] = "length"
     locations: ClassVar[tuple[str, ...]] = SPALL_LOCATIONS
 
     location: str = "screw"
@@ -72,9 +82,18 @@ class Spall:
     length: float = 1.5e-3
     angle: float = 0.0
     roller: int = 0
+    position: float = 0.0
+    flank: str = "loaded"
 
     def __post_init__(self):
         _require_location(self)
+        require(
+            self.flank in SPALL_FLANKS,
+            "faults.flank",
+            self.flank,
+            f"must be one of {', '.join(SPALL_FLANKS)}",
+        )
+        require_range("faults.position", self.position, -10.0, 10.0, unit="m")
         require_range("faults.depth", self.depth, 0.0, 200e-6, unit="m")
         require_range("faults.length", self.length, 1e-5, 10e-3, unit="m")
         require_range("faults.angle", self.angle, -2 * math.pi, 2 * math.pi, unit="rad")
@@ -288,7 +307,7 @@ FAULT_CLASSES = (
 class FaultThresholds:
     """Fault taxonomy thresholds (recipe ``[faults]``).
 
-    A run's class, in this order of precedence: ``spall`` when it has a spall deeper than
+    A run's class, in this order of precedence: ``spall`` when it has a spall longer than
     ``spall`` [m]; ``tooth_damage`` when a gear tooth has a crack or pit deeper than
     ``tooth_damage`` [m]; ``severe_wear`` when its largest thread clearance ≥ ``severe_wear`` [m];
     ``wear`` when ≥ ``wear`` [m]; ``preload_loss`` when it has lost a share ≥ ``preload_loss``

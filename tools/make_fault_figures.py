@@ -6,11 +6,11 @@ as the screw speeds up, new and degraded.
 Preload loss: the nut's lost motion through load reversals as the preload goes.
 
 Localised faults (spalls, gear tooth damage): the paper-01 design with the default drive train,
-100 rad/s, 300 N, 1 s, seed 4, measured by `flight-ema`; the nut axial accelerometer over 60 ms
-(faulty over healthy, same seed) and its envelope spectrum (2–8 kHz band,
+100 rad/s, 3000 N, 1 s, seed 4, measured by `flight-ema`; the nut axial accelerometer over 60 ms
+(faulty over healthy, same seed), its spectrum and its envelope spectrum (2–8 kHz band,
 `prsm_health.spectra.envelope_spectrum`) with the predicted defect frequency and its harmonics
-marked. Prints, per fault, the line at the defect frequency over the local median of the
-envelope spectrum (the statistic tests/dynamics/test_spalls.py checks). Writes
+marked. Prints, per fault, the line at the defect frequency over the local median of each
+spectrum (the statistic tests/dynamics/test_spalls.py checks). Writes
 docs/figures/fault-<name>.png.
 
     python tools/make_fault_figures.py [NAME ...]
@@ -39,30 +39,51 @@ from prsm_health.spectra import envelope_spectrum
 OUT = Path(__file__).resolve().parents[1] / "docs" / "figures"
 DESIGN = "paper01"
 SPEED = 100.0  # rad/s
-PROFILE = OperatingProfile(duration=1.0, speed=SPEED, load=300.0)
+PROFILE = OperatingProfile(duration=1.0, speed=SPEED, load=3000.0)
+#: A screw spall 25 mm ahead of the nut's start: its rollers reach it after ≈ 0.06 s and leave it
+#: ≈ 0.14 s later; the spectra of that run are taken over that interval only.
+PASSING = OperatingProfile(duration=0.4, speed=SPEED, load=3000.0)
 SEED = 4
 BAND = (2000.0, 8000.0)  # Hz: above the structural modes, below the accelerometer's limit
 CHANNEL = "nut_axial_accel"
 
-#: name → (fault table, defect frequency it should show, title)
+#: name → (fault table, defect frequency it should show, title, profile)
 LOCALISED = {
-    "screw-spall": ({"kind": "spall", "location": "screw"}, "screw_flank", "screw flank spall"),
-    "nut-spall": ({"kind": "spall", "location": "nut"}, "nut_flank", "nut flank spall"),
-    "roller-spall": ({"kind": "spall", "location": "roller"}, "roller_flank", "roller flank spall"),
+    "screw-spall": (
+        {"kind": "spall", "location": "screw", "length": 6e-3, "position": 0.025},
+        "screw_flank",
+        "screw flank spall, 6 mm, 25 mm ahead",
+        PASSING,
+    ),
+    "nut-spall": (
+        {"kind": "spall", "location": "nut", "length": 6e-3},
+        "nut_flank",
+        "nut flank spall, 6 mm",
+        PROFILE,
+    ),
+    "roller-spall": (
+        {"kind": "spall", "location": "roller"},
+        "roller_flank",
+        "roller flank spall",
+        PROFILE,
+    ),
     "ring-tooth-crack": (
         {"kind": "tooth_crack", "location": "ring_gear"},
         "ring_gear_tooth",
         "ring gear tooth crack",
+        PROFILE,
     ),
     "roller-tooth-crack": (
         {"kind": "tooth_crack", "location": "roller_gear"},
         "roller_gear_tooth",
         "roller gear tooth crack",
+        PROFILE,
     ),
     "ring-tooth-pit": (
         {"kind": "tooth_pit", "location": "ring_gear"},
         "ring_gear_tooth",
         "ring gear tooth pit",
+        PROFILE,
     ),
 }
 
@@ -75,51 +96,76 @@ def line_ratio(f: np.ndarray, p: np.ndarray, f0: float) -> float:
 
 def severity_text(fault) -> str:
     value = getattr(fault, fault.severity_field)
+    if fault.severity_field == "length":
+        return f"{value * 1e3:.3g} mm"
     return f"{value * 1e6:.4g} µm" if fault.severity_field == "depth" else f"{value:g}"
 
 
-def localised_figure(name: str, healthy_run) -> tuple[Path, float]:
+def localised_figure(name: str, healthy: dict) -> tuple[Path, float, float]:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from scipy import signal
 
-    table, location, title = LOCALISED[name]
+    table, location, title, profile = LOCALISED[name]
     fault = fault_from_dict(table)
-    run = simulate(DESIGN, HealthState(faults=(fault,)), PROFILE, "flight-ema", SEED)
+    if profile not in healthy:
+        healthy[profile] = simulate(DESIGN, HealthState(), profile, "flight-ema", SEED)
+    healthy_run = healthy[profile]
+    run = simulate(DESIGN, HealthState(faults=(fault,)), profile, "flight-ema", SEED)
     f0 = defect_frequencies(preset(DESIGN), SPEED)[location]
-    fig, (ax_t, ax_e) = plt.subplots(2, 1, figsize=(9, 6))
-    shown = (run.time >= 0.5) & (run.time < 0.56)
+    fig, (ax_t, ax_d, ax_e) = plt.subplots(3, 1, figsize=(9, 8.5))
+    window = slice(None)
+    if fault.kind == "spall" and fault.location == "screw":
+        # while the rollers' threads span the spall (nut travel counted from its start)
+        travel = np.abs(run.truth["nut_position"] - run.truth["nut_position"][0])
+        offset = abs(fault.position)
+        half = 0.5 * preset(DESIGN).engaged_threads * preset(DESIGN).pitch
+        inside = np.flatnonzero(np.abs(travel - offset) < half)
+        window = slice(inside[0], inside[-1] + 1)
+    mid = run.time[window][len(run.time[window]) // 2]
+    shown = (run.time >= mid - 0.03) & (run.time < mid + 0.03)
     t_ms = 1e3 * run.time[shown]
     ax_t.plot(t_ms, healthy_run[CHANNEL][shown], color="0.6", lw=0.8, label="healthy")
     ax_t.plot(t_ms, run[CHANNEL][shown], color="C3", lw=0.8, label=title)
     ax_t.set(xlabel="time [ms]", ylabel="nut axial acceleration [m/s²]")
     ax_t.legend(loc="upper right", fontsize=8)
-    ratio = float("nan")
+    ratios = {}
     for r, color, label in ((healthy_run, "0.6", "healthy"), (run, "C3", title)):
-        f, p = envelope_spectrum(r[CHANNEL], r.sample_rate, BAND)
-        keep = f <= 5 * f0
-        ax_e.semilogy(f[keep], p[keep], color=color, lw=0.9, label=label)
-        if r is run:
-            ratio = line_ratio(f, p, f0)
-    for k in (1, 2, 3, 4):
-        ax_e.axvline(k * f0, color="k", ls="--", lw=0.6, alpha=0.6)
-    ax_e.text(f0, ax_e.get_ylim()[1], f" {location}\n {f0:.1f} Hz", va="top", fontsize=8)
+        x = r[CHANNEL][window]
+        nperseg = min(8192, len(x))
+        spectra = {
+            "direct": signal.welch(x - x.mean(), fs=r.sample_rate, nperseg=nperseg),
+            "envelope": envelope_spectrum(x, r.sample_rate, BAND, nperseg=nperseg),
+        }
+        for (kind, (f, p)), ax in zip(spectra.items(), (ax_d, ax_e)):
+            keep = f <= 5 * f0
+            ax.semilogy(f[keep], p[keep], color=color, lw=0.9, label=label)
+            if r is run:
+                ratios[kind] = line_ratio(f, p, f0)
+    for ax in (ax_d, ax_e):
+        for k in (1, 2, 3, 4):
+            ax.axvline(k * f0, color="k", ls="--", lw=0.6, alpha=0.6)
+        ax.text(f0, ax.get_ylim()[1], f" {location}\n {f0:.1f} Hz", va="top", fontsize=8)
+        ax.legend(loc="upper right", fontsize=8)
+    ax_d.set(xlabel="frequency [Hz]", ylabel="PSD [(m/s²)²/Hz]")
     ax_e.set(
         xlabel="frequency [Hz]",
-        ylabel=f"envelope PSD {BAND[0] / 1e3:g}–{BAND[1] / 1e3:g} kHz [(m/s²)²/Hz]",
+        ylabel=f"envelope PSD {BAND[0] / 1e3:g}–{BAND[1] / 1e3:g} kHz",
     )
-    ax_e.legend(loc="upper right", fontsize=8)
+    during = "" if window == slice(None) else ", spectra while the nut spans it"
     fig.suptitle(
-        f"{title}, default severity ({fault.severity_field} {severity_text(fault)}): flight-ema, "
-        f"{SPEED:g} rad/s, {PROFILE.load:g} N — line/median {ratio:.1f}×",
+        f"{title} ({fault.severity_field} {severity_text(fault)}): flight-ema, {SPEED:g} rad/s, "
+        f"{profile.load:g} N{during}\nline/median: direct {ratios['direct']:.1f}×, "
+        f"envelope {ratios['envelope']:.1f}×",
         fontsize=10,
     )
     fig.tight_layout()
     path = OUT / f"fault-{name}.png"
     fig.savefig(path, dpi=110)
     plt.close(fig)
-    return path, ratio
+    return path, ratios["direct"], ratios["envelope"]
 
 
 REVERSING = OperatingProfile(
@@ -230,14 +276,17 @@ def lubrication_figure() -> Path:
 def main(names: list[str]) -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     names = names or [*LOCALISED, "preload-loss", "lubrication"]
-    healthy = simulate(DESIGN, HealthState(), PROFILE, "flight-ema", SEED)
+    healthy: dict = {}
     for name in names:
         if name in ("preload-loss", "lubrication"):
             maker = preload_figure if name == "preload-loss" else lubrication_figure
-            print(f"{name:14s} {maker().relative_to(OUT.parents[1])}")
+            print(f"{name:18s} {maker().relative_to(OUT.parents[1])}")
             continue
-        path, ratio = localised_figure(name, healthy)
-        print(f"{name:14s} line/median {ratio:6.1f}×  {path.relative_to(OUT.parents[1])}")
+        path, direct, envelope = localised_figure(name, healthy)
+        print(
+            f"{name:18s} line/median direct {direct:5.1f}×, envelope {envelope:5.1f}×  "
+            f"{path.relative_to(OUT.parents[1])}"
+        )
 
 
 if __name__ == "__main__":

@@ -115,6 +115,56 @@ def _thread_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c,
 
 
 @njit(cache=True, inline="always")
+def _pitted_flank(closure, rate, depth, depth_rate, share, k, c, exponent):
+    # One flank of an engagement whose thread turns are sound but one, which has a depression
+    # `depth` at the contact: the share `share` of the turns closes `depth` less. Returns the
+    # total force, the pitted turn's force (its slope term), and the dissipated power.
+    sound, d1 = _flank(closure, rate, k, c, exponent)
+    pit, d2 = _flank(closure - depth, rate - depth_rate, k, c, exponent)
+    return (1.0 - share) * sound + share * pit, share * pit, (1.0 - share) * d1 + share * d2
+
+
+@njit(cache=True, inline="always")
+def _pitted_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c, expo, spall):
+    # _thread_pair with a depression on one thread turn; spall = (share, depth and its rate on
+    # the plus flank, on the minus flank). Returns forces, pitted-turn forces, dissipation.
+    share, d_plus, r_plus, d_minus, r_minus = spall
+    f_plus, pit_plus, d1 = _pitted_flank(
+        d_ax + cot_b * approach - clearance,
+        d_ax_dot + cot_b * approach_dot,
+        d_plus,
+        r_plus,
+        share,
+        k,
+        c,
+        expo,
+    )
+    f_minus, pit_minus, d2 = _pitted_flank(
+        -d_ax + cot_b * approach - clearance,
+        -d_ax_dot + cot_b * approach_dot,
+        d_minus,
+        r_minus,
+        share,
+        k,
+        c,
+        expo,
+    )
+    return f_plus, f_minus, d1 + d2, pit_plus, pit_minus
+
+
+@njit(cache=True, inline="always")
+def _gate(x, half, ramp):
+    # 1 while |x| ≤ half − ramp/2, falling linearly to 0 at half + ramp/2: (value, slope).
+    a = abs(x)
+    if a <= half - 0.5 * ramp:
+        return 1.0, 0.0
+    if a >= half + 0.5 * ramp:
+        return 0.0, 0.0
+    slope = -1.0 / ramp if x > 0.0 else 1.0 / ramp
+    return 1.0 - (a - half + 0.5 * ramp) / ramp, slope
+
+
+@njit(cache=True, inline="always")
 def _mesh_stiffness(table, phase):
     n = table.shape[0]
     x = (phase - math.floor(phase)) * n
@@ -266,34 +316,45 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         d_ax_dot = lead_local * (w_s - w_rev) - lead_r * (w_c - w_rev) - g1 * (vz_c - vz_s)
         approach = orbit - rho + e_rad - ro_c
         approach_dot = -rho_dot + de_rad * (w_rev - w_s) + ro_s * (w_c - w_rev)
-        # spalls: extra local clearance h on both flanks, its slope in the forces
-        h = dh = h_r = dh_r = 0.0
+        # Spalls: a depression of one thread turn (share 1/n_t) on the flanks they are on; the
+        # screw spall only while the roller's threads span its axial position (gate).
         if spalled:
             h, dh = _wave(errors, L.ERR_SCREW_SPALL, u)
+            gate, dgate = _gate(z_c - z_s - p[L.P_SPALL_Z], p[L.P_SPALL_HALF], p[L.P_SPALL_RAMP])
             h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev + math.pi)
             h_r *= rollers[i, L.R_SPALL]
             dh_r *= rollers[i, L.R_SPALL]
-        # closure rate loses dh·u̇ (u̇ = w_rev − w_s) and dh_r·χ̇ (χ̇ = w_c − w_rev)
-        spall_rate = dh * (w_rev - w_s) + dh_r * (w_c - w_rev)
-        f_plus, f_minus, diss = _thread_pair(
-            d_ax,
-            d_ax_dot,
-            approach,
-            approach_dot - spall_rate / cot_b,
-            rollers[i, L.R_B_S] + h + h_r,
-            cot_b,
-            k_ts,
-            c_ts,
-            expo,
-        )
+            on_plus, on_minus = p[L.P_SPALL_PLUS_S], p[L.P_SPALL_MINUS_S]
+            # depth rates: dh·u̇ (u̇ = w_rev − w_s) gated, the gate's own, dh_r·χ̇
+            rate = dh * gate * (w_rev - w_s) + h * dgate * (vz_c - vz_s)
+            rate_r = dh_r * (w_c - w_rev)
+            spall = (
+                p[L.P_SPALL_SHARE],
+                h * gate * on_plus + h_r,
+                rate * on_plus + rate_r,
+                h * gate * on_minus + h_r,
+                rate * on_minus + rate_r,
+            )
+            f_plus, f_minus, diss, pit_plus, pit_minus = _pitted_pair(
+                d_ax, d_ax_dot, approach, approach_dot, rollers[i, L.R_B_S], cot_b, k_ts, c_ts,
+                expo, spall,
+            )  # fmt: skip
+            f_dh = (pit_plus * on_plus + pit_minus * on_minus) * gate  # times dh
+            f_dhr = pit_plus + pit_minus  # times dh_r
+            f_gate = (pit_plus * on_plus + pit_minus * on_minus) * h * dgate  # along z_c − z_s
+        else:
+            f_plus, f_minus, diss = _thread_pair(
+                d_ax, d_ax_dot, approach, approach_dot, rollers[i, L.R_B_S], cot_b, k_ts, c_ts,
+                expo,
+            )  # fmt: skip
+            dh = dh_r = f_dh = f_dhr = f_gate = 0.0
         p_diss += diss
         screw_contact = f_plus + f_minus > 0.0
         f_ax = f_plus - f_minus  # axial force of the screw on the roller (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller outward, screw inward
         # along e_t of the roller, from θ_rev (helix, radial error slope, runout, spall slopes)
-        f_sum = f_plus + f_minus
         g_tan = (
-            f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s + f_sum * (dh - dh_r)
+            f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s + f_dh * dh - f_dhr * dh_r
         ) / orbit
         # Screw–roller traction: elastic tangential compliance k_t (Mindlin) that sticks up to
         # the Coulomb limit μN and slides beyond it (reset integrator, Haessig & Friedland
@@ -330,8 +391,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         m_diff = mu_r * normal * math.tanh(w_rel / w_roll)
         p_fric += m_diff * w_rel
         friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
-        torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff - f_sum * dh
-        force_screw_axial -= g1 * f_ax + f_axial
+        torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff - f_dh * dh
+        force_screw_axial -= g1 * f_ax + f_axial + f_gate
         # on the roller: radial push f_rad·e_r, helix reaction, traction and the reaction of the
         # differential-sliding torque along e_t
         tangential = g_tan + f_fric + m_diff / orbit
@@ -341,8 +402,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         dy[v0 + L.Q_YS] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric - f_rad * ro_s + f_sum * dh_r
-        dy[v0 + b + 3] += g1 * f_ax + f_axial
+        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric - f_rad * ro_s + f_dhr * dh_r
+        dy[v0 + b + 3] += g1 * f_ax + f_axial + f_gate
 
         # ---------------- roller–nut thread
         rho, tau, rho_dot, tau_dot = _roller_frame(
@@ -365,41 +426,49 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         cos_chi, minus_sin_chi = _wave(errors, L.ERR_UNIT_COSINE, chi)
         ro_c, ro_s = runout * cos_chi, -runout * minus_sin_chi
         u_n = th_rev + psi - th_n
-        h = dh = h_r = dh_r = 0.0
         if spalled:
             h, dh = _wave(errors, L.ERR_NUT_SPALL, u_n)
             h_r, dh_r = _wave(errors, L.ERR_ROLLER_SPALL, th_c - th_rev)
             h_r *= rollers[i, L.R_SPALL]
             dh_r *= rollers[i, L.R_SPALL]
-        spall_rate = dh * (w_rev - w_n) + dh_r * (w_c - w_rev)
-        f_plus, f_minus, diss = _thread_pair(
-            d_ax,
-            d_ax_dot,
-            rho - orbit + ro_c,
-            rho_dot - ro_s * (w_c - w_rev) - spall_rate / cot_b,
-            rollers[i, L.R_B_N] + h + h_r,
-            cot_b,
-            k_tn,
-            c_tn,
-            expo,
-        )
+            on_plus, on_minus = p[L.P_SPALL_PLUS_N], p[L.P_SPALL_MINUS_N]
+            rate = dh * (w_rev - w_n)
+            rate_r = dh_r * (w_c - w_rev)
+            spall = (
+                p[L.P_SPALL_SHARE],
+                h * on_plus + h_r,
+                rate * on_plus + rate_r,
+                h * on_minus + h_r,
+                rate * on_minus + rate_r,
+            )
+            f_plus, f_minus, diss, pit_plus, pit_minus = _pitted_pair(
+                d_ax, d_ax_dot, rho - orbit + ro_c, rho_dot - ro_s * (w_c - w_rev),
+                rollers[i, L.R_B_N], cot_b, k_tn, c_tn, expo, spall,
+            )  # fmt: skip
+            f_dh = pit_plus * on_plus + pit_minus * on_minus
+            f_dhr = pit_plus + pit_minus
+        else:
+            f_plus, f_minus, diss = _thread_pair(
+                d_ax, d_ax_dot, rho - orbit + ro_c, rho_dot - ro_s * (w_c - w_rev),
+                rollers[i, L.R_B_N], cot_b, k_tn, c_tn, expo,
+            )  # fmt: skip
+            dh = dh_r = f_dh = f_dhr = 0.0
         p_diss += diss
         if screw_contact and f_plus + f_minus > 0.0:
             engaged += 1.0
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
-        f_sum = f_plus + f_minus
-        g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s + f_sum * (dh - dh_r)) / orbit
+        g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s + f_dh * dh - f_dhr * dh_r) / orbit
         fx_r = -f_rad * c + g_tan * (-s)
         fy_r = -f_rad * s + g_tan * c
         dy[v0 + L.Q_XN] -= fx_r
         dy[v0 + L.Q_YN] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s + f_sum * dh_r
+        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s + f_dhr * dh_r
         dy[v0 + b + 3] -= f_ax
         dy[v0 + L.Q_ZN] += f_ax
-        dy[v0 + L.Q_THN] += f_ax * lead_local - f_sum * dh
+        dy[v0 + L.Q_THN] += f_ax * lead_local - f_dh * dh
 
         # ---------------- roller gear – ring gear mesh (line of action n = cos α0 e_t − sin α0 e_r)
         phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, L.R_MESH_PHASE]

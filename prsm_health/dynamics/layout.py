@@ -79,7 +79,12 @@ P_LEAD_SLOPE = 71  # cumulative lead error of the screw, axial error per axial t
 P_HAS_SPALLS = 72  # 1 when the health state has a spall: only then the spall tables are read
 P_HAS_TOOTH_DAMAGE = 73  # 1 when a gear tooth is damaged: only then the tooth tables are read
 P_STRIBECK = 74  # 1: the Coulomb coefficient follows the lubrication regime (ERR_COULOMB)
-N_PARAMS = 75
+# Spalls: the share of an engagement's thread turns that the spalled turn is (1/n_t); the
+# screw spall's axial gate (centre on z_c − z_s, half the engaged length, ramp of one pitch);
+# which flanks carry the screw and the nut spall (1/0 for the plus and the minus flank).
+P_SPALL_SHARE, P_SPALL_Z, P_SPALL_HALF, P_SPALL_RAMP = 75, 76, 77, 78
+P_SPALL_PLUS_S, P_SPALL_MINUS_S, P_SPALL_PLUS_N, P_SPALL_MINUS_N = 79, 80, 81, 82
+N_PARAMS = 83
 
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 

@@ -370,7 +370,7 @@ def build_model(
     rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
     rollers = _roller_params(design, health, options.variation, orbit, rng)
     errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng, health.spalls)
-    p[L.P_HAS_SPALLS] = 1.0 if health.spalls else 0.0
+    p[L.P_HAS_SPALLS] = _spall_params(p, design, health, profile, options)
     p[L.P_STRIBECK] = _coulomb_table(errors, design, health, profile, options)
     p[L.P_HAS_TOOTH_DAMAGE] = _tooth_tables(errors, rollers, design, health, options)
     return Model(
@@ -496,6 +496,57 @@ def _coulomb_table(errors, design, health, profile, options) -> float:
     )
     errors[L.ERR_COULOMB, 0] = speeds[-1]
     errors[L.ERR_COULOMB, 1:] = curve.coefficient
+    return 1.0
+
+
+#: Which flank (plus, minus) of the screw–roller and roller–nut engagements carries a positive
+#: resisting load (tests/dynamics/test_spalls.py checks it through the signature).
+LOADED_FLANK = {"screw": (1.0, 0.0), "nut": (1.0, 0.0)}
+
+
+def _spall_params(p, design, health, profile, options) -> float:
+    """Share, axial gate and flanks of the run's spalls (layout ``P_SPALL_*``); 1.0 when there
+    is one, else 0.0. One spall per location and run; positions checked against the design."""
+    spalls = health.spalls
+    if not spalls:
+        return 0.0
+    engaged = design.engaged_threads * design.pitch
+    for location in ("screw", "nut", "roller"):
+        here = [s for s in spalls if s.location == location]
+        require(
+            len(here) <= 1,
+            "faults.location",
+            location,
+            "one spall per location and run at most (the model has one depression per part)",
+        )
+        for spall in here:
+            limit = design.screw_free_length / 2 if location == "screw" else engaged / 2
+            what = "the screw's threaded length" if location == "screw" else "the engaged turns"
+            require(
+                abs(spall.position) <= limit,
+                "faults.position",
+                spall.position,
+                f"must lie within ±{limit:.4g} m ({what}) for a {location} spall",
+            )
+    p[L.P_SPALL_SHARE] = 1.0 / design.engaged_threads
+    p[L.P_SPALL_HALF], p[L.P_SPALL_RAMP] = 0.5 * engaged, design.pitch
+    p[L.P_SPALL_Z] = 1e9  # no screw spall: the gate stays shut
+    for spall in spalls:
+        if spall.location == "roller":
+            continue
+        plus, minus = LOADED_FLANK[spall.location]
+        if spall.flank == "unloaded":
+            plus, minus = minus, plus
+        elif spall.flank == "both":
+            plus = minus = 1.0
+        side = "S" if spall.location == "screw" else "N"
+        p[getattr(L, f"P_SPALL_PLUS_{side}")] = plus
+        p[getattr(L, f"P_SPALL_MINUS_{side}")] = minus
+        if spall.location == "screw":
+            # the roller threads' axial position relative to the screw, z_c − z_s, starts at 0
+            # at the start of settling; the nut has moved on by t = 0
+            settled = speed_ratios(design).nut * float(profile.motion_knots()[1, 0])
+            p[L.P_SPALL_Z] = spall.position + settled * options.settle_time
     return 1.0
 
 
