@@ -55,7 +55,7 @@ def test_scenario_toml_round_trip_and_labels():
     assert labels["fault_kinds"] == "spall"
     assert json.loads(labels["faults"]) == [
         {"kind": "spall", "location": "roller", "depth": 20e-6, "length": 1.5e-3, "angle": 0.0,
-         "roller": 2}
+         "roller": 2, "position": 0.0, "flank": "loaded"}
     ]  # fmt: skip
     path_text = scenario.to_toml()
     assert "[[health.faults]]" in path_text
@@ -76,9 +76,10 @@ def test_primary_class_precedence():
 
 
 def test_severity_scaling_names_the_field_out_of_range():
-    assert scaled(Spall(depth=20e-6), 2.0).depth == pytest.approx(40e-6)
-    with pytest.raises(ParameterError, match="faults.depth"):
-        scaled(Spall(depth=150e-6), 2.0)
+    assert scaled(Spall(length=2e-3), 2.0).length == pytest.approx(4e-3)
+    assert scaled(ToothCrack(depth=0.2e-3), 2.0).depth == pytest.approx(0.4e-3)
+    with pytest.raises(ParameterError, match="faults.length"):
+        scaled(Spall(length=8e-3), 2.0)
 
 
 @pytest.mark.parametrize(
@@ -121,13 +122,13 @@ def test_recipe_sweeps_fault_kinds_and_severities():
     assert {(x["fault_case"], x["severity"]) for x in labels} == {
         (c, s) for c in ("none", "screw_spall", "two") for s in (0.5, 1.0)
     }
-    depths = {
-        (x["fault_case"], x["severity"]): [f["depth"] for f in json.loads(x["faults"])]
+    lengths = {
+        (x["fault_case"], x["severity"]): [f["length"] for f in json.loads(x["faults"])]
         for x in labels
     }
-    assert depths[("screw_spall", 0.5)] == [pytest.approx(10e-6)]
-    assert depths[("two", 1.0)] == [pytest.approx(20e-6)] * 2
-    assert depths[("none", 1.0)] == []
+    assert lengths[("screw_spall", 0.5)] == [pytest.approx(0.75e-3)]
+    assert lengths[("two", 1.0)] == [pytest.approx(1.5e-3)] * 2
+    assert lengths[("none", 1.0)] == []
     assert {x["fault_class"] for x in labels} == {"healthy", "spall"}
     random = Recipe.from_dict(
         dict(RECIPE, sweep={"mode": "random", "samples": 12, "fault_case": ["none", "two"],
@@ -141,7 +142,7 @@ def test_recipe_sweeps_fault_kinds_and_severities():
     [
         ({"sweep": {"fault_case": ["bogus"]}}, "sweep.fault_case"),
         ({"fault_cases": {"x": [{"kind": "spall", "depth": -1.0}]}}, "fault_cases.x"),
-        ({"sweep": {"fault_case": ["screw_spall"], "severity": [20.0]}}, "faults.depth"),
+        ({"sweep": {"fault_case": ["screw_spall"], "severity": [20.0]}}, "faults.length"),
     ],
 )
 def test_recipe_fault_errors(change, message):
