@@ -88,6 +88,23 @@ LOCALISED = {
 }
 
 
+def pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, name: str) -> Path:
+    fig.tight_layout()
+    path = OUT / f"fault-{name}.png"
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+    return path
+
+
 def line_ratio(f: np.ndarray, p: np.ndarray, f0: float) -> float:
     """The largest of the 3 bins around f0 over the median of ±40 % around it."""
     k = int(np.argmin(np.abs(f - f0)))
@@ -102,10 +119,7 @@ def severity_text(fault) -> str:
 
 
 def localised_figure(name: str, healthy: dict) -> tuple[Path, float, float]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from scipy import signal
 
     table, location, title, profile = LOCALISED[name]
@@ -161,11 +175,7 @@ def localised_figure(name: str, healthy: dict) -> tuple[Path, float, float]:
         f"envelope {ratios['envelope']:.1f}×",
         fontsize=10,
     )
-    fig.tight_layout()
-    path = OUT / f"fault-{name}.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path, ratios["direct"], ratios["envelope"]
+    return save(fig, name), ratios["direct"], ratios["envelope"]
 
 
 REVERSING = OperatingProfile(
@@ -183,10 +193,7 @@ def preload_figure() -> Path:
     """The lost-motion indicator through ±300 N load reversals for a nut with 5 µm of worn
     clearance and 10 µm of installed preload, as the preload is lost, read by flight-ema's
     sensors (LVDT, resolver) and by ideal ones."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fractions = np.linspace(0.0, 1.0, 6)
     fig, ax = plt.subplots(figsize=(7, 3.6))
@@ -210,11 +217,7 @@ def preload_figure() -> Path:
         title="Preload loss (b = 5 µm, 10 µm installed), ±300 N reversals",
     )
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    path = OUT / "fault-preload-loss.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, "preload-loss")
 
 
 def lubrication_figure() -> Path:
@@ -222,10 +225,7 @@ def lubrication_figure() -> Path:
     curve of :mod:`prsm_health.lubrication`) at three temperatures and for a degraded and a
     starved lubricant. Right: the mean drive torque flight-ema measures at 300 N vs screw speed,
     new and degraded lubricant, and with paper 02's constant coefficient."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     design = preset(DESIGN)
     speeds = np.geomspace(1e-4, 5.0, 300)
@@ -266,11 +266,7 @@ def lubrication_figure() -> Path:
         title="Measured drive torque at 300 N",
     )
     ax_t.legend(fontsize=8)
-    fig.tight_layout()
-    path = OUT / "fault-lubrication.png"
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save(fig, "lubrication")
 
 
 def main(names: list[str]) -> None:
