@@ -158,7 +158,10 @@ def test_recipe_fault_errors(change, message):
         ('[[faults]]\nkind = "spall"\ndepth = -1e-6\n', "faults.depth"),
         ('[[faults]]\nkind = "preload_loss"\n', "faults.kind"),
         ('[[faults]]\nkind = "spall"\nposition = 0.3\n', "faults.position"),  # off the threads
-        ('[[faults]]\nkind = "tooth_crack"\ndepth = 0.9e-3\n', "faults.depth"),  # past centreline
+        (
+            '[[faults]]\nkind = "tooth_crack"\nlocation = "roller_gear"\ndepth = 0.9e-3\n',
+            "faults.depth",
+        ),
         ("clearance = [", "not valid TOML"),
     ],
 )
