@@ -24,6 +24,7 @@ Layout (contract, docs/formats.md)::
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import itertools
 import json
@@ -64,6 +65,13 @@ SWEPT = {
     "temperature": "K",
     "severity": "-",
 }
+#: Groups whose scalar fields a sweep may also draw — domain randomisation of the operating
+#: profile, simulation options (contact damping, restitution, manufacturing scatter), drive train
+#: and sensors: ``[sweep.drive_train] coupling_stiffness = [1e3, 2e3]`` or the dotted key
+#: ``"drive_train.coupling_stiffness"``; nested fields by more dots
+#: (``options.variation.pitch_error``, ``instrumentation.nut_axial_accel.noise_density_ug``).
+#: Units are the group's (docs/formats.md); the scenario validates every drawn value.
+SWEPT_GROUPS = ("profile", "options", "drive_train", "instrumentation")
 #: Swept by name: a list of ``fault_cases`` names (drawn uniformly in random and lhs mode).
 FAULT_CASE_KEY = "fault_case"
 NO_FAULT = "none"
@@ -121,6 +129,8 @@ class Recipe:
         unknown = sorted(set(data) - known)
         if unknown:
             raise RecipeError(f"recipe: unknown key(s) {', '.join(unknown)}")
+        if isinstance(data["sweep"], dict):
+            data["sweep"] = _flat_sweep(data["sweep"])
         faults = data.pop("faults", {})
         try:
             thresholds = FaultThresholds(**faults)
@@ -181,13 +191,15 @@ class Recipe:
         check(isinstance(sweep, dict), "sweep", sweep, "must be a table")
         mode = sweep.get("mode", "grid")
         check(mode in SWEEP_MODES, "sweep.mode", mode, f"must be one of {', '.join(SWEEP_MODES)}")
-        unknown = sorted(set(sweep) - set(SWEPT) - {"mode", "repeats", "samples", FAULT_CASE_KEY})
+        unknown = sorted(
+            set(sweep) - set(_swept_keys(sweep)) - {"mode", "repeats", "samples", FAULT_CASE_KEY}
+        )
         check(
             not unknown,
             "sweep",
             unknown,
             f"unknown key(s); allowed: mode, repeats, samples, {FAULT_CASE_KEY}, "
-            f"{', '.join(SWEPT)}",
+            f"{', '.join(SWEPT)}, and fields of {', '.join(SWEPT_GROUPS)} as group.field",
         )
         self._validate_fault_cases(check)
         repeats = sweep.get("repeats", 1)
@@ -197,17 +209,16 @@ class Recipe:
             repeats,
             "must be an integer ≥ 1",
         )
-        for key in SWEPT:
-            if key not in sweep:
-                continue
+        for key in _swept_keys(sweep):
             value = sweep[key]
+            unit = SWEPT.get(key, "the group's unit")
             if mode == "grid" and isinstance(value, dict):
                 ok = set(value) == {"uniform"} and _is_range(value["uniform"])
                 check(
                     ok,
                     f"sweep.{key}",
                     value,
-                    f"a drawn value must be {{uniform = [min, max]}} [{SWEPT[key]}]",
+                    f"a drawn value must be {{uniform = [min, max]}} [{unit}]",
                 )
             elif mode == "grid":
                 ok = (
@@ -219,7 +230,7 @@ class Recipe:
                     ok,
                     f"sweep.{key}",
                     value,
-                    f"must be a non-empty list of numbers [{SWEPT[key]}], or {{uniform = [min, max]}}, in grid mode",
+                    f"must be a non-empty list of numbers [{unit}], or {{uniform = [min, max]}}, in grid mode",
                 )
             else:
                 ok = (
@@ -232,7 +243,7 @@ class Recipe:
                     ok,
                     f"sweep.{key}",
                     value,
-                    f"must be a range [min, max] [{SWEPT[key]}] in {mode} mode",
+                    f"must be a range [min, max] [{unit}] in {mode} mode",
                 )
         if mode != "grid":
             samples = sweep.get("samples")
@@ -306,7 +317,7 @@ class Recipe:
         return specs
 
     def _points(self) -> list[dict]:
-        keys = [k for k in SWEPT if k in self.sweep]
+        keys = _swept_keys(self.sweep)
         mode = self.sweep.get("mode", "grid")
         cases = self.sweep.get(FAULT_CASE_KEY)
         if mode == "grid":
@@ -340,6 +351,38 @@ class Recipe:
         """Run ids grouped into the fixed batches that workers write as one shard each."""
         ids = list(range(len(self.runs())))
         return [ids[i : i + self.batch_size] for i in range(0, len(ids), self.batch_size)]
+
+
+def _flat_sweep(sweep: dict) -> dict:
+    """The sweep with group tables (``[sweep.drive_train]`` …) as dotted keys."""
+    out = {}
+
+    def walk(prefix: str, table: dict) -> None:
+        for key, value in table.items():
+            name = f"{prefix}.{key}"
+            if isinstance(value, dict) and "uniform" not in value:
+                walk(name, value)
+            else:
+                out[name] = value
+
+    for key, value in sweep.items():
+        if key in SWEPT_GROUPS and isinstance(value, dict):
+            walk(key, value)
+        else:
+            out[key] = value
+    return out
+
+
+def _swept_keys(sweep: dict) -> list[str]:
+    """The swept quantities of a (flat) sweep: :data:`SWEPT` order, then group fields sorted."""
+    grouped = sorted(k for k in sweep if k.split(".")[0] in SWEPT_GROUPS and "." in k)
+    return [k for k in SWEPT if k in sweep] + grouped
+
+
+def _set_path(target: dict, path: list[str], value) -> None:
+    for key in path[:-1]:
+        target = target.setdefault(key, {})
+    target[path[-1]] = value
 
 
 def _is_range(value) -> bool:
@@ -389,17 +432,19 @@ class RunSpec:
         for key in ("load_amplitude", "temperature"):
             if key in p:
                 profile[key] = p[key]
+        groups = {
+            "profile": profile,
+            "instrumentation": copy.deepcopy(_with_sample_rate(r.instrumentation, r.sample_rate)),
+            "options": copy.deepcopy(r.options),
+            "drive_train": dict(r.drive_train),
+        }
+        for key, value in p.items():
+            group, *path = key.split(".")
+            if path:  # a domain-randomised field
+                _set_path(groups[group], path, value)
         try:
             return Scenario.from_dict(
-                {
-                    "design": r.design,
-                    "health": health,
-                    "profile": profile,
-                    "instrumentation": _with_sample_rate(r.instrumentation, r.sample_rate),
-                    "options": r.options,
-                    "drive_train": r.drive_train,
-                    "seed": self.seed,
-                }
+                {"design": r.design, "health": health, **groups, "seed": self.seed}
             )
         except ParameterError as exc:
             raise RecipeError(f"recipe (run {self.run_id}): {exc}") from None
@@ -427,6 +472,8 @@ class RunSpec:
             "fault_case": self.point.get(FAULT_CASE_KEY, NO_FAULT),
             "severity": self.point.get("severity", 1.0),
             **scenario.labels(),
+            # domain-randomised fields, under their dotted names
+            **{k: v for k, v in self.point.items() if "." in k},
         }
         if run is not None:
             out.update({k: v for k, v in run.labels.items() if "_realised_" in k})

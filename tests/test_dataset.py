@@ -81,6 +81,44 @@ def test_latin_hypercube_and_bad_recipes():
             Recipe.from_dict(bad)
 
 
+def test_domain_randomised_group_fields():
+    """Fields of profile, options, drive_train and instrumentation drawn per run: reach the
+    scenario, land in the labels under their dotted names, and leave the recipe untouched."""
+    base = dict(name="x", design="paper01", duration=0.01, sample_rate=20000, seed=1)
+    sweep = {
+        "mode": "random",
+        "samples": 4,
+        "profile": {"accel_time": [0.001, 0.01]},
+        "options": {"contact_restitution": [0.4, 0.8], "variation": {"pitch_error": [1e-6, 3e-6]}},
+        "drive_train": {"coupling_stiffness": [1e3, 2e3]},
+        "instrumentation": {"nut_axial_accel": {"noise_density_ug": [20.0, 60.0]}},
+    }
+    recipe = Recipe.from_dict(dict(base, sweep=sweep))
+    seen = set()
+    for spec in recipe.runs():
+        sc, labels = spec.scenario(), spec.labels()
+        p = spec.point
+        assert sc.profile.accel_time == p["profile.accel_time"] == labels["profile.accel_time"]
+        assert sc.options.contact_restitution == p["options.contact_restitution"]
+        assert sc.options.variation.pitch_error == p["options.variation.pitch_error"]
+        assert sc.drive_train.coupling_stiffness == p["drive_train.coupling_stiffness"]
+        ug = p["instrumentation.nut_axial_accel.noise_density_ug"]
+        assert sc.instrumentation.nut_axial_accel.noise_density == pytest.approx(ug * 9.80665e-6)
+        assert 1e3 <= p["drive_train.coupling_stiffness"] <= 2e3
+        seen.add(round(p["drive_train.coupling_stiffness"]))
+    assert len(seen) == 4  # a fresh draw per run
+    assert recipe.instrumentation == "flight-ema" and recipe.options == {}
+    # the flat (dotted) form is the same recipe
+    assert Recipe.from_dict(recipe.source).runs() == recipe.runs()
+    for bad, needle in [
+        ({"drive_train": {"coupling_stiff": [1e3, 2e3]}}, "coupling_stiff"),
+        ({"drive_train": {"coupling_stiffness": [-1e3, 2e3]}}, "coupling_stiffness"),
+        ({"colour": {"red": [0, 1]}}, "unknown key"),
+    ]:
+        with pytest.raises(RecipeError, match=needle):
+            Recipe.from_dict(dict(base, sweep={"mode": "random", "samples": 3, **bad}))
+
+
 def test_recipe_instrumentation(tmp_path):
     from prsm_health.instrumentation import load_instrumentation
 
