@@ -34,8 +34,8 @@ import numpy as np
 from .channels import MEASURED_TOPICS
 from .design import PRSMDesign
 from .design_files import load_design
-from .errors import PRSMHealthError, RecordingError
-from .features import extract_features, windows
+from .errors import PRSMHealthError
+from .features import FEATURES, extract_features, indicator_groups, windows
 from .jsonable import finite_or_none
 from .run import MIN_SAMPLES, Run
 
@@ -45,6 +45,20 @@ DEFAULT_MODEL = Path(__file__).resolve().parents[1] / "models" / "default.skops"
 #: least this fraction of a window (indicators over less are biased: fewer reversals, wider
 #: spectral bins), and reported as dropped otherwise.
 MIN_TAIL_FRACTION = 0.5
+#: The class of a window whose class the model cannot see (clearance hidden, channels missing,
+#: indicators unlike the training set).
+CANNOT_TELL = "cannot_tell"
+#: Out-of-distribution score above which a window is unlike the training set. The score is 1 at
+#: the 99th percentile of the training windows' own scores; 1.5 leaves room for the held-out
+#: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
+OOD_LIMIT = 1.5
+#: Words for the operating indicators in warnings.
+REGIME_WORDS = {
+    "speed_mean": "speed",
+    "load_mean": "mean load",
+    "load_range": "load swing",
+    "drive_torque_mean": "mean drive torque (load)",
+}
 
 
 @dataclass
@@ -55,6 +69,7 @@ class ModelBundle:
     fault: object | None
     feature_names: list[str]
     metadata: dict
+    guard: object | None = None
     design: PRSMDesign = field(init=False)
 
     def __post_init__(self):
@@ -85,15 +100,14 @@ class ModelBundle:
         """The ``model`` entry of a diagnosis."""
         return {"name": self.name, "version": self.version, "design": self.design.name}
 
-    def check_channels(self, run: Run, what: str = "recording") -> None:
-        """Refuse a recording that lacks a channel the model was trained with."""
-        missing = [c for c in self.channels or () if c not in run.channels]
-        if missing:
-            raise RecordingError(
-                f"{what} lacks channel(s) {', '.join(missing)} that model {self.name!r} was "
-                f"trained with ({', '.join(self.channels)}); use a model trained for this "
-                "instrumentation"
-            )
+    def missing_channels(self, channels) -> list[str]:
+        """The channels the model was trained with that a recording lacks."""
+        return [c for c in self.channels or () if c not in channels]
+
+    @property
+    def regime(self) -> dict[str, list[float]]:
+        """Indicator → [min, max] of the operating indicators over the training windows."""
+        return dict(self.metadata.get("regime", {}))
 
 
 def load_bundle(
@@ -110,7 +124,11 @@ def load_bundle(
     if not isinstance(model, dict) or "feature_names" not in model:
         raise PRSMHealthError(f"{path}: not a prsm_health diagnosis bundle")
     return ModelBundle(
-        model.get("clearance"), model.get("fault"), list(model["feature_names"]), metadata
+        model.get("clearance"),
+        model.get("fault"),
+        list(model["feature_names"]),
+        metadata,
+        model.get("guard"),
     )
 
 
@@ -133,7 +151,17 @@ class Diagnosis:
     windows : list of Diagnosis
         Per-window diagnoses of a recording diagnosis.
     warnings : list of str
-        Sentences a person can act on (e.g. a dropped tail).
+        Sentences a person can act on: why a target is not observable, a missing channel, a
+        recording outside the trained range, a dropped tail.
+    observability : dict
+        ``clearance`` and ``fault``: whether the window lets the model see them (bool), or the
+        fraction of windows that did for a recording.
+    ood_score : float or None
+        Out-of-distribution score of the indicators (:class:`DistributionGuard`: 1 = the
+        training windows' 99th percentile; above :data:`OOD_LIMIT` the window is unlike the
+        training set); a recording's is the median of its windows'.
+    indicator_groups : dict
+        Indicator group → ``"computed"`` or why not (missing channels, window).
     """
 
     clearance: dict
@@ -144,6 +172,9 @@ class Diagnosis:
     window: dict | None = None
     windows: list[Diagnosis] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    observability: dict = field(default_factory=dict)
+    ood_score: float | None = None
+    indicator_groups: dict = field(default_factory=dict)
 
     def to_json(self) -> dict:
         """The Diagnosis contract as plain JSON values."""
@@ -151,7 +182,10 @@ class Diagnosis:
             "clearance": dict(self.clearance),
             "fault_class": self.fault_class,
             "class_probabilities": dict(self.class_probabilities),
+            "observability": dict(self.observability),
+            "ood_score": self.ood_score,
             "indicators": dict(self.indicators),
+            "indicator_groups": dict(self.indicator_groups),
             "model": dict(self.model),
             "warnings": list(self.warnings),
         }
@@ -170,30 +204,95 @@ def _matrix(rows: list[dict], names: list[str]):
     )
 
 
-def diagnose_indicators(rows: list[dict], bundle: ModelBundle) -> list[Diagnosis]:
-    """One :class:`Diagnosis` per row of indicators (one row per window)."""
+def diagnose_indicators(
+    rows: list[dict], bundle: ModelBundle, channels: list | None = None, design: str | None = None
+) -> list[Diagnosis]:
+    """One :class:`Diagnosis` per row of indicators (one row per window).
+
+    ``channels``: the measured channels of each row's window (default: the model's, i.e. none
+    missing); ``design``: the recording's design label, if it has one.
+    """
     from threadpoolctl import threadpool_limits
 
     x = _matrix(rows, bundle.feature_names)
+    channels = channels or [bundle.channels or ()] * len(rows)
     # A few rows per call: OpenMP threads in the boosted trees only add spin-wait latency, and
     # under load (the service, parallel replays) oversubscribe the cores.
     with threadpool_limits(limits=1, user_api="openmp"):
-        return _predict(rows, x, bundle)
+        return _predict(rows, x, bundle, channels, design)
 
 
-def _predict(rows: list[dict], x, bundle: ModelBundle) -> list[Diagnosis]:
+def _window_gates(row: dict, channels, bundle: ModelBundle, ood: float, design) -> tuple:
+    """(clearance observable, fault observable, warnings) of one window."""
+    notes = []
+    missing = bundle.missing_channels(channels)
+    if missing:
+        notes.append(
+            f"channel(s) {', '.join(missing)} missing: model {bundle.name!r} was trained with "
+            f"them ({', '.join(bundle.channels)}); their indicators are NaN"
+        )
+    reversal = row.get("reversal")
+    reverses = reversal is not None and np.isfinite(reversal) and reversal > 0
+    gate = bundle.metadata.get("observability_feature")
+    gate_ok = gate not in bundle.feature_names or np.isfinite(row.get(gate, np.nan))
+    clearance_ok = bool(reverses and gate_ok and not missing)
+    if bundle.clearance is not None and not clearance_ok:
+        if not reverses:
+            notes.append(
+                "no load or motion reversal in this window: clearance is not observable (the "
+                "rollers stay on one flank); the interval is the whole trained range"
+            )
+        elif missing:
+            notes.append("clearance is not observable without the missing channel(s)")
+        else:
+            notes.append(f"indicator {gate} not computable: clearance is not observable")
+    for name, (lo, hi) in bundle.regime.items():
+        value = row.get(name)
+        if value is not None and np.isfinite(value):
+            slack = 0.05 * max(hi - lo, abs(hi), abs(lo))  # the range of a few hundred windows
+            if not lo - slack <= value <= hi + slack:
+                notes.append(
+                    f"recording outside the trained {REGIME_WORDS.get(name, name)} range: "
+                    f"{value:.4g} vs {lo:.4g} … {hi:.4g} {FEATURES[name]}"
+                )
+    if design is not None and design != bundle.design.name:
+        notes.append(
+            f"recording of design {design!r}, model trained on {bundle.design.name!r}: its "
+            "indicators mean something else"
+        )
+    ood_high = np.isfinite(ood) and ood > OOD_LIMIT
+    if ood_high:
+        notes.append(
+            f"indicators unlike the training windows (out-of-distribution score {ood:.2g} > "
+            f"{OOD_LIMIT:g}): another design, instrumentation or operating regime? No class, "
+            "and the clearance interval is the whole trained range"
+        )
+    fault_ok = bool(clearance_ok and not ood_high and not missing)
+    if bundle.fault is not None and not fault_ok:
+        notes.append(
+            "fault class: cannot tell — wear classes differ by clearance, which this window "
+            "does not show"
+            if not clearance_ok
+            else "fault class: cannot tell"
+        )
+    return clearance_ok, fault_ok, notes
+
+
+def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
     n = len(rows)
     estimate = lower = upper = np.full(n, np.nan)
+    guard = bundle.guard
+    ood = np.asarray(guard.score(x), float) if guard is not None else np.full(n, np.nan)
+    gates = [_window_gates(r, c, bundle, o, design) for r, c, o in zip(rows, channels, ood)]
     if bundle.clearance is not None:
         estimate = np.asarray(bundle.clearance.predict(x), float)
         lower, upper = (np.asarray(a, float) for a in bundle.clearance.predict_interval(x))
-        # Regime gate: without a load or motion reversal the clearance is not observable
-        # (steady preload keeps each roller on one flank, docs/validation.md), so the interval
+        # Where the clearance is not observable (no reversal: steady load keeps each roller on
+        # one flank, docs/validation.md) or the window is unlike the training set, the interval
         # is the whole range the model was trained on, whatever the regression says.
-        gate = bundle.metadata.get("observability_feature")
         span = bundle.metadata.get("clearance_range")
-        if gate in x.columns and span:
-            hidden = ~np.isfinite(x[gate].to_numpy(float))
+        if span:
+            hidden = np.array([not g[0] or o > OOD_LIMIT for g, o in zip(gates, ood)])
             lower = np.where(hidden, span[0], lower)
             upper = np.where(hidden, span[1], upper)
     classes, proba = [], np.zeros((n, 0))
@@ -202,7 +301,11 @@ def _predict(rows: list[dict], x, bundle: ModelBundle) -> list[Diagnosis]:
         proba = np.asarray(bundle.fault.predict_proba(x), float)
     out = []
     for i, row in enumerate(rows):
+        clearance_ok, fault_ok, notes = gates[i]
         probabilities = {c: float(p) for c, p in zip(classes, proba[i])}
+        fault_class = None
+        if probabilities:
+            fault_class = max(probabilities, key=probabilities.get) if fault_ok else CANNOT_TELL
         out.append(
             Diagnosis(
                 clearance={
@@ -210,44 +313,76 @@ def _predict(rows: list[dict], x, bundle: ModelBundle) -> list[Diagnosis]:
                     "lower": finite_or_none(lower[i]),
                     "upper": finite_or_none(upper[i]),
                 },
-                fault_class=max(probabilities, key=probabilities.get) if probabilities else None,
+                fault_class=fault_class,
                 class_probabilities=probabilities,
                 indicators={k: finite_or_none(v) for k, v in row.items()},
                 model=bundle.reference(),
+                warnings=notes,
+                observability={"clearance": clearance_ok, "fault": fault_ok},
+                ood_score=finite_or_none(ood[i]),
+                indicator_groups=indicator_groups(row, channels[i]),
             )
         )
     return out
 
 
 def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
-    """One diagnosis for a recording: medians of the window estimates and bounds, mean class
-    probabilities, median indicators; the windows attached."""
+    """One diagnosis for a recording: medians of the estimates and bounds of the windows where
+    the clearance is observable (else of all), mean class probabilities of the windows where
+    the class is (else ``cannot_tell``), median indicators and OOD score, each warning once
+    (with the number of windows it concerns); the windows attached."""
 
     def median(values):
         values = [v for v in values if v is not None]
         return float(np.median(values)) if values else None
 
+    seen = [d for d in diagnoses if d.observability.get("clearance")] or diagnoses
+    told = [d for d in diagnoses if d.observability.get("fault")]
     probs: dict[str, float] = {}
-    for d in diagnoses:
+    for d in told or diagnoses:
         for c, p in d.class_probabilities.items():
-            probs[c] = probs.get(c, 0.0) + p / len(diagnoses)
+            probs[c] = probs.get(c, 0.0) + p / len(told or diagnoses)
+    fault_class = None
+    if probs:
+        fault_class = max(probs, key=probs.get) if told else CANNOT_TELL
+    counts: dict[str, int] = {}
+    for d in diagnoses:
+        for note in d.warnings:
+            counts[note] = counts.get(note, 0) + 1
+    notes = [
+        note if k == len(diagnoses) else f"{note} (in {k} of {len(diagnoses)} windows)"
+        for note, k in counts.items()
+    ]
     names = diagnoses[0].indicators.keys()
+    groups = {
+        g: next(
+            (d.indicator_groups[g] for d in diagnoses if d.indicator_groups.get(g) == "computed"), r
+        )
+        for g, r in diagnoses[0].indicator_groups.items()
+    }
     return Diagnosis(
         clearance={
-            k: median([d.clearance[k] for d in diagnoses]) for k in ("estimate", "lower", "upper")
+            k: median([d.clearance[k] for d in seen]) for k in ("estimate", "lower", "upper")
         },
-        fault_class=max(probs, key=probs.get) if probs else None,
+        fault_class=fault_class,
         class_probabilities=probs,
         indicators={n: median([d.indicators[n] for d in diagnoses]) for n in names},
         model=bundle.reference(),
         windows=list(diagnoses),
+        warnings=notes,
+        observability={
+            k: float(np.mean([bool(d.observability.get(k)) for d in diagnoses]))
+            for k in ("clearance", "fault")
+        },
+        ood_score=median([d.ood_score for d in diagnoses]),
+        indicator_groups=groups,
     )
 
 
 def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:
     """Diagnosis of one window (a :class:`Run` of about the model's window length)."""
-    bundle.check_channels(run, "window")
-    return diagnose_indicators([extract_features(run, bundle.design)], bundle)[0]
+    row = extract_features(run, bundle.design)
+    return diagnose_indicators([row], bundle, [tuple(run.channels)], run.labels.get("design"))[0]
 
 
 def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
@@ -291,10 +426,11 @@ def diagnose(
     """
     bundle = bundle or load_bundle()
     run = run.without_truth().validate()
-    bundle.check_channels(run)
     parts, notes = split_windows(run, window or bundle.window)
     rows = [extract_features(part, bundle.design) for part in parts]
-    per_window = diagnose_indicators(rows, bundle)
+    per_window = diagnose_indicators(
+        rows, bundle, [tuple(run.channels)] * len(rows), run.labels.get("design")
+    )
     for k, (part, d) in enumerate(zip(parts, per_window)):
         d.window = {"index": k, "start": float(part.time[0]), "end": float(part.time[-1])}
     result = aggregate(per_window, bundle)

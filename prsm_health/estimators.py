@@ -41,7 +41,7 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 
 from .errors import ParameterError, require, require_range
 
-__all__ = ["ClearanceEstimator", "FaultClassifier"]
+__all__ = ["ClearanceEstimator", "DistributionGuard", "FaultClassifier"]
 
 _SEED_MAX = np.iinfo(np.int32).max
 
@@ -614,3 +614,98 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         """
         proba = self.predict_proba(X)
         return self.classes_[np.argmax(proba, axis=1)]
+
+
+# --------------------------------------------------------------------------------------------
+# Out-of-distribution score
+# --------------------------------------------------------------------------------------------
+
+
+class DistributionGuard(BaseEstimator):
+    """How far a row of indicators lies from the training rows: an out-of-distribution score.
+
+    Indicators are put on a common scale (centred on the training median, divided by the
+    training IQR/1.349, a robust standard deviation). The distance of two rows is the RMS of
+    their differences over the indicators either has; an indicator one row has and the other
+    lacks (NaN) counts as ``missing_penalty`` robust standard deviations, so a window that lacks
+    what the training windows had (no reversal, a missing channel) is far from all of them. The
+    raw score of a row is its mean distance to its ``n_neighbors`` nearest training rows
+    (k-nearest-neighbour novelty detection [3]_); the score returned is the raw score divided by
+    the ``quantile`` of the training rows' own raw scores (each left out of its own neighbours):
+    ≤ 1 for all but a fraction ``1 − quantile`` of windows like the training ones, ≫ 1 for a
+    window unlike any of them.
+
+    Parameters
+    ----------
+    n_neighbors : int, default 5
+    quantile : float, default 0.99
+        Training quantile that scores 1, in (0, 1).
+    missing_penalty : float, default 5.0
+        Distance [robust standard deviations] of a present to an absent indicator, ≥ 0.
+
+    References
+    ----------
+    .. [3] S. Ramaswamy, R. Rastogi, K. Shim, "Efficient algorithms for mining outliers from
+       large data sets", SIGMOD 2000 (distance to the k-th nearest neighbour as outlier score).
+    """
+
+    def __init__(self, n_neighbors=5, quantile=0.99, missing_penalty=5.0):
+        self.n_neighbors = n_neighbors
+        self.quantile = quantile
+        self.missing_penalty = missing_penalty
+
+    def fit(self, X, y=None):
+        require(
+            isinstance(self.n_neighbors, (int, np.integer)) and self.n_neighbors >= 1,
+            "n_neighbors",
+            self.n_neighbors,
+            "must be an integer >= 1",
+        )
+        require_range("quantile", self.quantile, 0.0, 1.0, inclusive=False)
+        require_range("missing_penalty", self.missing_penalty, 0.0, math.inf)
+        X = validate_data(self, X, ensure_all_finite="allow-nan", dtype=np.float64)
+        require(len(X) > self.n_neighbors, "X", len(X), f"needs more than {self.n_neighbors} rows")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN columns
+            self.center_ = np.nan_to_num(np.nanmedian(X, axis=0))
+            q75, q25 = np.nanpercentile(X, [75, 25], axis=0)
+            spread = np.nan_to_num((q75 - q25) / 1.349)
+            fallback = np.nan_to_num(np.nanstd(X, axis=0))
+        # a constant column (IQR 0): its standard deviation, else 1 (any change is then large)
+        spread = np.where(spread > 0, spread, np.where(fallback > 0, fallback, 1.0))
+        self.scale_ = spread
+        self.reference_ = self._scaled(X)
+        raw = self._raw(self.reference_, leave_out_self=True)
+        self.threshold_ = float(np.quantile(raw, self.quantile))
+        return self
+
+    def _scaled(self, X) -> np.ndarray:
+        return ((X - self.center_) / self.scale_).astype(np.float32)
+
+    def _raw(self, Z: np.ndarray, leave_out_self: bool = False, chunk: int = 64) -> np.ndarray:
+        ref = self.reference_
+        ref_ok = np.isfinite(ref)
+        ref0 = np.where(ref_ok, ref, 0.0)
+        out = np.empty(len(Z))
+        for start in range(0, len(Z), chunk):
+            z = Z[start : start + chunk]
+            ok = np.isfinite(z)
+            z0 = np.where(ok, z, 0.0)
+            both = ok[:, None, :] & ref_ok[None, :, :]
+            one = ok[:, None, :] ^ ref_ok[None, :, :]
+            diff = np.where(both, z0[:, None, :] - ref0[None, :, :], 0.0)
+            sq = np.sum(diff**2, axis=2) + self.missing_penalty**2 * np.sum(one, axis=2)
+            used = np.maximum(np.sum(both | one, axis=2), 1)
+            d = np.sqrt(sq / used)
+            if leave_out_self:
+                rows = np.arange(start, start + len(z))
+                d[np.arange(len(z)), rows] = np.inf
+            d.sort(axis=1)
+            out[start : start + len(z)] = d[:, : self.n_neighbors].mean(axis=1)
+        return out
+
+    def score(self, X) -> np.ndarray:
+        """Out-of-distribution score of each row (1 = the training rows' ``quantile``)."""
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
+        return self._raw(self._scaled(X)) / max(self.threshold_, 1e-12)

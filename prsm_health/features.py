@@ -34,13 +34,14 @@ stiffness); paper 02 (friction torque, efficiency).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 from scipy import signal, stats
 from scipy.ndimage import uniform_filter1d
 
-from .channels import VIBRATION
+from .channels import CHANNEL_NAMES, VIBRATION
 from .design import PRSMDesign, preset
 from .errors import PRSMHealthError
 from .kinematics import speed_ratios
@@ -89,6 +90,7 @@ def _feature_table() -> dict[str, str]:
             "speed_mean": "rad/s",
             "load_mean": "N",
             "load_range": "N",
+            "reversal": "-",
         }
     )
     return units
@@ -113,8 +115,52 @@ GROUPS = {
     "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
     "lost_motion": ["lost_motion"],
     "torque_rattle": ["torque_rattle_rate"],
-    "operating": ["speed_mean", "load_mean", "load_range"],
+    "operating": ["speed_mean", "load_mean", "load_range", "reversal"],
 }
+
+
+@dataclass(frozen=True)
+class Needs:
+    """The measured channels an indicator group reads: all of ``all_of`` and, when ``any_of``
+    is not empty, at least one of it."""
+
+    all_of: tuple[str, ...] = ()
+    any_of: tuple[str, ...] = ()
+
+    def missing(self, channels) -> list[str]:
+        """What a set of channels lacks for this group (``a or b`` for an any-of set)."""
+        out = [c for c in self.all_of if c not in channels]
+        if self.any_of and not any(c in channels for c in self.any_of):
+            out.append(" or ".join(self.any_of))
+        return out
+
+
+#: The channels each indicator group needs: declared once. A window without them has the
+#: group's indicators NaN; a diagnosis names the groups it could not compute and why.
+GROUP_CHANNELS: dict[str, Needs] = {
+    "mesh": Needs(("screw_speed",), MESH_CHANNELS),
+    "axial_frequency": Needs(("nut_axial_accel",)),
+    "classic": Needs(any_of=VIBRATION),
+    "torque": Needs(("drive_torque",)),
+    "lost_motion": Needs(("nut_position", "screw_angle")),
+    "torque_rattle": Needs(("drive_torque",)),
+    "operating": Needs(any_of=("screw_speed", "axial_load", "drive_torque")),
+}
+
+
+def indicator_groups(row: dict, channels) -> dict[str, str]:
+    """Each indicator group of a window's indicators → ``"computed"`` (at least one finite
+    value), or why not: the channels it lacks, or that the window does not support it."""
+    out = {}
+    for group, members in GROUPS.items():
+        values = [row.get(name) for name in members]
+        if any(v is not None and np.isfinite(v) for v in values):
+            out[group] = "computed"
+        elif missing := GROUP_CHANNELS[group].missing(channels):
+            out[group] = "missing channel(s) " + ", ".join(missing)
+        else:
+            out[group] = "not supported by this window (e.g. no reversal, too slow or too short)"
+    return out
 
 
 @lru_cache(maxsize=256)
@@ -228,9 +274,10 @@ def extract_features(
         run.labels,
         truth={name: run.truth[name] for name in truth},
     ).validate(what="window")
-    if not any(ch in run.channels for ch in VIBRATION) and "nut_position" not in run.channels:
+    if not any(name in CHANNEL_NAMES for name in run.channels):
         raise PRSMHealthError(
-            "no usable channels: need nut accelerations or nut position (contract names)"
+            "no usable channels: the recording has no measured channel of the contract "
+            f"({', '.join(CHANNEL_NAMES)})"
         )
     if design is None:
         design = run.labels.get("design", "paper01")
@@ -333,6 +380,8 @@ def extract_features(
         or (load is not None and np.min(load) < 0 < np.max(load))
         or (load is None and slow_torque is not None and _reverses(slow_torque))
     )
+    if speed is not None or load is not None or torque is not None:
+        out["reversal"] = float(reversal)
     if reversal and torque is not None:
         out["torque_rattle_rate"] = _rattle_rate(torque, rate)
     # lost motion: nut lag behind the rigid kinematics across a reversal

@@ -32,6 +32,8 @@ MODEL_SUFFIX = ".skops"
 #: Indicator whose absence means the window has no load/motion reversal, i.e. the clearance is
 #: not observable (docs/validation.md: steady preload keeps every roller on one flank).
 OBSERVABILITY_FEATURE = "lost_motion"
+#: Operating indicators whose training range a model records (diagnosis warns outside it).
+REGIME_FEATURES = ("speed_mean", "load_mean", "load_range", "drive_torque_mean")
 
 #: Clearance estimator settings. A few hundred runs: small leaves. Quantiles of the out-of-fold
 #: residual, because the clearance is nearly a deterministic function of lost motion
@@ -423,7 +425,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     # One OpenMP thread: a few hundred samples gain nothing from threads, and spin-waiting
     # threads of two busy processes on 2 cores made training 50× slower (docs/performance.md).
     from .dataset import Dataset
-    from .estimators import ClearanceEstimator, FaultClassifier
+    from .estimators import ClearanceEstimator, DistributionGuard, FaultClassifier
     from .evaluation import cross_validated_metrics, permutation_importance_table
     from .persistence import save_model
 
@@ -456,6 +458,8 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         "indicators_absent": absent,
     }
     bundle: dict = {"feature_names": features, "clearance": None, "fault": None}
+    # How far a window's indicators lie from the training windows (diagnosis: OOD score).
+    bundle["guard"] = DistributionGuard().fit(x_train)
 
     if target in ("clearance", "both"):
         y = clearance_target(train_rows)
@@ -549,6 +553,13 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         "clearance_range": metrics.get("clearance_range"),
         # what a recording must have to be diagnosed by this model (diagnosis.check_channels)
         "channels": list(ds.channels),
+        "instrumentation": _instrumentation_name(ds.manifest["recipe"]),
+        # the operating range of the training windows (diagnosis warns outside it)
+        "regime": {
+            name: [float(train_rows[name].min()), float(train_rows[name].max())]
+            for name in REGIME_FEATURES
+            if name in train_rows and train_rows[name].notna().any()
+        },
         "observability_feature": OBSERVABILITY_FEATURE,
         "target": target,
     }
@@ -561,6 +572,12 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     metrics_path.write_text(dumps(metrics, indent=2))
     metrics["metrics_path"] = str(metrics_path)
     return metrics
+
+
+def _instrumentation_name(recipe: dict) -> str | None:
+    """The instrumentation profile's name of a dataset's recipe (a name or a complete table)."""
+    value = recipe.get("instrumentation")
+    return value.get("name") if isinstance(value, dict) else value
 
 
 def _importance_records(frame) -> list[dict]:

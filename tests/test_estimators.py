@@ -18,7 +18,7 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from prsm_health import __version__
 from prsm_health.errors import ModelVersionError, ParameterError, PRSMHealthError
-from prsm_health.estimators import ClearanceEstimator, FaultClassifier
+from prsm_health.estimators import ClearanceEstimator, DistributionGuard, FaultClassifier
 from prsm_health.evaluation import cross_validated_metrics, permutation_importance_table
 from prsm_health.persistence import _bundle_bytes, load_model, save_model
 
@@ -504,3 +504,41 @@ def test_estimator_module_is_trusted():
         assert cls.__module__ in _TRUSTED_ROOTS
         assert _is_trusted(f"{cls.__module__}.{cls.__qualname__}")
     assert not _is_trusted("prsm_health.persistence.Path")
+
+
+# ------------------------------------------------------------------------------------------
+# Out-of-distribution score
+# ------------------------------------------------------------------------------------------
+def test_distribution_guard_scores_unlike_rows_high():
+    rng = np.random.default_rng(3)
+    train = rng.normal(size=(600, 12))
+    guard = DistributionGuard().fit(train)
+    like = guard.score(rng.normal(size=(400, 12)))
+    # Rows from the training distribution: the score is 1 at the training rows' 99th percentile
+    # (leave-one-out), so ≈ 1 % of fresh rows exceed 1; 5 % allows the quantile's sampling
+    # error with 600 rows (binomial sd of 1 % of 400 ≈ 0.5 %) and the leave-one-out bias.
+    assert np.mean(like > 1.0) < 0.05
+    assert 0.5 < np.median(like) < 1.0
+    # Shifted by 3 robust sd in every indicator: far outside.
+    assert np.min(guard.score(rng.normal(size=(50, 12)) + 3.0)) > 1.5
+    # Indicators the training rows always had, missing: far (penalty 5 sd each).
+    missing = rng.normal(size=(50, 12))
+    missing[:, :4] = np.nan
+    assert np.min(guard.score(missing)) > 1.5
+    # A column the training rows never had stays neutral when a row lacks it too.
+    with_nan = np.column_stack([train, np.full(len(train), np.nan)])
+    rows = np.column_stack([rng.normal(size=(400, 12)), np.full(400, np.nan)])
+    assert np.mean(DistributionGuard().fit(with_nan).score(rows) > 1.0) < 0.05
+
+
+def test_distribution_guard_bad_parameters():
+    x = np.zeros((10, 2))
+    for params, field in [
+        ({"n_neighbors": 0}, "n_neighbors"),
+        ({"quantile": 1.0}, "quantile"),
+        ({"missing_penalty": -1.0}, "missing_penalty"),
+    ]:
+        with pytest.raises(ParameterError, match=field):
+            DistributionGuard(**params).fit(x)
+    with pytest.raises(ParameterError, match="more than 5 rows"):
+        DistributionGuard().fit(np.zeros((5, 2)))

@@ -201,15 +201,22 @@ def test_diagnose_several_windows_and_time_start(client, recording):
 
 
 def test_diagnose_subset_of_channels(client, recording):
-    # The shipped model was trained on what flight-ema fits: a recording without those channels
-    # cannot be diagnosed by it, and the answer names what is missing (not a guess).
+    # The shipped model was trained on what flight-ema fits: a recording with only the
+    # accelerometer is diagnosed with what it has, names what is missing, and gives no class
+    # (not a guess): cannot_tell, clearance not observable.
     body = {
         "sample_rate": recording.sample_rate,
         "channels": {"nut_axial_accel": recording["nut_axial_accel"].tolist()},
     }
     r = client.post("/v1/diagnose", json=body)
-    assert r.status_code == 422
-    assert "lacks channel(s) screw_angle, screw_speed, nut_position, drive_torque" in r.text
+    assert r.status_code == 200, r.text
+    d = r.json()
+    assert d["fault_class"] == "cannot_tell"
+    assert d["observability"] == {"clearance": 0.0, "fault": 0.0}
+    assert any(
+        "screw_angle, screw_speed, nut_position, drive_torque missing" in w for w in d["warnings"]
+    )
+    assert d["indicator_groups"]["lost_motion"] == "missing channel(s) nut_position, screw_angle"
 
 
 def _mutate(run, kind):
