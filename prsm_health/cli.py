@@ -407,6 +407,47 @@ def _cmd_diagnose(args) -> int:
     return 0
 
 
+def _cmd_evaluate(args) -> int:
+    from .dataset import Dataset
+    from .diagnosis import load_bundle
+    from .evaluation import evaluate_model
+
+    bundle = load_bundle(args.model)
+    dataset = Dataset(args.dataset)
+    report, records = evaluate_model(bundle, dataset, split=args.split, progress=not args.json)
+    if args.plot:
+        from .plots import plot_evaluation
+
+        report["figures"] = [str(p) for p in plot_evaluation(report, records, args.plot)]
+    if args.json:
+        _print_json(report)
+        return 0
+    rows = [
+        ("model", f"{report['model']['name']} v{report['model']['version']}", ""),
+        ("dataset", f"{report['dataset']} ({report['split']}: {report['runs']} runs)", ""),
+    ]
+    if "clearance" in report:
+        c = report["clearance"]
+        rows += [
+            ("clearance MAE", _scaled(c["mae"], 1e6), "µm"),
+            ("clearance 90 % interval coverage", _scaled(c["coverage"]), ""),
+            ("clearance mean interval width", _scaled(c["mean_width"], 1e6), "µm"),
+            ("clearance observable", _scaled(c["observable_fraction"]), "of runs"),
+        ]
+    if "fault" in report:
+        f = report["fault"]
+        rows += [
+            ("fault macro-F1", _scaled(f["macro_f1"]), "cannot_tell counted as a miss"),
+            ("fault macro-F1, runs given a class", _scaled(f["macro_f1_told"]), ""),
+            ("cannot_tell", _scaled(f["cannot_tell_fraction"]), "of runs"),
+        ]
+        rows += [(f"F1({k})", v, "") for k, v in f["f1_by_class"].items()]
+    rows.append(("out of distribution", _scaled(report["ood"]["flagged_fraction"]), "of runs"))
+    rows += [("figure", p, "") for p in report.get("figures", [])]
+    _print_table(rows)
+    return 0
+
+
 def _cmd_train(args) -> int:
     from .training import train
 
@@ -769,6 +810,23 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--plot", default=None, help="write a PNG of the per-window estimates")
     _add_json(d, "the Diagnosis contract")
     d.set_defaults(func=_cmd_diagnose)
+
+    e = command(
+        "evaluate", "score a model on a dataset (generated or imported) through the diagnosis"
+    )
+    e.add_argument("model", help="model bundle (.skops)")
+    e.add_argument("dataset", help="dataset directory")
+    e.add_argument(
+        "--split", choices=("test", "train", "all"), default="test", help="which runs to score"
+    )
+    e.add_argument(
+        "--plot",
+        default=None,
+        metavar="DIR",
+        help="write clearance.png, calibration.png and confusion.png into DIR",
+    )
+    _add_json(e, "the metrics")
+    e.set_defaults(func=_cmd_evaluate)
 
     r = command("replay", "stream an MCAP recording window by window through the diagnosis")
     r.add_argument("file", help="MCAP recording")

@@ -30,7 +30,14 @@ from sklearn.utils import check_random_state
 
 from .errors import require
 
-__all__ = ["cross_validated_metrics", "permutation_importance_table"]
+__all__ = [
+    "clearance_report",
+    "cross_validated_metrics",
+    "evaluate_model",
+    "fault_report",
+    "permutation_importance_table",
+    "sensitivity_table",
+]
 
 
 # --------------------------------------------------------------------------------------------
@@ -303,3 +310,166 @@ def cross_validated_metrics(
             )
     result["folds"] = folds
     return result
+
+
+# --------------------------------------------------------------------------------------------
+# A trained model on a dataset, through the diagnosis (gates, OOD, cannot_tell)
+# --------------------------------------------------------------------------------------------
+
+
+def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = False) -> tuple:
+    """Diagnose every run of a dataset split as one window and score it against its labels.
+
+    The runs go through :func:`prsm_health.diagnosis.diagnose_indicators`, as a recording
+    would: observability gates, the OOD score, ``cannot_tell``. Clearance metrics are computed
+    over all runs and over those whose clearance the diagnosis called observable; fault
+    metrics count ``cannot_tell`` as not correct (``macro_f1``) and also over the runs given a
+    class (``macro_f1_told``).
+
+    Parameters
+    ----------
+    bundle : ModelBundle
+    dataset : Dataset (generated or imported)
+    split : {"test", "train", "all"}
+
+    Returns
+    -------
+    (report, records)
+        ``report``: JSON-serialisable metrics; ``records``: one row per run (labels, estimate,
+        bounds, class, top probability, observability, OOD score) for plots and sensitivity
+        tables.
+    """
+    from .diagnosis import diagnose_indicators
+    from .features import dataset_features
+
+    require(split in ("test", "train", "all"), "split", split, "must be test, train or all")
+    runs = dataset.runs if split == "all" else dataset.runs[dataset.runs["split"] == split]
+    require(len(runs) > 0, "split", split, f"has no runs in {dataset.path}")
+    table = dataset_features(dataset, runs["run_id"], progress=progress)
+    rows = [{k: row[k] for k in bundle.feature_names} | _extra(row) for _, row in table.iterrows()]
+    designs = table["design"] if "design" in table else [None] * len(table)
+    results = [
+        diagnose_indicators([r], bundle, [dataset.channels], d)[0] for r, d in zip(rows, designs)
+    ]
+    records = table.copy()
+    records["estimate"] = [_num(r.clearance["estimate"]) for r in results]
+    records["lower"] = [_num(r.clearance["lower"]) for r in results]
+    records["upper"] = [_num(r.clearance["upper"]) for r in results]
+    records["predicted_class"] = [r.fault_class for r in results]
+    records["top_probability"] = [
+        max(r.class_probabilities.values()) if r.class_probabilities else np.nan for r in results
+    ]
+    records["clearance_observable"] = [bool(r.observability["clearance"]) for r in results]
+    records["fault_observable"] = [bool(r.observability["fault"]) for r in results]
+    records["ood_score"] = [_num(r.ood_score) for r in results]
+    report = {
+        "dataset": str(dataset.path),
+        "model": bundle.reference(),
+        "split": split,
+        "runs": len(records),
+        "ood": {
+            "median_score": _num(np.nanmedian(records["ood_score"])),
+            "flagged_fraction": float(np.mean(records["ood_score"] > _ood_limit())),
+        },
+    }
+    if bundle.clearance is not None and {"clearance_screw", "clearance_nut"} <= set(records):
+        records["clearance"] = 0.5 * (records["clearance_screw"] + records["clearance_nut"])
+        report["clearance"] = clearance_report(records)
+    if bundle.fault is not None and "fault_class" in records:
+        report["fault"] = fault_report(records)
+    return report, records
+
+
+def _extra(row) -> dict:
+    # the indicators the gates read even when the model does not use them
+    return {k: row[k] for k in ("reversal",) if k in row}
+
+
+def _num(value) -> float:
+    return float("nan") if value is None else float(value)
+
+
+def _ood_limit() -> float:
+    from .diagnosis import OOD_LIMIT
+
+    return OOD_LIMIT
+
+
+def clearance_report(records: pd.DataFrame) -> dict:
+    """MAE, bias, interval coverage and width [m] over all rows and the observable ones."""
+
+    def stats(part: pd.DataFrame) -> dict:
+        if part.empty:
+            return {"n": 0, "mae": None, "bias": None, "coverage": None, "mean_width": None}
+        y, est = part["clearance"].to_numpy(float), part["estimate"].to_numpy(float)
+        lo, hi = part["lower"].to_numpy(float), part["upper"].to_numpy(float)
+        return {
+            "n": len(part),
+            "mae": float(np.mean(np.abs(est - y))),
+            "bias": float(np.mean(est - y)),
+            "coverage": float(np.mean((y >= lo) & (y <= hi))),
+            "mean_width": float(np.mean(hi - lo)),
+        }
+
+    observable = records[records["clearance_observable"]]
+    return {
+        **stats(records),
+        "observable_fraction": float(records["clearance_observable"].mean()),
+        "observable": stats(observable),
+    }
+
+
+def fault_report(records: pd.DataFrame) -> dict:
+    """Macro-F1 (``cannot_tell`` counted as a miss), macro-F1 of the runs given a class,
+    per-class F1, the confusion matrix (rows: true, columns: predicted incl. ``cannot_tell``)."""
+    from sklearn.metrics import confusion_matrix
+
+    y = records["fault_class"].astype(str).to_numpy()
+    pred = records["predicted_class"].astype(str).to_numpy()
+    classes = sorted(set(y))
+    columns = classes + sorted(set(pred) - set(classes))
+    told = records["fault_observable"].to_numpy(bool)
+    per_class = f1_score(y, pred, labels=classes, average=None, zero_division=0)
+    return {
+        "n": len(y),
+        "macro_f1": float(f1_score(y, pred, labels=classes, average="macro", zero_division=0)),
+        "macro_f1_told": (
+            float(f1_score(y[told], pred[told], labels=classes, average="macro", zero_division=0))
+            if told.any()
+            else None
+        ),
+        "accuracy": float(np.mean(y == pred)),
+        "cannot_tell_fraction": float(np.mean(~told)),
+        "f1_by_class": {c: float(f) for c, f in zip(classes, per_class)},
+        "confusion": {
+            "true": classes,
+            "predicted": columns,
+            "matrix": confusion_matrix(y, pred, labels=columns)[: len(classes)].tolist(),
+        },
+    }
+
+
+def sensitivity_table(records: pd.DataFrame, columns: list[str], bins: int = 3) -> list[dict]:
+    """Clearance bias, MAE and coverage by thirds (``bins``) of each varied column's range:
+    how the estimate shifts across a chain element's documented range."""
+    out = []
+    for name in columns:
+        if name not in records or records[name].nunique() < bins:
+            continue
+        edges = np.linspace(records[name].min(), records[name].max(), bins + 1)
+        which = np.clip(np.digitize(records[name], edges[1:-1]), 0, bins - 1)
+        for b in range(bins):
+            part = records[which == b]
+            stats = clearance_report(part) if len(part) else {}
+            out.append(
+                {
+                    "parameter": name,
+                    "low": float(edges[b]),
+                    "high": float(edges[b + 1]),
+                    "n": len(part),
+                    "bias": stats.get("bias"),
+                    "mae": stats.get("mae"),
+                    "coverage": stats.get("coverage"),
+                }
+            )
+    return out

@@ -159,3 +159,103 @@ def plot_diagnosis(result, path: str | Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_evaluation(report: dict, records, directory: str | Path) -> list[Path]:
+    """Figures of :func:`prsm_health.evaluation.evaluate_model` as PNGs in ``directory``:
+
+    - ``clearance.png``: predicted vs true clearance with the 90 % intervals (grey where the
+      diagnosis called the clearance not observable);
+    - ``calibration.png``: reliability of the class probabilities (top probability in bins vs
+      the share of those runs whose class was right), runs given a class only;
+    - ``confusion.png``: the confusion matrix, ``cannot_tell`` as its own column.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    if "clearance" in report:
+        fig, ax = plt.subplots(figsize=(6, 6))
+        y = 1e6 * records["clearance"].to_numpy(float)
+        est = 1e6 * records["estimate"].to_numpy(float)
+        lo, hi = 1e6 * records["lower"].to_numpy(float), 1e6 * records["upper"].to_numpy(float)
+        seen = records["clearance_observable"].to_numpy(bool)
+        for mask, colour, label in ((seen, "tab:blue", "observable"), (~seen, "0.6", "not")):
+            if mask.any():
+                ax.errorbar(
+                    y[mask],
+                    est[mask],
+                    yerr=[est[mask] - lo[mask], hi[mask] - est[mask]],
+                    fmt="o",
+                    ms=3,
+                    color=colour,
+                    ecolor=colour,
+                    alpha=0.5,
+                    label=f"{label} (90 % interval)",
+                )
+        top = float(np.nanmax(np.concatenate([y, hi]))) if len(y) else 1.0
+        ax.plot([0, top], [0, top], "k--", lw=1, label="ideal")
+        c = report["clearance"]
+        ax.set_title(
+            f"MAE {_um_text(c['mae'])} µm, coverage {_fraction_text(c['coverage'])} (n = {c['n']})"
+        )
+        ax.set_xlabel("true clearance [µm]")
+        ax.set_ylabel("estimated clearance [µm]")
+        ax.legend(loc="upper left")
+        written.append(_save(fig, out / "clearance.png"))
+    if "fault" in report:
+        told = records[records["fault_observable"]]
+        fig, ax = plt.subplots(figsize=(6, 5))
+        edges = np.linspace(0.0, 1.0, 11)
+        right = (told["predicted_class"] == told["fault_class"]).to_numpy(float)
+        conf = told["top_probability"].to_numpy(float)
+        which = np.clip(np.digitize(conf, edges[1:-1]), 0, 9)
+        centres = [conf[which == b].mean() for b in range(10) if np.any(which == b)]
+        shares = [right[which == b].mean() for b in range(10) if np.any(which == b)]
+        ax.plot([0, 1], [0, 1], "k--", lw=1, label="perfectly calibrated")
+        ax.plot(centres, shares, "o-", label="model")
+        ax.set_xlabel("top class probability")
+        ax.set_ylabel("share correct")
+        ax.set_title(f"class calibration ({len(told)} runs given a class)")
+        ax.legend(loc="upper left")
+        written.append(_save(fig, out / "calibration.png"))
+        cm = report["fault"]["confusion"]
+        matrix = np.asarray(cm["matrix"], float)
+        fig, ax = plt.subplots(
+            figsize=(1.0 + 0.8 * len(cm["predicted"]), 1.0 + 0.7 * len(cm["true"]))
+        )
+        ax.imshow(matrix, cmap="Blues")
+        for i in range(matrix.shape[0]):
+            for j in range(matrix.shape[1]):
+                ax.text(j, i, int(matrix[i, j]), ha="center", va="center", fontsize=8)
+        ax.set_xticks(range(len(cm["predicted"])), cm["predicted"], rotation=45, ha="right")
+        ax.set_yticks(range(len(cm["true"])), cm["true"])
+        ax.set_xlabel("predicted")
+        ax.set_ylabel("true")
+        f = report["fault"]
+        ax.set_title(
+            f"macro-F1 {f['macro_f1']:.2f} (given a class: {_fraction_text(f['macro_f1_told'])})"
+        )
+        written.append(_save(fig, out / "confusion.png"))
+    return written
+
+
+def _um_text(value) -> str:
+    return "–" if value is None else f"{1e6 * value:.2f}"
+
+
+def _fraction_text(value) -> str:
+    return "–" if value is None else f"{value:.2f}"
+
+
+def _save(fig, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -113,6 +113,34 @@ def test_regime_gate_reports_the_trained_range_without_reversal(model, reversing
     assert steady["indicators"]["lost_motion"] is None
     span = bundle.metadata["clearance_range"]
     assert [steady["clearance"]["lower"], steady["clearance"]["upper"]] == pytest.approx(span)
+    # no class either (the wear classes differ by clearance), and a sentence saying why
+    assert steady["fault_class"] == "cannot_tell"
+    assert steady["observability"] == {"clearance": 0.0, "fault": 0.0}
+    assert any("no load or motion reversal" in w for w in steady["warnings"])
+    reversing = diagnose(reversing_run(26e-6), bundle).to_json()
+    assert reversing["observability"]["clearance"] == 1.0
+    assert reversing["indicator_groups"]["lost_motion"] == "computed"
+
+
+def test_evaluate_cli(model, tmp_path, capsys):
+    dataset = model[0].parent / "ds"
+    argv = ["evaluate", str(model[0]), str(dataset), "--json", "--plot", str(tmp_path / "f")]
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    test_runs = int((pd.read_parquet(dataset / "runs.parquet")["split"] == "test").sum())
+    assert report["runs"] == test_runs
+    c = report["clearance"]
+    assert 0 <= c["coverage"] <= 1 and c["mae"] > 0 and c["observable"]["n"] <= test_runs
+    matrix = np.array(report["fault"]["confusion"]["matrix"])
+    assert matrix.sum() == test_runs
+    for name in ("clearance.png", "calibration.png", "confusion.png"):
+        assert (tmp_path / "f" / name).read_bytes()[:4] == b"\x89PNG"
+    # the same numbers as the training's held-out metrics where no gate intervened
+    metrics = json.loads(model[0].with_name("model.metrics.json").read_text())
+    if c["observable_fraction"] == 1.0 and report["ood"]["flagged_fraction"] == 0.0:
+        assert c["mae"] == pytest.approx(metrics["clearance_test"]["mae"], rel=1e-9)
+    assert main(["evaluate", str(model[0]), str(tmp_path / "nowhere")]) == 2
+    assert capsys.readouterr().err.startswith("error: ")
 
 
 def test_sources_mcap_parquet_csv_agree(model, tmp_path, reversing_run):
