@@ -671,9 +671,10 @@ class DistributionGuard(BaseEstimator):
             q75, q25 = np.nanpercentile(X, [75, 25], axis=0)
             spread = np.nan_to_num((q75 - q25) / 1.349)
             fallback = np.nan_to_num(np.nanstd(X, axis=0))
-        # a constant column (IQR 0): its standard deviation, else 1 (any change is then large)
-        spread = np.where(spread > 0, spread, np.where(fallback > 0, fallback, 1.0))
-        self.scale_ = spread
+        # a constant column (IQR 0): its standard deviation; never below 0.1 % of its level, so
+        # a column constant in training up to rounding does not make every change infinite
+        spread = np.where(spread > 0, spread, fallback)
+        self.scale_ = np.maximum(spread, 1e-3 * np.maximum(np.abs(self.center_), 1e-9))
         self.reference_ = self._scaled(X)
         raw = self._raw(self.reference_, leave_out_self=True)
         self.threshold_ = float(np.quantile(raw, self.quantile))
