@@ -43,8 +43,10 @@ from scipy.ndimage import uniform_filter1d
 
 from .channels import CHANNEL_NAMES, VIBRATION
 from .design import PRSMDesign, preset
+from .envelope_analysis import defect_lines
 from .errors import PRSMHealthError
-from .kinematics import speed_ratios
+from .gear_indicators import GEAR_INDICATORS, gear_indicators
+from .kinematics import defect_frequencies, speed_ratios
 from .run import MIN_SAMPLES, Run, ms_hint
 from .spectra import amplitude_spectrum, dominant_frequency
 
@@ -56,6 +58,23 @@ SHORT = {
 }
 BANDS = ((50.0, 300.0), (300.0, 1000.0), (1000.0, 3000.0), (3000.0, 10000.0))
 MESH_CHANNELS = ("nut_tangential_accel", "nut_radial_x_accel")
+#: Channels averaged synchronously (TSA) and the periods averaged over: a carrier revolution
+#: (the ring gear meshes z_ring times in it) and a roller spin relative to the carrier (its gear
+#: meshes z_roller times) — both non-integer numbers of screw turns (docs/gear-indicators.md).
+TSA_CHANNELS = ("nut_axial_accel", "nut_tangential_accel")
+TSA_PERIODS = ("carrier", "roller")
+TSA_INDICATORS = tuple(n for n in GEAR_INDICATORS if n != "periods")
+#: Channels whose envelope is read at the defect frequencies (docs/envelope-analysis.md), and the
+#: defect locations (prsm_health.kinematics.defect_frequencies).
+ENVELOPE_CHANNELS = ("nut_axial_accel", "nut_tangential_accel")
+DEFECTS = (
+    "screw_flank",
+    "nut_flank",
+    "roller_flank",
+    "ring_gear_tooth",
+    "roller_gear_tooth",
+    "carrier",
+)
 ORDER_TRACKING_SPREAD = 0.05
 
 
@@ -74,6 +93,19 @@ def _feature_table() -> dict[str, str]:
         for k in (1, 2, 3):
             units[f"{s}_mesh_h{k}"] = "m/s²"
         units[f"{s}_mesh_sidebands"] = "m/s²"
+    for ch in ENVELOPE_CHANNELS:
+        s = SHORT[ch]
+        units[f"{s}_sk_max"] = "-"
+        units[f"{s}_sk_band_centre"] = "Hz"
+        for defect in DEFECTS:
+            units[f"{s}_env_{defect}"] = "m/s²"
+            units[f"{s}_env_{defect}_ratio"] = "-"
+            units[f"{s}_env_{defect}_ratio_sum"] = "-"
+    for ch in TSA_CHANNELS:
+        for period in TSA_PERIODS:
+            for name in TSA_INDICATORS:
+                unit = "m/s²" if name in ("tsa_rms", "sideband_index") else "-"
+                units[f"{SHORT[ch]}_tsa_{period}_{name}"] = unit
     units.update(
         {
             "mesh_frequency": "Hz",
@@ -111,7 +143,14 @@ TRUTH_FEATURES: dict[str, dict[str, str]] = {
 GROUPS = {
     "mesh": [k for k in FEATURES if "_mesh_" in k] + ["mesh_frequency"],
     "axial_frequency": [k for k in FEATURES if k.startswith("axial_")],
-    "classic": [k for k in FEATURES if k.split("_")[0] in SHORT.values() and "_mesh_" not in k],
+    "classic": [
+        k
+        for k in FEATURES
+        if k.split("_")[0] in SHORT.values()
+        and not any(tag in k for tag in ("_mesh_", "_tsa_", "_env_", "_sk_"))
+    ],
+    "gear": [k for k in FEATURES if "_tsa_" in k],
+    "envelope": [k for k in FEATURES if "_env_" in k or "_sk_" in k],
     "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
     "lost_motion": ["lost_motion"],
     "torque_rattle": ["torque_rattle_rate"],
@@ -141,6 +180,8 @@ GROUP_CHANNELS: dict[str, Needs] = {
     "mesh": Needs(("screw_speed",), MESH_CHANNELS),
     "axial_frequency": Needs(("nut_axial_accel",)),
     "classic": Needs(any_of=VIBRATION),
+    "gear": Needs(("screw_angle",), TSA_CHANNELS),
+    "envelope": Needs(("screw_speed",), ENVELOPE_CHANNELS),
     "torque": Needs(("drive_torque",)),
     "lost_motion": Needs(("nut_position", "screw_angle")),
     "torque_rattle": Needs(("drive_torque",)),
@@ -337,6 +378,14 @@ def extract_features(
                 [_line(orders, amp, base - side), _line(orders, amp, base + side)]
             )
 
+    # ---- time-synchronous averages and the gear indicators (docs/gear-indicators.md)
+    if "screw_angle" in ch:
+        _gear(ch, design, ratios, out)
+
+    # ---- envelope lines at the defect frequencies, band by spectral kurtosis
+    if speed is not None and abs(float(np.mean(speed))) > 0:
+        _envelope(ch, rate, defect_frequencies(design, float(np.mean(speed))), out)
+
     # ---- shifted axial frequency
     if "nut_axial_accel" in ch:
         x = ch["nut_axial_accel"]
@@ -396,6 +445,40 @@ def extract_features(
                 ch["nut_position"], ch["screw_angle"], ratios.nut, side
             )
     return out
+
+
+def _envelope(ch: dict, rate: float, frequencies: dict, out: dict) -> None:
+    names = {k: v for k, v in frequencies.items() if k in DEFECTS}
+    for name in ENVELOPE_CHANNELS:
+        if name not in ch:
+            continue
+        s = SHORT[name]
+        try:
+            result = defect_lines(ch[name], rate, names)
+        except PRSMHealthError:  # no band fits (low sample rate, very short window)
+            continue
+        out[f"{s}_sk_max"] = result["sk"]
+        out[f"{s}_sk_band_centre"] = 0.5 * sum(result["band"])
+        for defect, line in result["lines"].items():
+            out[f"{s}_env_{defect}"] = line["amplitude"]
+            out[f"{s}_env_{defect}_ratio"] = line["ratio"]
+            out[f"{s}_env_{defect}_ratio_sum"] = line["ratio_sum"]
+
+
+def _gear(ch: dict, design: PRSMDesign, ratios, out: dict) -> None:
+    periods = {"carrier": (ratios.carrier, None), "roller": (ratios.roller_spin_relative, None)}
+    if design.gear is not None and design.variant != "recirculating":
+        periods = {
+            "carrier": (ratios.carrier, design.gear.ring_teeth),
+            "roller": (ratios.roller_spin_relative, design.gear.roller_teeth),
+        }
+    for name in TSA_CHANNELS:
+        if name not in ch:
+            continue
+        for period, (ratio, teeth) in periods.items():
+            values = gear_indicators(ch[name], ch["screw_angle"], 2 * math.pi / abs(ratio), teeth)
+            for key in TSA_INDICATORS:
+                out[f"{SHORT[name]}_tsa_{period}_{key}"] = values[key]
 
 
 def _lost_motion(position: np.ndarray, angle: np.ndarray, lead: float, side: np.ndarray) -> float:

@@ -31,6 +31,8 @@ LAYERS = {
     "sensors": 1,
     "instrumentation": 1,
     "spectra": 1,
+    "gear_indicators": 1,
+    "envelope_analysis": 1,
     "dynamics": 2,
     "scenario": 2,
     "io": 3,
