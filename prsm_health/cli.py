@@ -407,6 +407,33 @@ def _cmd_diagnose(args) -> int:
     return 0
 
 
+def _cmd_import(args) -> int:
+    from .io.importer import import_recordings
+
+    summary = import_recordings(
+        args.recordings,
+        args.labels,
+        args.map,
+        args.out,
+        test_fraction=args.test_fraction,
+        seed=args.seed,
+        overwrite=args.overwrite,
+    )
+    if args.json:
+        _print_json(summary)
+        return 0
+    _print_table(
+        [
+            ("dataset", summary["out"], ""),
+            ("runs", f"{summary['runs']} ({summary['train']} train, {summary['test']} test)", ""),
+            ("channels", ", ".join(summary["channels"]), ""),
+            ("sample rate", summary["sample_rate"], "Hz"),
+            ("classes", ", ".join(summary["classes"]) or "–", ""),
+        ]
+    )
+    return 0
+
+
 def _cmd_evaluate(args) -> int:
     from .dataset import Dataset
     from .diagnosis import load_bundle
@@ -785,6 +812,30 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_json(g, "the generation report")
     g.set_defaults(func=_cmd_generate)
+
+    i = command("import", "turn your rig's recordings and a labels table into a dataset")
+    i.add_argument("recordings", nargs="+", help="recordings: .csv, .parquet or .mcap files")
+    i.add_argument(
+        "--labels",
+        required=True,
+        help="CSV: a 'recording' column (file names) and label columns (fault_class, clearance [m], …)",
+    )
+    i.add_argument(
+        "--map",
+        required=True,
+        help="TOML: [columns] channel → file column, [units] column → unit, sample_rate, design",
+    )
+    i.add_argument("--out", required=True, help="dataset directory to create")
+    i.add_argument(
+        "--test-fraction",
+        type=_finite_float,
+        default=0.25,
+        help="held-out share when the labels have no split column",
+    )
+    i.add_argument("--seed", type=int, default=0, help="seed of that split")
+    i.add_argument("--overwrite", action="store_true", help="replace an existing --out")
+    _add_json(i, "the summary")
+    i.set_defaults(func=_cmd_import)
 
     t = command("train", "train the clearance estimator and fault classifier on a dataset")
     t.add_argument("dataset", help="dataset directory (prsm-health generate)")

@@ -35,7 +35,7 @@ from .channels import MEASURED_TOPICS
 from .design import PRSMDesign
 from .design_files import load_design
 from .errors import PRSMHealthError
-from .features import FEATURES, extract_features, indicator_groups, windows
+from .features import FEATURES, NO_DESIGN, extract_features, indicator_groups, windows
 from .jsonable import finite_or_none
 from .run import MIN_SAMPLES, Run
 
@@ -70,10 +70,20 @@ class ModelBundle:
     feature_names: list[str]
     metadata: dict
     guard: object | None = None
-    design: PRSMDesign = field(init=False)
+    design: PRSMDesign | None = field(init=False)
 
     def __post_init__(self):
-        self.design = load_design(self.metadata.get("design", "paper01"))
+        # None: a model trained on an imported rig that is not a PRSM (no design)
+        design = self.metadata.get("design", "paper01")
+        self.design = None if design is None else load_design(design)
+
+    @property
+    def design_name(self) -> str:
+        return self.design.name if self.design is not None else NO_DESIGN
+
+    def indicators(self, run: Run) -> dict:
+        """The indicators of one window, as this model was trained to read them."""
+        return extract_features(run, self.design or NO_DESIGN, lead=self.metadata.get("lead"))
 
     @property
     def name(self) -> str:
@@ -98,7 +108,7 @@ class ModelBundle:
 
     def reference(self) -> dict:
         """The ``model`` entry of a diagnosis."""
-        return {"name": self.name, "version": self.version, "design": self.design.name}
+        return {"name": self.name, "version": self.version, "design": self.design_name}
 
     def missing_channels(self, channels) -> list[str]:
         """The channels the model was trained with that a recording lacks."""
@@ -255,9 +265,9 @@ def _window_gates(row: dict, channels, bundle: ModelBundle, ood: float, design) 
                     f"recording outside the trained {REGIME_WORDS.get(name, name)} range: "
                     f"{value:.4g} vs {lo:.4g} … {hi:.4g} {FEATURES[name]}"
                 )
-    if design is not None and design != bundle.design.name:
+    if design is not None and design != bundle.design_name:
         notes.append(
-            f"recording of design {design!r}, model trained on {bundle.design.name!r}: its "
+            f"recording of design {design!r}, model trained on {bundle.design_name!r}: its "
             "indicators mean something else"
         )
     ood_high = np.isfinite(ood) and ood > OOD_LIMIT
@@ -381,7 +391,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
 
 def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:
     """Diagnosis of one window (a :class:`Run` of about the model's window length)."""
-    row = extract_features(run, bundle.design)
+    row = bundle.indicators(run)
     return diagnose_indicators([row], bundle, [tuple(run.channels)], run.labels.get("design"))[0]
 
 
@@ -427,7 +437,7 @@ def diagnose(
     bundle = bundle or load_bundle()
     run = run.without_truth().validate()
     parts, notes = split_windows(run, window or bundle.window)
-    rows = [extract_features(part, bundle.design) for part in parts]
+    rows = [bundle.indicators(part) for part in parts]
     per_window = diagnose_indicators(
         rows, bundle, [tuple(run.channels)] * len(rows), run.labels.get("design")
     )

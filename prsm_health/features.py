@@ -76,6 +76,8 @@ DEFECTS = (
     "carrier",
 )
 ORDER_TRACKING_SPREAD = 0.05
+#: The design of a rig that is not a PRSM (imported recordings): no design-dependent indicators.
+NO_DESIGN = "none"
 
 
 def _feature_table() -> dict[str, str]:
@@ -279,7 +281,11 @@ def _truth_request(run: Run, truth) -> tuple[str, ...]:
 
 
 def extract_features(
-    run: Run, design: PRSMDesign | str | None = None, *, truth: tuple[str, ...] = ()
+    run: Run,
+    design: PRSMDesign | str | None = None,
+    *,
+    truth: tuple[str, ...] = (),
+    lead: float | None = None,
 ) -> dict[str, float]:
     """All indicators of one run or window.
 
@@ -288,8 +294,12 @@ def extract_features(
     run : Run
         Measured channels at ``run.sample_rate``; missing channels give NaN indicators.
         ``run.truth`` is not read unless named in ``truth``.
-    design : PRSMDesign, preset name or None
-        Default: the run's ``labels["design"]``, else paper01.
+    design : PRSMDesign, preset name, :data:`NO_DESIGN` or None
+        Default: the run's ``labels["design"]``, else paper01. :data:`NO_DESIGN` (or a run
+        labelled ``design = None``, an imported rig that is not a PRSM): the indicators that
+        need the design's kinematics (mesh, gear, envelope, axial baseline) are NaN.
+    lead : float or None [m per revolution of screw_angle]
+        Without a design, the lead lost motion needs (default the run's ``labels["lead"]``).
     truth : tuple of str
         Truth signals to use (keys of :data:`TRUTH_FEATURES`), research only: each adds its
         indicators; ``"carrier_speed"`` locates the mesh lines from the true carrier speed.
@@ -322,7 +332,11 @@ def extract_features(
         )
     if design is None:
         design = run.labels.get("design", "paper01")
-    design = preset(design) if isinstance(design, str) else design
+    if design is None or design == NO_DESIGN:
+        design = None
+        lead = lead if lead is not None else run.labels.get("lead")
+    elif isinstance(design, str):
+        design = preset(design)
     rate = run.sample_rate
     out = dict.fromkeys(FEATURES, np.nan)
     for name in truth:
@@ -335,7 +349,9 @@ def extract_features(
 
     speed = ch.get("screw_speed")
     load = ch.get("axial_load")
-    ratios = speed_ratios(design)
+    ratios = speed_ratios(design) if design is not None else None
+    # nut travel per screw radian: the design's kinematics, or the rig's lead
+    nut_per_rad = ratios.nut if ratios is not None else (lead / (2 * math.pi) if lead else None)
     if speed is not None:
         out["speed_mean"] = float(np.mean(speed))
     if load is not None:
@@ -346,10 +362,10 @@ def extract_features(
     if "carrier_speed" in run.truth:
         f_c = abs(float(np.mean(run.truth["carrier_speed"]))) / (2 * math.pi)
     elif speed is not None:
-        f_c = abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi)
+        f_c = abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi) if ratios else np.nan
     else:
         f_c = np.nan
-    if design.gear is not None and np.isfinite(f_c) and f_c > 0:
+    if design is not None and design.gear is not None and np.isfinite(f_c) and f_c > 0:
         z = design.gear.ring_teeth
         out["mesh_frequency"] = z * f_c
         varying = speed is not None and np.std(speed) > ORDER_TRACKING_SPREAD * abs(np.mean(speed))
@@ -379,11 +395,11 @@ def extract_features(
             )
 
     # ---- time-synchronous averages and the gear indicators (docs/gear-indicators.md)
-    if "screw_angle" in ch:
+    if "screw_angle" in ch and design is not None:
         _gear(ch, design, ratios, out)
 
     # ---- envelope lines at the defect frequencies, band by spectral kurtosis
-    if speed is not None and abs(float(np.mean(speed))) > 0:
+    if design is not None and speed is not None and abs(float(np.mean(speed))) > 0:
         _envelope(ch, rate, defect_frequencies(design, float(np.mean(speed))), out)
 
     # ---- shifted axial frequency
@@ -400,7 +416,7 @@ def extract_features(
             float(np.sqrt(np.sum(psd[band]) * (f[1] - f[0]))) if band.any() else np.nan
         )
         mean_load = abs(out["load_mean"]) if np.isfinite(out["load_mean"]) else 100.0
-        if design.gear is not None:
+        if design is not None and design.gear is not None:
             f0 = axial_baseline_frequency(design, round(mean_load, 1))
             out["axial_baseline_frequency"] = f0
             out["axial_frequency_shift"] = f_dom - f0
@@ -434,7 +450,7 @@ def extract_features(
     if reversal and torque is not None:
         out["torque_rattle_rate"] = _rattle_rate(torque, rate)
     # lost motion: nut lag behind the rigid kinematics across a reversal
-    if "nut_position" in ch and "screw_angle" in ch:
+    if "nut_position" in ch and "screw_angle" in ch and nut_per_rad is not None:
         if reversal:
             if speed is not None and np.min(speed) < 0 < np.max(speed):
                 side = np.sign(speed)
@@ -442,7 +458,7 @@ def extract_features(
                 force = load if load is not None else slow_torque
                 side = np.sign(force - 0.5 * (np.max(force) + np.min(force)))
             out["lost_motion"] = _lost_motion(
-                ch["nut_position"], ch["screw_angle"], ratios.nut, side
+                ch["nut_position"], ch["screw_angle"], nut_per_rad, side
             )
     return out
 

@@ -543,6 +543,8 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         "name": name or f"{ds.manifest['name']}-model",
         "model_version": "1",
         "design": ds.manifest["recipe"]["design"],
+        # a rig without a PRSM design: the lead its lost motion was read with
+        "lead": (ds.manifest["recipe"].get("map") or {}).get("lead"),
         "window": float(ds.manifest["duration"]),
         "sample_rate": float(ds.manifest["sample_rate"]),
         "trained_on": {

@@ -12,7 +12,7 @@ import time
 
 from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
 from prsm_health.diagnosis import diagnose_indicators, load_bundle
-from prsm_health.features import extract_features, windows
+from prsm_health.features import windows
 
 AXES = ("axial", "tangential", "radial_x", "radial_y")
 
@@ -40,11 +40,9 @@ def main() -> None:
     )
     parts = list(windows(run, 1.0))
     bundle = load_bundle()
-    diagnose_indicators(
-        [extract_features(parts[0], bundle.design)], bundle
-    )  # warm-up (thread pools)
+    diagnose_indicators([bundle.indicators(parts[0])], bundle)  # warm-up (thread pools)
     t0 = time.perf_counter()
-    rows = [extract_features(p, bundle.design) for p in parts]
+    rows = [bundle.indicators(p) for p in parts]
     t_features = time.perf_counter() - t0
     t0 = time.perf_counter()
     for row in rows:

@@ -74,15 +74,15 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     if len(set(lengths.values())) > 1:
         described = ", ".join(f"{k} {v}" for k, v in lengths.items())
         raise HTTPError(422, f"channels must have equal lengths; got {described}")
-    if req.design is not None and req.design != bundle.design.name:
+    if req.design is not None and req.design != bundle.design_name:
         raise HTTPError(
             422,
             f"design = {req.design!r}: model {bundle.name!r} was trained on design "
-            f"{bundle.design.name!r}; load a model for {req.design!r} (prsm-health serve --model)",
+            f"{bundle.design_name!r}; load a model for {req.design!r} (prsm-health serve --model)",
         )
     n = next(iter(lengths.values()))
     rate = float(req.sample_rate)  # range checked by the request's validation
-    labels = {"design": bundle.design.name}
+    labels = {"design": bundle.design_name}
     if req.speed is not None:
         labels["screw_speed"] = float(req.speed)
     if req.load is not None:

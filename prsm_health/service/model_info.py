@@ -16,7 +16,7 @@ def model_info(bundle, model_file: Path | None) -> dict:
             "name": bundle.name,
             "version": bundle.version,
             "window": bundle.window,
-            "design": bundle.design.name,
+            "design": bundle.design_name,
             "sample_rate": bundle.metadata.get("sample_rate"),
             "feature_names": list(bundle.feature_names),
             "classes": [str(c) for c in getattr(bundle.fault, "classes_", [])],
