@@ -98,9 +98,16 @@ class WindowRef(BaseModel):
 
 class WindowDiagnosis(BaseModel):
     clearance: Clearance
-    fault_class: str | None
+    fault_class: str | None = Field(description="most probable class, or cannot_tell")
     class_probabilities: dict[str, float]
+    observability: dict[str, bool] = Field(
+        description="clearance, fault: whether the window lets the model see them"
+    )
+    ood_score: float | None = Field(
+        description="out-of-distribution score (1 = training 99th percentile; > 1.5 unlike it)"
+    )
     indicators: dict[str, float | None]
+    indicator_groups: dict[str, str] = Field(description="group → computed, or why not")
     model: ModelRef
     window: WindowRef
     warnings: list[str] = Field(description="sentences a person can act on")
@@ -110,12 +117,18 @@ class Diagnosis(BaseModel):
     """The Diagnosis contract (docs/service.md)."""
 
     clearance: Clearance
-    fault_class: str | None
+    fault_class: str | None = Field(description="most probable class, or cannot_tell")
     class_probabilities: dict[str, float]
+    observability: dict[str, float] = Field(
+        description="clearance, fault: fraction of the windows that let the model see them"
+    )
+    ood_score: float | None = Field(description="median out-of-distribution score of the windows")
     indicators: dict[str, float | None]
+    indicator_groups: dict[str, str] = Field(description="group → computed, or why not")
     model: ModelRef
     warnings: list[str] = Field(
-        description="sentences a person can act on, e.g. a recording tail left undiagnosed"
+        description="sentences a person can act on: why a target is not observable, a missing "
+        "channel, a recording outside the trained range, a tail left undiagnosed"
     )
     windows: list[WindowDiagnosis] | None = Field(
         None, description="per-window diagnoses, present when there is more than one window"
