@@ -790,6 +790,17 @@ def _run_dask(scheduler, recipe, out, formats, pending, finished) -> None:
             client.close()
 
 
+def dataset_counts(frame) -> dict:
+    """The manifest's ``counts`` of a labels table: runs, train, test, runs per fault class."""
+    classes = frame["fault_class"].value_counts().sort_index() if "fault_class" in frame else {}
+    return {
+        "runs": len(frame),
+        "train": int((frame["split"] == "train").sum()),
+        "test": int((frame["split"] == "test").sum()),
+        "fault_class": {k: int(v) for k, v in dict(classes).items()},
+    }
+
+
 def _atomic_write(path: Path, text: str) -> None:
     tmp = path.with_name(path.name + ".partial")
     tmp.write_text(text)
@@ -830,14 +841,7 @@ def _finalise(out: Path, recipe: Recipe, formats: str) -> None:
             "thresholds": recipe.faults.as_dict(),
             "rule": FaultThresholds.__doc__.split("\n\n")[1].strip().replace("\n    ", " "),
         },
-        "counts": {
-            "runs": len(frame),
-            "train": int((frame["split"] == "train").sum()),
-            "test": int((frame["split"] == "test").sum()),
-            "fault_class": {
-                k: int(v) for k, v in frame["fault_class"].value_counts().sort_index().items()
-            },
-        },
+        "counts": dataset_counts(frame),
     }
     _atomic_write(out / "manifest.json", dumps(manifest, indent=2))
 

@@ -337,6 +337,7 @@ def import_recordings(
     import pyarrow.parquet as pq
 
     from .. import __version__
+    from ..dataset import dataset_counts
     from ..faults import FAULT_CLASSES
 
     out = Path(out)
@@ -438,16 +439,7 @@ def import_recordings(
                 "thresholds": None,
                 "rule": "labels given by the user (imported)",
             },
-            "counts": {
-                "runs": len(frame),
-                "train": int((frame["split"] == "train").sum()),
-                "test": int((frame["split"] == "test").sum()),
-                "fault_class": {
-                    k: int(v) for k, v in frame["fault_class"].value_counts().sort_index().items()
-                }
-                if "fault_class" in frame
-                else {},
-            },
+            "counts": dataset_counts(frame),
         }
         (tmp / "manifest.json").write_text(dumps(manifest, indent=2))
         if out.exists():
