@@ -341,8 +341,17 @@ Fault class (drop of accuracy):
   diagnosis warns outside the trained speed and drive-torque ranges.
 - Clearance is not observable without a load or motion reversal (steady load holds each roller
   on one flank): the interval is the trained range and the class `cannot_tell`.
-- Gear tooth damage has no signature in these channels (docs/faults.md); spalls at these
-  loads barely do. Their F1 above says what the model makes of them.
+- **Faults this chain cannot tell apart.** Gear tooth damage has no signature in these
+  channels (docs/faults.md); spalls at default severity barely do at these loads, and the
+  impacts of the clearance at every reversal dominate the envelope; a lubricant's extra
+  friction is hidden in a drive torque dominated by an axial load no sensor measures (no load
+  cell on a flight EMA); a partial preload loss changes the play by a few µm, inside the
+  clearance's own spread. The per-class table above says what the model makes of them: only
+  wear and severe wear are seen (by the lost motion). The issue asked for a fault macro-F1 ≥ 0.9
+  at default severities; this instrumentation gives the value above, and no indicator we tried
+  (time-synchronous averages, envelope lines at the defect frequencies, spectral kurtosis)
+  changed that (ablation table). What would: a load cell, a tangential accelerometer, longer
+  windows at higher load (docs/faults.md).
 - Real recordings differ from the simulator (mounting, transfer paths, temperature): validate
   on measured data (`prsm-health import`, `prsm-health evaluate`) before trusting it.
 """
