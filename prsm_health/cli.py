@@ -399,6 +399,9 @@ def _cmd_diagnose(args) -> int:
     ]
     rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
     rows += [
+        ("clearance observable", result.observability.get("clearance"), "share of windows"),
+        ("class observable", result.observability.get("fault"), "share of windows"),
+        ("out-of-distribution score", result.ood_score, "> 1.5: unlike the training set"),
         ("windows", len(result.windows), ""),
         ("model", f"{result.model['name']} v{result.model['version']}", ""),
     ]
