@@ -12,6 +12,10 @@ its model card.
 4. checks the honesty gates: recordings of another design and another instrumentation (OOD
    flagged?), steady-load recordings and accelerometer-only recordings (no confident class?);
 5. writes models/MODEL_CARD.md from the measured numbers.
+
+``--instrumentation lab-rig`` (any other profile): the same recipe measured by that profile,
+trained and evaluated (held-out split, each class at default severity) into WORK, as an
+experiment on what an instrumentation can see; the shipped model is not touched.
 """
 
 from __future__ import annotations
@@ -357,6 +361,50 @@ Fault class (drop of accuracy):
 """
 
 
+def experiment(reference: Recipe, instrumentation: str, work: Path, args) -> int:
+    """The reference recipe measured by another instrumentation profile: train, then the
+    held-out split and each class at default severity through the diagnosis. Writes
+    WORK/<profile>.skops and WORK/<profile>.metrics.json; the shipped model is not touched."""
+    import pandas as pd
+
+    from prsm_health.evaluation import clearance_report, fault_report
+
+    source = dict(reference.source, instrumentation=instrumentation)
+    source["name"] = f"{reference.name}-{instrumentation}"
+    # the sensor sweeps name flight-ema's sensors; this profile keeps its own figures
+    source["sweep"] = {
+        k: v for k, v in reference.sweep.items() if not k.startswith("instrumentation.")
+    }
+    other = Recipe.from_dict(source)
+    generate(other, work / other.name, workers=args.workers)
+    model_path = work / f"{instrumentation}.skops"
+    metrics = train(work / other.name, model_path, name=f"prsm-{instrumentation}", cv=3)
+    bundle = load_bundle(model_path)
+    held_out, _ = evaluate_model(bundle, Dataset(work / other.name))
+    parts = []
+    for recipe in default_severity_recipes(other, args.per_class).values():
+        generate(recipe, work / recipe.name, workers=args.workers)
+        parts.append(evaluate_model(bundle, Dataset(work / recipe.name), split="all")[1])
+    pooled = pd.concat(parts, ignore_index=True)
+    result = {
+        "instrumentation": instrumentation,
+        "channels": list(bundle.channels),
+        "indicators": len(bundle.feature_names),
+        "held_out": held_out,
+        "default_severity": {
+            "per_class": args.per_class,
+            "fault": fault_report(pooled),
+            "clearance": clearance_report(pooled),
+        },
+        "fault_importance": metrics.get("fault_importance"),
+    }
+    path = work / f"{instrumentation}.metrics.json"
+    path.write_text(json.dumps(result, indent=2, default=float))
+    print(json.dumps({k: result[k] for k in ("held_out", "default_severity")}, indent=2))
+    print(f"metrics {path}")
+    return 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser()
     parser.add_argument("--workers", type=int, default=None)
@@ -365,11 +413,18 @@ def main() -> int:
     parser.add_argument(
         "--per-class", type=int, default=30, help="runs per class at default severity"
     )
+    parser.add_argument(
+        "--instrumentation",
+        default="flight-ema",
+        help="another profile (e.g. lab-rig): an experiment with metrics in WORK, no card",
+    )
     args = parser.parse_args()
     work = Path(args.work)
     work.mkdir(parents=True, exist_ok=True)
     MODELS.mkdir(exist_ok=True)
     reference = load_recipe(ROOT / "datasets" / f"{REFERENCE}.toml")
+    if args.instrumentation != "flight-ema":
+        return experiment(reference, args.instrumentation, work, args)
     generate(reference, work / REFERENCE, workers=args.workers)
     model_path = MODELS / "default.skops"
     metrics = train(work / REFERENCE, model_path, name="prsm-default-flight-ema", cv=3)
