@@ -276,6 +276,10 @@ Off-grid: clearance observable in {_f(ogc["observable_fraction"], 2)} of the run
 distribution {_f(og["ood"]["flagged_fraction"], 3)}; `cannot_tell` {_f(ogf["cannot_tell_fraction"], 3)};
 macro-F1 of the runs given a class {_f(ogf["macro_f1_told"])}.
 
+Figures of the off-grid set: [predicted vs true clearance](figures/clearance.png),
+[class calibration](figures/calibration.png) (the probabilities are cautious: the share correct
+lies above the top probability), [confusion matrix](figures/confusion.png).
+
 ### Each class at its default severity
 
 {metrics["default_severity"]["per_class"]} runs per class, on otherwise healthy units (clearance
@@ -433,6 +437,9 @@ def main() -> int:
     generate(off, work / off.name, workers=args.workers)
     report, records = evaluate_model(bundle, Dataset(work / off.name), split="all", progress=True)
     metrics["off_grid"] = report
+    from prsm_health.plots import plot_evaluation
+
+    plot_evaluation(report, records, MODELS / "figures")
     varied = [k for k in off.sweep if k not in ("mode", "samples", "repeats", "fault_case")]
     label_of = {"clearance": "clearance", "speed": "screw_speed", "load": "axial_load"}
     metrics["sensitivity"] = sensitivity_table(records, [label_of.get(k, k) for k in varied])
