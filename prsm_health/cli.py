@@ -391,6 +391,7 @@ def _cmd_diagnose(args) -> int:
     rows = [
         ("file", args.file, ""),
         ("fault class", result.fault_class, ""),
+        ("class set", ", ".join(result.class_set), "classes not ruled out"),
         (
             "clearance",
             f"{_um(c['estimate'])} [{_um(c['lower'])}, {_um(c['upper'])}]",

@@ -53,6 +53,8 @@ CANNOT_TELL = "cannot_tell"
 #: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
 OOD_LIMIT = 1.5
 #: Words for the operating indicators in warnings.
+#: How the warning of an ambiguous class set begins.
+_SET_NOTE = "fault class: one of "
 REGIME_WORDS = {
     "speed_mean": "speed",
     "load_mean": "mean load",
@@ -151,8 +153,13 @@ class Diagnosis:
     clearance : dict
         ``estimate``, ``lower``, ``upper`` [m] (90 % interval); None where not computable.
     fault_class : str or None
-        The most probable class.
+        The class, when the window shows the fault (``observability``) and the class set holds
+        only it; else ``cannot_tell``.
     class_probabilities : dict of class → probability
+    class_set : list of str
+        The classes the evidence cannot rule out (the model's conformal class set, 90 % by
+        default: :meth:`prsm_health.estimators.FaultClassifier.predict_set`); every class where
+        the fault is not observable.
     indicators : dict of name → value (None where not computable)
     model : dict
         ``name``, ``version``, ``design`` of the model bundle.
@@ -185,6 +192,7 @@ class Diagnosis:
     observability: dict = field(default_factory=dict)
     ood_score: float | None = None
     indicator_groups: dict = field(default_factory=dict)
+    class_set: list[str] = field(default_factory=list)
 
     def to_json(self) -> dict:
         """The Diagnosis contract as plain JSON values."""
@@ -192,6 +200,7 @@ class Diagnosis:
             "clearance": dict(self.clearance),
             "fault_class": self.fault_class,
             "class_probabilities": dict(self.class_probabilities),
+            "class_set": list(self.class_set),
             "observability": dict(self.observability),
             "ood_score": self.ood_score,
             "indicators": dict(self.indicators),
@@ -313,9 +322,7 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
     for i, row in enumerate(rows):
         clearance_ok, fault_ok, notes = gates[i]
         probabilities = {c: float(p) for c, p in zip(classes, proba[i])}
-        fault_class = None
-        if probabilities:
-            fault_class = max(probabilities, key=probabilities.get) if fault_ok else CANNOT_TELL
+        fault_class, class_set = _fault_answer(probabilities, fault_ok, bundle, notes)
         out.append(
             Diagnosis(
                 clearance={
@@ -325,6 +332,7 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
                 },
                 fault_class=fault_class,
                 class_probabilities=probabilities,
+                class_set=class_set,
                 indicators={k: finite_or_none(v) for k, v in row.items()},
                 model=bundle.reference(),
                 warnings=notes,
@@ -334,6 +342,40 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
             )
         )
     return out
+
+
+def _fault_answer(probabilities: dict, observable: bool, bundle: ModelBundle, notes: list):
+    """(fault class, class set) of class probabilities; a warning appended when the set holds
+    several classes. A single class only when the fault is observable and the set holds it
+    alone: where the instrumentation cannot tell classes apart, their held-out probabilities
+    overlap and the set holds them all."""
+    from .estimators import class_sets  # scikit-learn only when a model is used
+
+    if not probabilities:
+        return None, []
+    names = list(probabilities)
+    if not observable:
+        return CANNOT_TELL, names
+    thresholds = getattr(bundle.fault, "set_thresholds_", None)
+    if thresholds is None:  # a bundle saved before class sets: its most probable class
+        best = max(probabilities, key=probabilities.get)
+        return best, [best]
+    chosen = class_sets([list(probabilities.values())], thresholds)[0]
+    members = [c for c, keep in zip(names, chosen) if keep]
+    members.sort(key=probabilities.get, reverse=True)
+    if len(members) == 1:
+        return members[0], members
+    ruled_out = [c for c in names if c not in members]
+    notes.append(
+        f"{_SET_NOTE}{', '.join(members)}: cannot tell them apart (the model's "
+        f"{_set_coverage(bundle):.0%} class set holds them all)"
+        + (f"; ruled out: {', '.join(ruled_out)}" if ruled_out else "")
+    )
+    return CANNOT_TELL, members
+
+
+def _set_coverage(bundle: ModelBundle) -> float:
+    return float(getattr(bundle.fault, "set_coverage", 0.9))
 
 
 def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
@@ -352,17 +394,16 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
     for d in told or diagnoses:
         for c, p in d.class_probabilities.items():
             probs[c] = probs.get(c, 0.0) + p / len(told or diagnoses)
-    fault_class = None
-    if probs:
-        fault_class = max(probs, key=probs.get) if told else CANNOT_TELL
     counts: dict[str, int] = {}
     for d in diagnoses:
         for note in d.warnings:
-            counts[note] = counts.get(note, 0) + 1
+            if not note.startswith(_SET_NOTE):  # restated below for the mean probabilities
+                counts[note] = counts.get(note, 0) + 1
     notes = [
         note if k == len(diagnoses) else f"{note} (in {k} of {len(diagnoses)} windows)"
         for note, k in counts.items()
     ]
+    fault_class, class_set = _fault_answer(probs, bool(told), bundle, notes)
     names = diagnoses[0].indicators.keys()
     groups = {
         g: next(
@@ -376,6 +417,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         },
         fault_class=fault_class,
         class_probabilities=probs,
+        class_set=class_set,
         indicators={n: median([d.indicators[n] for d in diagnoses]) for n in names},
         model=bundle.reference(),
         windows=list(diagnoses),

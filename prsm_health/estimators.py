@@ -9,7 +9,8 @@ reversal), because gradient-boosted histogram trees route NaN to a learned side 
 - :class:`ClearanceEstimator`: conformalized quantile regression (CQR) of a clearance [m];
   the interval is wide where the operating regime hides the clearance and narrow where it
   reveals it.
-- :class:`FaultClassifier`: gradient boosting with Platt-calibrated class probabilities.
+- :class:`FaultClassifier`: gradient boosting with Platt-calibrated class probabilities and a
+  conformal class set (every class the evidence cannot rule out at a set coverage).
 
 Evaluation (permutation importance, cross-validated metrics) lives in
 :mod:`prsm_health.evaluation`; saving and loading in :mod:`prsm_health.persistence`.
@@ -21,6 +22,9 @@ References
 .. [2] A. Niculescu-Mizil, R. Caruana, "Predicting good probabilities with supervised
    learning", ICML 2005 (boosted trees need calibration; Platt scaling beats isotonic
    regression when the calibration set is small).
+.. [4] M. Sadinle, J. Lei, L. Wasserman, "Least ambiguous set-valued classifiers with bounded
+   error levels", JASA 114 (2019) 223-234 (the class set {y : p_y >= t}, t from the held-out
+   probabilities of the true classes, section 2 and eq. 4).
 """
 
 from __future__ import annotations
@@ -451,6 +455,9 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         Calibration method.
     calibration_cv : int, default 5
         Number of calibration folds (>= 2), reduced on small data.
+    set_coverage : float, default 0.9
+        Coverage of the class set (:meth:`predict_set`), in (0, 1): the share of held-out
+        samples whose true class the set should hold.
     random_state : int, RandomState or None, default 0
         Seeds the folds and the boosting models.
 
@@ -468,11 +475,30 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         Calibration folds used (0: uncalibrated).
     n_iter_ : int
         Largest number of boosting iterations run by the fold boosters.
+    set_thresholds_ : ndarray of shape (n_classes,)
+        Probability each class needs to enter the class set. From the calibration folds: each
+        sample's calibrated probabilities come from the fold model that did not train on it,
+        and a class's threshold is the conformal quantile of its own samples' probability of
+        it [2]_ (least ambiguous set-valued classifier with class-specific coverage). 0
+        without calibration folds (the set is then every class: nothing was held out to
+        measure the ambiguity on).
+
+    Notes
+    -----
+    The class set is what the evidence cannot rule out: where the features separate the
+    classes it holds one; where an instrumentation cannot tell two classes apart (their
+    held-out probabilities overlap) it mostly holds both, and a diagnosis should say "cannot
+    tell" rather than pick one. By construction a share ``1 − set_coverage`` of each class's
+    samples still gets a set without its class. The fold models are averaged in
+    :meth:`predict_proba`, which is somewhat sharper than a single fold model, so the
+    coverage is approximate (measured in the model card).
 
     References
     ----------
     .. [1] A. Niculescu-Mizil, R. Caruana, "Predicting good probabilities with supervised
        learning", ICML 2005, sections 3-4 and figure 6.
+    .. [2] M. Sadinle, J. Lei, L. Wasserman, "Least ambiguous set-valued classifiers with
+       bounded error levels", JASA 114 (2019), sections 2 and 4.1 (class-specific coverage).
     """
 
     def __init__(
@@ -485,6 +511,7 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         class_weight=None,
         calibration_method="sigmoid",
         calibration_cv=5,
+        set_coverage=0.9,
         random_state=0,
     ):
         self.max_iter = max_iter
@@ -495,6 +522,7 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         self.class_weight = class_weight
         self.calibration_method = calibration_method
         self.calibration_cv = calibration_cv
+        self.set_coverage = set_coverage
         self.random_state = random_state
 
     def __sklearn_tags__(self):
@@ -503,6 +531,7 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         return tags
 
     def _check_params(self) -> None:
+        require_range("set_coverage", self.set_coverage, 0.0, 1.0, inclusive=False)
         require(
             self.calibration_method in ("sigmoid", "isotonic"),
             "calibration_method",
@@ -569,6 +598,7 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
             ).fit(X, y_idx, sample_weight=sample_weight)
             self.calibration_folds_ = folds
             boosters = [c.estimator for c in self.model_.calibrated_classifiers_]
+            self.set_thresholds_ = self._set_thresholds(X, y_idx, cv)
         else:
             warnings.warn(
                 "FaultClassifier: a class has a single sample, so probabilities are not calibrated",
@@ -578,8 +608,48 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
             self.model_ = booster.fit(X, y_idx, sample_weight=sample_weight)
             self.calibration_folds_ = 0
             boosters = [self.model_]
+            self.set_thresholds_ = np.zeros(len(self.classes_))
         self.n_iter_ = max(int(b.n_iter_) for b in boosters)
         return self
+
+    def _set_thresholds(self, X, y_idx, cv) -> np.ndarray:
+        """Per-class conformal thresholds of the class set from the out-of-fold calibrated
+        probabilities.
+
+        ``calibrated_classifiers_`` follow ``cv.split`` (deterministic: shuffled with a fixed
+        seed), so fold ``k``'s model predicts exactly the samples it did not see."""
+        held_out = np.empty(len(y_idx))
+        for model, (_, test) in zip(self.model_.calibrated_classifiers_, cv.split(X, y_idx)):
+            proba = np.clip(model.predict_proba(X[test]), 0.0, 1.0)
+            proba /= proba.sum(axis=1, keepdims=True)
+            held_out[test] = proba[np.arange(len(test)), y_idx[test]]
+        # Sadinle et al. section 4.1 (class-specific coverage): per class, the
+        # floor((n_y + 1)·α)-th smallest held-out probability of that class among its own
+        # samples, so that a new sample of class y keeps y in its set with probability ≥
+        # set_coverage, whatever the class — a rare class is not sacrificed to a common one
+        thresholds = np.zeros(len(self.classes_))
+        for k in range(len(self.classes_)):
+            own = np.sort(held_out[y_idx == k])
+            rank = int(np.floor((len(own) + 1) * (1.0 - self.set_coverage)))
+            thresholds[k] = own[rank - 1] if rank >= 1 else 0.0
+        return thresholds
+
+    def predict_set(self, X):
+        """The class set: every class whose probability reaches its ``set_thresholds_``.
+
+        Parameters
+        ----------
+        X : array-like or DataFrame of shape (n_samples, n_features)
+            Features; NaN allowed.
+
+        Returns
+        -------
+        ndarray of bool, shape (n_samples, n_classes)
+            True where the class is in the set (columns follow ``classes_``); the most probable
+            class always is, so no set is empty.
+        """
+        proba = self.predict_proba(X)
+        return class_sets(proba, self.set_thresholds_)
 
     def predict_proba(self, X):
         """Class probabilities.
@@ -614,6 +684,16 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         """
         proba = self.predict_proba(X)
         return self.classes_[np.argmax(proba, axis=1)]
+
+
+def class_sets(proba, thresholds) -> np.ndarray:
+    """Boolean class sets of probability rows: ``p >= thresholds`` (one per class) plus each
+    row's most probable class (:meth:`FaultClassifier.predict_set`; also for averaged window
+    probabilities)."""
+    proba = np.atleast_2d(np.asarray(proba, float))
+    chosen = proba >= np.asarray(thresholds, float)
+    chosen[np.arange(len(proba)), np.argmax(proba, axis=1)] = True
+    return chosen
 
 
 # --------------------------------------------------------------------------------------------

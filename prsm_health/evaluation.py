@@ -356,6 +356,7 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
     records["lower"] = [_num(r.clearance["lower"]) for r in results]
     records["upper"] = [_num(r.clearance["upper"]) for r in results]
     records["predicted_class"] = [r.fault_class for r in results]
+    records["class_set"] = [list(r.class_set) for r in results]
     records["top_probability"] = [
         max(r.class_probabilities.values()) if r.class_probabilities else np.nan for r in results
     ]
@@ -421,14 +422,20 @@ def clearance_report(records: pd.DataFrame) -> dict:
 
 def fault_report(records: pd.DataFrame) -> dict:
     """Macro-F1 (``cannot_tell`` counted as a miss), macro-F1 of the runs given a class,
-    per-class F1, the confusion matrix (rows: true, columns: predicted incl. ``cannot_tell``)."""
+    per-class F1, the confusion matrix (rows: true, columns: predicted incl. ``cannot_tell``),
+    and the class sets: how often they hold the true class, their mean size, and per true
+    class the share of runs whose set holds each class."""
     from sklearn.metrics import confusion_matrix
+
+    from .diagnosis import CANNOT_TELL
 
     y = records["fault_class"].astype(str).to_numpy()
     pred = records["predicted_class"].astype(str).to_numpy()
     classes = sorted(set(y))
     columns = classes + sorted(set(pred) - set(classes))
-    told = records["fault_observable"].to_numpy(bool)
+    told = pred != CANNOT_TELL
+    sets = list(records["class_set"]) if "class_set" in records else [[p] for p in pred]
+    held = np.array([truth in s for truth, s in zip(y, sets)])
     per_class = f1_score(y, pred, labels=classes, average=None, zero_division=0)
     return {
         "n": len(y),
@@ -440,6 +447,15 @@ def fault_report(records: pd.DataFrame) -> dict:
         ),
         "accuracy": float(np.mean(y == pred)),
         "cannot_tell_fraction": float(np.mean(~told)),
+        "set_coverage": float(np.mean(held)),
+        "mean_set_size": float(np.mean([len(s) for s in sets])),
+        "set_membership": {
+            c: {
+                k: float(np.mean([k in s for s, t in zip(sets, y) if t == c]))
+                for k in sorted({k for s in sets for k in s})
+            }
+            for c in classes
+        },
         "f1_by_class": {c: float(f) for c, f in zip(classes, per_class)},
         "confusion": {
             "true": classes,

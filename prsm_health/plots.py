@@ -208,7 +208,7 @@ def plot_evaluation(report: dict, records, directory: str | Path) -> list[Path]:
         ax.legend(loc="upper left")
         written.append(_save(fig, out / "clearance.png"))
     if "fault" in report:
-        told = records[records["fault_observable"]]
+        told = records[records["predicted_class"] != "cannot_tell"]
         fig, ax = plt.subplots(figsize=(6, 5))
         edges = np.linspace(0.0, 1.0, 11)
         right = (told["predicted_class"] == told["fault_class"]).to_numpy(float)

@@ -84,7 +84,11 @@ def test_diagnosis_contract(model, reversing_run):
     c = result["clearance"]
     assert c["lower"] <= c["estimate"] <= c["upper"]
     assert sum(result["class_probabilities"].values()) == pytest.approx(1.0)
-    assert result["fault_class"] in result["class_probabilities"]
+    assert set(result["class_set"]) <= set(result["class_probabilities"])
+    if result["fault_class"] == "cannot_tell":  # several classes not ruled out, and why
+        assert len(result["class_set"]) > 1 and any("one of" in w for w in result["warnings"])
+    else:
+        assert result["class_set"] == [result["fault_class"]]
     assert result["model"]["name"] == "diag-test-model"
     json.dumps(result, allow_nan=False)  # plain JSON (NaN indicators become null)
 

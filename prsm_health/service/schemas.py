@@ -98,8 +98,15 @@ class WindowRef(BaseModel):
 
 class WindowDiagnosis(BaseModel):
     clearance: Clearance
-    fault_class: str | None = Field(description="most probable class, or cannot_tell")
+    fault_class: str | None = Field(
+        description="the class, or cannot_tell (fault not observable, or several classes in "
+        "the class set)"
+    )
     class_probabilities: dict[str, float]
+    class_set: list[str] = Field(
+        default_factory=list,
+        description="classes the evidence cannot rule out (the model's conformal class set)",
+    )
     observability: dict[str, bool] = Field(
         description="clearance, fault: whether the window lets the model see them"
     )
@@ -117,8 +124,15 @@ class Diagnosis(BaseModel):
     """The Diagnosis contract (docs/service.md)."""
 
     clearance: Clearance
-    fault_class: str | None = Field(description="most probable class, or cannot_tell")
+    fault_class: str | None = Field(
+        description="the class, or cannot_tell (fault not observable, or several classes in "
+        "the class set)"
+    )
     class_probabilities: dict[str, float]
+    class_set: list[str] = Field(
+        default_factory=list,
+        description="classes the evidence cannot rule out (the model's conformal class set)",
+    )
     observability: dict[str, float] = Field(
         description="clearance, fault: fraction of the windows that let the model see them"
     )
