@@ -423,8 +423,9 @@ def clearance_report(records: pd.DataFrame) -> dict:
 def fault_report(records: pd.DataFrame) -> dict:
     """Macro-F1 (``cannot_tell`` counted as a miss), macro-F1 of the runs given a class,
     per-class F1, the confusion matrix (rows: true, columns: predicted incl. ``cannot_tell``),
-    and the class sets: how often they hold the true class, their mean size, and per true
-    class the share of runs whose set holds each class."""
+    the share of confident wrong answers (a class named, wrong, top probability > 0.6), and the
+    class sets: how often they hold the true class, their mean size, and per true class the
+    share of runs whose set holds each class."""
     from sklearn.metrics import confusion_matrix
 
     from .diagnosis import CANNOT_TELL
@@ -447,6 +448,10 @@ def fault_report(records: pd.DataFrame) -> dict:
         ),
         "accuracy": float(np.mean(y == pred)),
         "cannot_tell_fraction": float(np.mean(~told)),
+        # a class named (not cannot_tell), wrong, with a top probability over 0.6
+        "confident_wrong_fraction": float(
+            np.mean(told & (pred != y) & (records["top_probability"].to_numpy(float) > 0.6))
+        ),
         "set_coverage": float(np.mean(held)),
         "mean_set_size": float(np.mean([len(s) for s in sets])),
         "set_membership": {

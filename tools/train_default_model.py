@@ -209,6 +209,12 @@ def card(metrics: dict, size: int) -> str:
         + " |"
         for i, c in enumerate(dsf["confusion"]["true"])
     )
+    members = sorted({k for row in dsf["set_membership"].values() for k in row})
+    set_head = " | ".join(members)
+    set_rows = "\n".join(
+        f"| {c} | " + " | ".join(_f(row.get(k, 0.0), 2) for k in members) + " |"
+        for c, row in dsf["set_membership"].items()
+    )
     ablation_rows = "\n".join(
         f"| {r['features']} | {r['n_features']} | {_um(r['mae'])} | {r['coverage']:.3f} | "
         f"{_um(r['width'])} | {r['macro_f1']:.3f} |"
@@ -294,6 +300,19 @@ everything else drawn from the reference ranges, fresh seeds: fault macro-F1
 | class | F1 | {ds_head} |
 |---|---|{"---|" * len(metrics["default_severity"]["fault"]["confusion"]["predicted"])}
 {ds_rows}
+
+**Class sets.** A diagnosis names a class only when the model's 90 % class set (per-class
+conformal thresholds from the calibration folds: `FaultClassifier.predict_set`) holds it alone;
+otherwise it answers `cannot_tell` and names the classes it cannot rule out. At default
+severity the sets hold the true class in {_f(dsf["set_coverage"])} of the runs, with
+{_f(dsf["mean_set_size"], 2)} classes on average; confident wrong answers (a class named, wrong,
+top probability > 0.6): {_f(dsf["confident_wrong_fraction"], 3)} of the runs (off-grid:
+{_f(ogf["confident_wrong_fraction"], 3)}). Share of each class's runs whose set holds each
+class (rows true):
+
+| class | {set_head} |
+|---|{"---|" * len(members)}
+{set_rows}
 
 ### Fault classes (off-grid): F1 and confusion (rows true, columns predicted)
 
