@@ -430,10 +430,9 @@ def extract_features(
         out["drive_torque_mean"] = float(np.mean(ch["drive_torque"]))
         out["drive_torque_ripple"] = float(np.std(ch["drive_torque"]))
         if speed is not None and load is not None and "nut_position" in ch:
-            p_in = float(np.mean(ch["drive_torque"] * speed))
-            v_nut = np.gradient(ch["nut_position"], run.time)
-            p_out = float(np.mean(load * v_nut))
-            out["efficiency"] = p_out / p_in if p_in > 0 else np.nan
+            out["efficiency"] = _window_efficiency(
+                ch["drive_torque"] * speed, load * np.gradient(ch["nut_position"], run.time)
+            )
 
     # ---- reversals: of the motion, of the load (load cell), or of the drive torque when no
     # load cell is fitted (the motor current reverses with the load it carries)
@@ -522,6 +521,22 @@ def _reverses(x: np.ndarray) -> bool:
     # smoothed signal: a steady run's noise around a small mean must not count).
     margin = 0.1 * float(np.ptp(x))
     return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
+
+
+def _window_efficiency(p_in: np.ndarray, p_out: np.ndarray) -> float:
+    """A window's efficiency from its energy balance: the power through the screw over itself
+    plus the friction loss, ⟨|F·v|⟩ / (⟨|F·v|⟩ + ⟨T·ω − F·v⟩) [-].
+
+    Paper 02's form, F·p_s / (F·p_s + 2π·T_loss), with the loss measured as input minus output
+    power: under a steady driving load it is the efficiency η; under a load that reverses it
+    stays defined (the ratio of mean powers ⟨F·v⟩/⟨T·ω⟩ does not: both means swing through 0)
+    and falls as the friction rises — 1 / (1 + (1/η − η)/2) for a load driving and back-driving
+    half the time each. The inertias' kinetic energy is taken as unchanged over the window (a
+    speed held by the drive). NaN without power through the screw.
+    """
+    through = float(np.mean(np.abs(p_out)))
+    total = through + float(np.mean(p_in - p_out))
+    return through / total if through > 0 and total > 0 else np.nan
 
 
 def _rattle_rate(torque: np.ndarray, rate: float) -> float:
