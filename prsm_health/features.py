@@ -38,7 +38,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy import signal, stats
 from scipy.ndimage import uniform_filter1d
 
 from .channels import CHANNEL_NAMES, VIBRATION
@@ -48,7 +47,7 @@ from .errors import PRSMHealthError
 from .gear_indicators import GEAR_INDICATORS, gear_indicators
 from .kinematics import defect_frequencies, speed_ratios
 from .run import MIN_SAMPLES, Run, ms_hint
-from .spectra import amplitude_spectrum, dominant_frequency
+from .spectra import amplitude_spectrum, peak_frequency, welch_psd
 
 SHORT = {
     "nut_axial_accel": "ax",
@@ -225,17 +224,13 @@ def _classic(x: np.ndarray, rate: float, prefix: str, out: dict) -> None:
     out[f"{prefix}_rms"] = rms
     out[f"{prefix}_peak"] = peak
     out[f"{prefix}_crest"] = peak / rms if rms > 0 else np.nan
-    out[f"{prefix}_kurtosis"] = float(stats.kurtosis(centred, fisher=False)) if rms > 0 else np.nan
-    out[f"{prefix}_skewness"] = float(stats.skew(centred)) if rms > 0 else np.nan
+    # moments about the mean, biased (scipy.stats.kurtosis(fisher=False) and skew, without
+    # their per-call overhead)
+    m2 = rms**2
+    out[f"{prefix}_kurtosis"] = float(np.mean(centred**4) / m2**2) if rms > 0 else np.nan
+    out[f"{prefix}_skewness"] = float(np.mean(centred**3) / m2**1.5) if rms > 0 else np.nan
     nperseg = min(1024, len(x))
-    f, psd = signal.welch(
-        centred,
-        fs=rate,
-        window="hann",
-        nperseg=nperseg,
-        noverlap=3 * nperseg // 4,
-        scaling="density",
-    )
+    f, psd = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
     df = f[1] - f[0]
     for lo, hi in BANDS:
         band = (f >= lo) & (f < min(hi, rate / 2))
@@ -405,12 +400,10 @@ def extract_features(
     # ---- shifted axial frequency
     if "nut_axial_accel" in ch:
         x = ch["nut_axial_accel"]
-        f_dom = dominant_frequency(x, rate, (100.0, min(2000.0, 0.45 * rate)), min(512, len(x)))
-        out["axial_dominant_frequency"] = f_dom
         nperseg = min(512, len(x))
-        f, psd = signal.welch(
-            x - np.mean(x), fs=rate, window="hann", nperseg=nperseg, noverlap=3 * nperseg // 4
-        )
+        f, psd = welch_psd(x - np.mean(x), rate, nperseg, 3 * nperseg // 4)
+        f_dom = peak_frequency(f, psd, (100.0, min(2000.0, 0.45 * rate)))
+        out["axial_dominant_frequency"] = f_dom
         band = (f > 0.9 * f_dom) & (f < 1.1 * f_dom)
         out["axial_dominant_amplitude"] = (
             float(np.sqrt(np.sum(psd[band]) * (f[1] - f[0]))) if band.any() else np.nan
