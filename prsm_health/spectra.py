@@ -6,8 +6,31 @@ coherent gain, Welch PSDs in units²/Hz.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy import signal
+
+
+@lru_cache(maxsize=64)
+def hann(n: int) -> np.ndarray:
+    """Periodic Hann window of ``n`` samples (``scipy.signal.windows.hann(n, sym=False)``),
+    made once per length: the indicators ask for the same few lengths on every window."""
+    window = signal.windows.hann(n, sym=False)
+    window.flags.writeable = False
+    return window
+
+
+def bandpass_sos(order: int, low: float, high: float, sample_rate: float) -> np.ndarray:
+    """Butterworth band-pass in second-order sections, designed once per band (scipy's design
+    costs milliseconds, more than filtering a second of signal); a copy, as scipy's filters
+    want a writable array."""
+    return _bandpass_sos(order, low, high, sample_rate).copy()
+
+
+@lru_cache(maxsize=256)
+def _bandpass_sos(order: int, low: float, high: float, sample_rate: float) -> np.ndarray:
+    return signal.butter(order, (low, high), btype="bandpass", fs=sample_rate, output="sos")
 
 
 def amplitude_spectrum(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, np.ndarray]:
@@ -25,7 +48,7 @@ def amplitude_spectrum(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, n
     (frequency [Hz], amplitude [unit of x])
     """
     x = np.asarray(x, float) - np.mean(x)
-    window = signal.windows.hann(len(x), sym=False)
+    window = hann(len(x))
     spectrum = np.abs(np.fft.rfft(x * window)) * 2.0 / np.sum(window)
     return np.fft.rfftfreq(len(x), 1.0 / sample_rate), spectrum
 
@@ -65,7 +88,7 @@ def welch_psd(
     noverlap = nperseg // 2 if noverlap is None else int(noverlap)
     frames = np.lib.stride_tricks.sliding_window_view(x, nperseg, axis=-1)
     frames = frames[..., :: nperseg - noverlap, :]
-    window = signal.windows.hann(nperseg, sym=False)
+    window = hann(nperseg)
     spectrum = np.fft.rfft((frames - frames.mean(axis=-1, keepdims=True)) * window, axis=-1)
     psd = np.mean(spectrum.real**2 + spectrum.imag**2, axis=-2)
     psd /= sample_rate * np.sum(window**2)
@@ -123,6 +146,6 @@ def envelope_spectrum(
     """
     x = np.asarray(x, float)
     high = min(band[1], 0.45 * sample_rate)
-    sos = signal.butter(4, (band[0], high), btype="bandpass", fs=sample_rate, output="sos")
+    sos = bandpass_sos(4, float(band[0]), float(high), float(sample_rate))
     envelope = np.abs(signal.hilbert(signal.sosfiltfilt(sos, x - np.mean(x))))
     return welch_psd(envelope - envelope.mean(), sample_rate, nperseg)
