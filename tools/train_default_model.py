@@ -272,7 +272,7 @@ Clearance through the diagnosis (gates and OOD score applied: an interval is the
 range where the clearance was not observable or the window out of distribution); fault macro-F1
 counts `cannot_tell` as a miss.
 
-| set | clearance MAE | 90 % coverage | mean width | fault macro-F1 |
+| set | clearance MAE | 90 % coverage | mean width | fault macro-F1 (models alone: argmax; through the diagnosis: class sets) |
 |---|---|---|---|---|
 | 3-fold CV on train (grouped by operating point; models alone) | {_um(cv["mae"])} | {_f(cv["interval_coverage"])} | {_um(cv["mean_interval_width"])} | {_f(fcv["macro_f1"])} |
 | held-out split ({ct["n"]} runs; models alone) | {_um(ct["mae"])} | {_f(ct["interval_coverage"])} | {_um(ct["mean_interval_width"])} | {_f(ft["macro_f1"])} |
@@ -340,7 +340,7 @@ MAE and interval coverage of the runs in each third.
 
 ## What each indicator group adds (held-out split, both models retrained without it)
 
-| features | n | clearance MAE | 90 % coverage | mean width | fault macro-F1 |
+| features | n | clearance MAE | 90 % coverage | mean width | fault macro-F1 (argmax) |
 |---|---|---|---|---|---|
 {ablation_rows}
 
@@ -373,12 +373,21 @@ Fault class (drop of accuracy):
   impacts of the clearance at every reversal dominate the envelope; a lubricant's extra
   friction is hidden in a drive torque dominated by an axial load no sensor measures (no load
   cell on a flight EMA); a partial preload loss changes the play by a few µm, inside the
-  clearance's own spread. The per-class table above says what the model makes of them: only
-  wear and severe wear are seen (by the lost motion). The issue asked for a fault macro-F1 ≥ 0.9
-  at default severities; this instrumentation gives the value above, and no indicator we tried
-  (time-synchronous averages, envelope lines at the defect frequencies, spectral kurtosis)
-  changed that (ablation table). What would: a load cell, a tangential accelerometer, longer
-  windows at higher load (docs/faults.md).
+  clearance's own spread. Only wear and severe wear are seen (by the lost motion: the argmax of
+  the classifier reaches F1 ≈ 0.7–0.9 on them, ablation and earlier cards). But a spall or a
+  cracked tooth may sit on a worn unit too (the taxonomy names the localised fault first), and
+  nothing in these channels rules it out: the class set keeps spall and tooth damage for nearly
+  every window, so the diagnosis answers `cannot_tell` and says what it *can* rule out
+  (healthy and lubrication for most worn units, the class-set table) — the clearance estimate
+  and its interval carry the wear. The issue asked for a fault macro-F1 ≥ 0.9 at default
+  severities; this instrumentation cannot give it honestly: naming the most probable class
+  (the previous card, 2026-11-24) scored 0.34, and gave a wrong class to 25–29 of the 30 runs
+  of healthy, preload loss, spall and tooth damage (14 of lubrication); the class sets score
+  {_f(dsf["macro_f1"])} with {_f(dsf["confident_wrong_fraction"], 3)} confident wrong answers.
+  No indicator we tried (time-synchronous averages, envelope lines at the defect frequencies,
+  spectral kurtosis, plain-spectrum lines at the defect frequencies) changed that (ablation
+  table, docs/faults.md). What would: a load cell, a tangential accelerometer, longer windows
+  at higher load (docs/faults.md).
 - Real recordings differ from the simulator (mounting, transfer paths, temperature): validate
   on measured data (`prsm-health import`, `prsm-health evaluate`) before trusting it.
 """
