@@ -53,8 +53,12 @@ CANNOT_TELL = "cannot_tell"
 #: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
 OOD_LIMIT = 1.5
 #: Words for the operating indicators in warnings.
-#: How the warning of an ambiguous class set begins.
-_SET_NOTE = "fault class: one of "
+#: A class is named when its calibrated probability reaches this: more probable than all the
+#: others together, so the named class is right more often than not (calibration figure of the
+#: model card); below it the answer is ``cannot_tell`` with the candidates in a warning.
+NAME_PROBABILITY = 0.5
+#: How the class-set part of a fault-class warning begins.
+_SET_NOTE = "not ruled out at "
 REGIME_WORDS = {
     "speed_mean": "speed",
     "load_mean": "mean load",
@@ -153,8 +157,8 @@ class Diagnosis:
     clearance : dict
         ``estimate``, ``lower``, ``upper`` [m] (90 % interval); None where not computable.
     fault_class : str or None
-        The class, when the window shows the fault (``observability``) and the class set holds
-        only it; else ``cannot_tell``.
+        The most probable class, when the window shows the fault (``observability``) and its
+        probability reaches :data:`NAME_PROBABILITY`; else ``cannot_tell``.
     class_probabilities : dict of class → probability
     class_set : list of str
         The classes the evidence cannot rule out (the model's conformal class set, 90 % by
@@ -345,10 +349,13 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
 
 
 def _fault_answer(probabilities: dict, observable: bool, bundle: ModelBundle, notes: list):
-    """(fault class, class set) of class probabilities; a warning appended when the set holds
-    several classes. A single class only when the fault is observable and the set holds it
-    alone: where the instrumentation cannot tell classes apart, their held-out probabilities
-    overlap and the set holds them all."""
+    """(fault class, class set) of class probabilities, and a warning when the set holds more
+    than the named class or no class is named.
+
+    The class is named when the fault is observable and its probability reaches
+    :data:`NAME_PROBABILITY`; otherwise ``cannot_tell``. The class set (the model's conformal
+    set) lists what the evidence cannot rule out: where the instrumentation cannot tell
+    classes apart, their held-out probabilities overlap and the set holds them all."""
     from .estimators import class_sets  # scikit-learn only when a model is used
 
     if not probabilities:
@@ -356,22 +363,30 @@ def _fault_answer(probabilities: dict, observable: bool, bundle: ModelBundle, no
     names = list(probabilities)
     if not observable:
         return CANNOT_TELL, names
+    best = max(probabilities, key=probabilities.get)
     thresholds = getattr(bundle.fault, "set_thresholds_", None)
-    if thresholds is None:  # a bundle saved before class sets: its most probable class
-        best = max(probabilities, key=probabilities.get)
-        return best, [best]
-    chosen = class_sets([list(probabilities.values())], thresholds)[0]
-    members = [c for c, keep in zip(names, chosen) if keep]
-    members.sort(key=probabilities.get, reverse=True)
-    if len(members) == 1:
-        return members[0], members
+    members = [best]  # a bundle saved before class sets: its most probable class
+    if thresholds is not None:
+        chosen = class_sets([list(probabilities.values())], thresholds)[0]
+        members = sorted(
+            (c for c, keep in zip(names, chosen) if keep), key=probabilities.get, reverse=True
+        )
+    named = probabilities[best] >= NAME_PROBABILITY
+    if named and members == [best]:
+        return best, members
+    others = [c for c in members if c != best] if named else members
     ruled_out = [c for c in names if c not in members]
+    head = (
+        f"fault class {best} (P = {probabilities[best]:.2f})"
+        if named
+        else f"fault class: cannot tell — no class reaches P = {NAME_PROBABILITY:g} (most "
+        f"probable {best}, {probabilities[best]:.2f})"
+    )
     notes.append(
-        f"{_SET_NOTE}{', '.join(members)}: cannot tell them apart (the model's "
-        f"{_set_coverage(bundle):.0%} class set holds them all)"
+        f"{head}; {_SET_NOTE}{100 * _set_coverage(bundle):.0f} %: {', '.join(others)}"
         + (f"; ruled out: {', '.join(ruled_out)}" if ruled_out else "")
     )
-    return CANNOT_TELL, members
+    return (best if named else CANNOT_TELL), members
 
 
 def _set_coverage(bundle: ModelBundle) -> float:
@@ -397,7 +412,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
     counts: dict[str, int] = {}
     for d in diagnoses:
         for note in d.warnings:
-            if not note.startswith(_SET_NOTE):  # restated below for the mean probabilities
+            if _SET_NOTE not in note:  # restated below for the mean probabilities
                 counts[note] = counts.get(note, 0) + 1
     notes = [
         note if k == len(diagnoses) else f"{note} (in {k} of {len(diagnoses)} windows)"
