@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -222,9 +223,16 @@ class Diagnosis:
 def _matrix(rows: list[dict], names: list[str]):
     import pandas as pd
 
-    return pd.DataFrame(
-        [[r.get(n, np.nan) for n in names] for r in rows], columns=names, dtype=float
-    )
+    values = np.array([[r.get(n, np.nan) for n in names] for r in rows], dtype=float)
+    return pd.DataFrame(values.reshape(len(rows), len(names)), columns=names)
+
+
+@lru_cache(maxsize=1)
+def _threadpools():
+    # made once: each threadpool_limits() call rescans the process's libraries (≈ 5 ms)
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
 
 
 def diagnose_indicators(
@@ -235,13 +243,11 @@ def diagnose_indicators(
     ``channels``: the measured channels of each row's window (default: the model's, i.e. none
     missing); ``design``: the recording's design label, if it has one.
     """
-    from threadpoolctl import threadpool_limits
-
     x = _matrix(rows, bundle.feature_names)
     channels = channels or [bundle.channels or ()] * len(rows)
     # A few rows per call: OpenMP threads in the boosted trees only add spin-wait latency, and
     # under load (the service, parallel replays) oversubscribe the cores.
-    with threadpool_limits(limits=1, user_api="openmp"):
+    with _threadpools().limit(limits=1, user_api="openmp"):
         return _predict(rows, x, bundle, channels, design)
 
 

@@ -44,6 +44,7 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from .errors import ParameterError, require, require_range
+from .trees import calibrated_proba, regressor_predict
 
 __all__ = ["ClearanceEstimator", "DistributionGuard", "FaultClassifier"]
 
@@ -73,6 +74,22 @@ def _check_hgb_params(est) -> None:
         "must be an integer >= 1",
     )
     require_range("l2_regularization", est.l2_regularization, 0.0, math.inf)
+
+
+def _predict_input(est, X) -> np.ndarray:
+    """``validate_data(est, X, reset=False)`` for prediction (float64, NaN allowed, inf not),
+    with a shortcut for the common case — a DataFrame whose columns are the fitted feature
+    names — where scikit-learn's per-column dtype checks cost milliseconds per call."""
+    names = getattr(est, "feature_names_in_", None)
+    columns = getattr(X, "columns", None)
+    if names is not None and columns is not None and list(columns) == list(names):
+        try:
+            matrix = X.to_numpy(dtype=np.float64)
+        except (TypeError, ValueError):
+            matrix = None  # a column that is not numeric: scikit-learn's check says which
+        if matrix is not None and not np.isinf(matrix).any():
+            return matrix
+    return validate_data(est, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
 
 
 def _hgb_params(est) -> dict:
@@ -348,10 +365,10 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
         return self
 
     def _raw_bounds(self, X):
-        lo = self.lower_model_.predict(X)
-        hi = self.upper_model_.predict(X)
+        lo = regressor_predict(self.lower_model_, X)
+        hi = regressor_predict(self.upper_model_, X)
         if self.residual_point_model_ is not None:
-            centre = self.residual_point_model_.predict(X)
+            centre = regressor_predict(self.residual_point_model_, X)
             lo, hi = centre + lo, centre + hi
         # Crossing quantile estimates are reordered, in calibration and prediction alike, so
         # the score remains one fixed function of (x, y) and the guarantee holds.
@@ -362,7 +379,7 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
 
     def _validated(self, X):
         check_is_fitted(self)
-        return validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
+        return _predict_input(self, X)
 
     def _clip(self, values):
         if self.lower_limit is not None:
@@ -383,7 +400,7 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
             Estimate [units of y].
         """
         X = self._validated(X)
-        return self._clip(self.point_model_.predict(X) / self.scale)
+        return self._clip(regressor_predict(self.point_model_, X) / self.scale)
 
     def predict_interval(self, X):
         """Conformal prediction interval of nominal coverage ``1 - alpha``.
@@ -400,7 +417,7 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
         """
         X = self._validated(X)
         lo, hi = self._raw_bounds(X)
-        point = self.point_model_.predict(X) / self.scale
+        point = regressor_predict(self.point_model_, X) / self.scale
         if self.conformity == "additive":
             margin = self.conformal_correction_
         else:
@@ -665,8 +682,12 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
             Probabilities in the order of ``classes_``; each row sums to 1.
         """
         check_is_fitted(self)
-        X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
-        proba = np.clip(self.model_.predict_proba(X), 0.0, 1.0)
+        X = _predict_input(self, X)
+        if isinstance(self.model_, CalibratedClassifierCV):
+            proba = calibrated_proba(self.model_, X)
+        else:
+            proba = self.model_.predict_proba(X)
+        proba = np.clip(proba, 0.0, 1.0)
         return proba / proba.sum(axis=1, keepdims=True)
 
     def predict(self, X):
@@ -788,5 +809,5 @@ class DistributionGuard(BaseEstimator):
     def score(self, X) -> np.ndarray:
         """Out-of-distribution score of each row (1 = the training rows' ``quantile``)."""
         check_is_fitted(self)
-        X = validate_data(self, X, reset=False, ensure_all_finite="allow-nan", dtype=np.float64)
+        X = _predict_input(self, X)
         return self._raw(self._scaled(X)) / max(self.threshold_, 1e-12)

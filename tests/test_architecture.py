@@ -40,6 +40,7 @@ LAYERS = {
     "dataset": 3,
     "features": 4,
     "estimators": 4,
+    "trees": 4,
     "evaluation": 4,
     "persistence": 4,
     "training": 4,
