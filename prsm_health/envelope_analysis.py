@@ -205,7 +205,9 @@ def defect_lines(
     lines = {}
     for name, f0 in frequencies.items():
         amplitude, ratio = line_and_ratio(freq, amp, f0, limit)
-        ratios = [line_and_ratio(freq, amp, h * f0, limit)[1] for h in range(1, harmonics + 1)]
+        ratios = [ratio] + [
+            line_and_ratio(freq, amp, h * f0, limit)[1] for h in range(2, harmonics + 1)
+        ]
         ratios = [r for r in ratios if math.isfinite(r)]
         lines[name] = {
             "amplitude": amplitude,
