@@ -361,6 +361,8 @@ def _cmd_serve(args) -> int:
     overrides = {"max_window_seconds": args.max_window}
     if args.workers is not None:  # 0 or negative: ServiceLimits refuses it by name
         overrides["workers"] = args.workers
+    if args.processes is not None:
+        overrides["processes"] = args.processes
     serve(
         args.host,
         args.port,
@@ -912,6 +914,12 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--token", default=None, help="bearer token (None: $PRSM_HEALTH_TOKEN)")
     v.add_argument(
         "--workers", type=int, default=None, help="diagnoses computed at once (None: cores)"
+    )
+    v.add_argument(
+        "--processes",
+        type=int,
+        default=None,
+        help="diagnosis processes, each with the model loaded once (None or 0: threads)",
     )
     v.add_argument(
         "--max-window", type=_finite_float, default=2.0, help="longest JSON recording [s]"

@@ -79,11 +79,12 @@ def _percentiles(values: list[float]) -> dict:
 class _Service:
     """``serve`` in a subprocess; stopped with SIGINT (uvicorn's graceful shutdown)."""
 
-    def __init__(self, db: Path, model: str | None, workers: int | None):
+    def __init__(self, db: Path, model: str | None, workers: int | None, processes: int):
         self.port = _free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         self.token = secrets.token_urlsafe(24)
-        limits = f"ServiceLimits(workers={workers})" if workers else "None"
+        settings = {"workers": workers, "processes": processes}
+        limits = f"ServiceLimits(**{ {k: v for k, v in settings.items() if v}!r})"
         code = (
             "import sys\n"
             "from prsm_health.service import ServiceLimits, serve\n"
@@ -138,24 +139,38 @@ def run(args) -> dict:
     from prsm_health.service import ServiceLimits
 
     rec = _recording(args.window, args.sample_rate)
-    payloads = [
-        json.dumps(
+    if args.body == "json":
+        payloads = [
+            json.dumps(
+                {
+                    "sample_rate": rec.sample_rate,
+                    "channels": {k: v.tolist() for k, v in rec.channels.items()},
+                    "asset_id": f"load-test-{c}",
+                }
+            ).encode()
+            for c in range(args.clients)
+        ]
+        body_bytes = len(payloads[0])
+    else:  # the recording as a Parquet file, uploaded as multipart form data
+        from prsm_health.io.parquet import write_run_parquet
+
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "recording.parquet"
+            write_run_parquet(rec.without_truth(), path)  # a measured recording
+            parquet = path.read_bytes()
+        payloads = [
             {
-                "sample_rate": rec.sample_rate,
-                "channels": {k: v.tolist() for k, v in rec.channels.items()},
-                "asset_id": f"load-test-{c}",
+                "files": {"file": ("recording.parquet", parquet)},
+                "data": {"asset_id": f"load-test-{c}"},
             }
-        ).encode()
-        for c in range(args.clients)
-    ]
+            for c in range(args.clients)
+        ]
+        body_bytes = len(parquet)
     with tempfile.TemporaryDirectory(prefix="prsm-health-load-") as tmp:
-        service = _Service(Path(tmp) / "history.sqlite", args.model, args.workers)
+        service = _Service(Path(tmp) / "history.sqlite", args.model, args.workers, args.processes)
         try:
             ready = service.wait_ready(args.startup_timeout)
-            headers = {
-                "Authorization": f"Bearer {service.token}",
-                "content-type": "application/json",
-            }
+            headers = {"Authorization": f"Bearer {service.token}"}
             lock = threading.Lock()
             issued = 0
             latencies: list[float] = []
@@ -178,7 +193,14 @@ def run(args) -> dict:
                             issued += 1
                         t0 = time.perf_counter()
                         try:
-                            r = c.post("/v1/diagnose", content=payloads[k])
+                            if args.body == "json":
+                                r = c.post(
+                                    "/v1/diagnose",
+                                    content=payloads[k],
+                                    headers={"content-type": "application/json"},
+                                )
+                            else:
+                                r = c.post("/v1/diagnose/file", **payloads[k])
                             ok = r.status_code == 200
                             problem = None if ok else f"{r.status_code}: {r.text[:200]}"
                         except httpx.HTTPError as exc:
@@ -233,8 +255,10 @@ def run(args) -> dict:
         "sample_rate_hz": rec.sample_rate,
         "samples_per_request": len(rec),
         "channels_per_request": len(rec.channels),
-        "request_bytes": len(payloads[0]),
+        "request_bytes": body_bytes,
+        "body": args.body,
         "server_workers": args.workers or ServiceLimits().workers,
+        "server_processes": args.processes,
         "cpu_count": os.cpu_count(),
         "model": f"{ready['model']} v{ready['version']}",
         "elapsed_s": elapsed,
@@ -257,8 +281,8 @@ def _report(r: dict) -> str:
         f"service load test: {r['clients']} clients, {r['answered']}/{r['requests']} requests answered"
         f"{' (time cap reached)' if r['time_capped'] else ''} in {r['elapsed_s']:.1f} s",
         f"  request: {r['window_s']:g} s at {r['sample_rate_hz']:g} Hz, {r['samples_per_request']} samples"
-        f" x {r['channels_per_request']} channels, {r['request_bytes'] / 1e6:.1f} MB JSON; model {r['model']}",
-        f"  machine: {r['cpu_count']} CPUs, server workers {r['server_workers']}",
+        f" x {r['channels_per_request']} channels, {r['request_bytes'] / 1e6:.1f} MB {r['body']}; model {r['model']}",
+        f"  machine: {r['cpu_count']} CPUs, server workers {r['server_workers']}, diagnosis processes {r['server_processes']}",
         f"  throughput: {r['throughput_rps']:.2f} diagnoses/s ({r['signal_seconds_per_s']:.2f} s of signal per s)",
     ]
     if lat["n"]:
@@ -291,6 +315,9 @@ def main(argv=None) -> int:
     p.add_argument("--sample-rate", type=float, default=20000.0, help="[Hz]")
     p.add_argument("--health-interval", type=float, default=0.05, help="/v1/health poll period [s]")
     p.add_argument(
+        "--processes", type=int, default=0, help="server diagnosis processes (0: threads)"
+    )
+    p.add_argument(
         "--workers",
         type=int,
         default=None,
@@ -299,6 +326,12 @@ def main(argv=None) -> int:
     p.add_argument("--model", default=None, help="model bundle (default: the shipped model)")
     p.add_argument("--startup-timeout", type=float, default=180.0, help="[s]")
     p.add_argument("--json", action="store_true", help="machine-readable result")
+    p.add_argument(
+        "--body",
+        choices=("json", "parquet"),
+        default="json",
+        help="request body: the JSON contract, or a Parquet file as multipart upload",
+    )
     args = p.parse_args(argv)
     if not (1 <= args.clients <= 64 and 1 <= args.requests <= 10_000 and 0 < args.time_cap <= 3600):
         p.error("keep it bounded: 1-64 clients, 1-10000 requests, time cap in (0, 3600] s")

@@ -83,7 +83,7 @@ def create_app(
     app.state.bundle = bundle
     app.state.store = store
     app.state.limits = limits
-    app.state.workers = WorkerPool(limits)
+    app.state.workers = WorkerPool(limits, bundle)
     app.state.model_info = model_info(bundle, model_file)
     app.state.started = time.monotonic()
     app.state.warm = not warmup
@@ -125,12 +125,14 @@ async def _lifespan(app: FastAPI, *, warmup: bool):
     try:
         yield
     finally:
+        app.state.workers.close()
         app.state.store.close()
 
 
 def _warm(app: FastAPI) -> None:
     try:
         warm_up(app.state.bundle)
+        app.state.workers.start()  # diagnosis processes, if any, load and warm their model
     except Exception:  # warm-up is an optimisation; a failure shows on the first request
         log.warning("warm-up diagnosis failed", exc_info=True)
     finally:

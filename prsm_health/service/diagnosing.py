@@ -21,7 +21,7 @@ from ..run import MIN_SAMPLES, Run
 from .limits import MAX_ABS_VALUE, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
 from .schemas import DiagnoseRequest, parse_diagnose_request
-from .uploads import Upload, precheck_upload
+from .uploads import ReceivedUpload, precheck_upload
 
 log = logging.getLogger("prsm_health.service")
 
@@ -90,7 +90,7 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     return Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
 
 
-def diagnose_body(body: bytes, bundle, limits: ServiceLimits):
+def diagnose_body(bundle, body: bytes, limits: ServiceLimits):
     """``POST /v1/diagnose``: ``(request, diagnosis dict, encoded answer)``; ``windows`` only
     when the recording spans more than one model window."""
     req = parse_diagnose_request(body, limits)
@@ -112,7 +112,7 @@ def diagnose_body(body: bytes, bundle, limits: ServiceLimits):
 
 
 # ----------------------------------------------------------------------------- upload
-def read_upload(upload: Upload, limits: ServiceLimits) -> tuple[Run, list[str]]:
+def read_upload(upload: ReceivedUpload, limits: ServiceLimits) -> tuple[Run, list[str]]:
     """The uploaded recording and the reader's notes (truncated recording); messages name the
     client's file name, never the server path."""
     from ..errors import TruncatedRecordingWarning
@@ -147,7 +147,7 @@ def read_upload(upload: Upload, limits: ServiceLimits) -> tuple[Run, list[str]]:
     return run.without_truth(), notes
 
 
-def diagnose_upload(upload: Upload, bundle, limits: ServiceLimits):
+def diagnose_upload(bundle, upload: ReceivedUpload, limits: ServiceLimits):
     """``POST /v1/diagnose/file``: ``(answer dict, encoded answer)`` — the whole-recording
     diagnosis, the per-window ones, what was read and the reader's notes."""
     run, notes = read_upload(upload, limits)

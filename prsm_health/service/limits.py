@@ -39,12 +39,16 @@ class ServiceLimits:
     min_sample_rate, max_sample_rate : float [Hz]
         Accepted sample rates.
     workers : int
-        Diagnoses (parse + diagnose) running at once in worker threads; more requests wait
-        their turn. Default: half the CPUs. A diagnosis holds the GIL much of the time, so
-        threads add little: on 2 CPUs, 40 in-process diagnoses of 1 s recordings ran at 22
-        per s on one thread and 19 per s on two, and the service with one worker gave as much
-        throughput as with two, a lower p99 latency and half the /v1/health p99
-        (docs/service.md).
+        Diagnoses (parse + diagnose) running at once in worker threads when ``processes`` is
+        0; more requests wait their turn. Default: half the CPUs. A diagnosis holds the GIL
+        much of the time, so threads add little: on 2 CPUs, 40 in-process diagnoses of 1 s
+        recordings ran at 22 per s on one thread and 19 per s on two, and the service with one
+        worker gave as much throughput as with two, a lower p99 latency and half the
+        /v1/health p99 (docs/service.md).
+    processes : int
+        Diagnosis processes (each loads the model once and diagnoses one request at a time);
+        0: diagnose in worker threads of the server process (``workers``). Processes use the
+        cores in parallel (docs/service.md has the measured throughput).
     max_pending : int
         Diagnose requests admitted at once (receiving, waiting for a worker or running);
         beyond, ``503`` with ``Retry-After``. Bounds the memory held by request bodies.
@@ -61,6 +65,7 @@ class ServiceLimits:
     min_sample_rate: float = 1.0
     max_sample_rate: float = 200e3
     workers: int = max(1, (os.cpu_count() or 1) // 2)
+    processes: int = 0
     max_pending: int = 16
     max_history: int = 10_000
 
@@ -78,6 +83,10 @@ class ServiceLimits:
             value = getattr(self, name)
             if not (isinstance(value, int) and value >= 1):
                 raise PRSMHealthError(f"ServiceLimits.{name} = {value!r} must be an integer >= 1")
+        if not (isinstance(self.processes, int) and 0 <= self.processes <= 64):
+            raise PRSMHealthError(
+                f"ServiceLimits.processes = {self.processes!r} must be an integer in [0, 64]"
+            )
         if not (math.isfinite(self.max_window_seconds) and self.max_window_seconds > 0):
             raise PRSMHealthError(
                 "ServiceLimits.max_window_seconds must be a finite number > 0 [s]"

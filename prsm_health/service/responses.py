@@ -17,6 +17,10 @@ class HTTPError(Exception):
         self.message = message
         self.headers = headers
 
+    def __reduce__(self):
+        # raised in a diagnosis process, it crosses back to the server by pickling
+        return (HTTPError, (self.status, self.message, self.headers))
+
 
 class BodyTooLarge(HTTPError):
     def __init__(self, limit: int):

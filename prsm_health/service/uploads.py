@@ -7,6 +7,7 @@ from __future__ import annotations
 import contextlib
 import re
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import anyio
@@ -63,6 +64,17 @@ def precheck_upload(path: Path, suffix: str, limits: ServiceLimits) -> None:
             413,
             f"recording decompresses to more than {limits.max_upload_decoded_bytes} bytes",
         )
+
+
+@dataclass(frozen=True)
+class ReceivedUpload:
+    """What a received upload is to the diagnosis: the file on disk and how the client named
+    it (plain data: it crosses to a diagnosis process)."""
+
+    path: Path | None
+    filename: str | None
+    suffix: str | None
+    file_bytes: int
 
 
 class Upload:
@@ -166,6 +178,10 @@ class Upload:
     def write(self, data: bytes) -> None:
         if self._file is not None and data:
             self._file.write(data)
+
+    def received(self) -> ReceivedUpload:
+        """The received file, for the diagnosis."""
+        return ReceivedUpload(self.path, self.filename, self.suffix, self.file_bytes)
 
     def close(self) -> None:
         if self._file is not None:

@@ -1,19 +1,49 @@
-"""The worker pool: diagnoses run in threads, a bounded number at once, and a bounded number of
-requests are admitted (the rest get ``503``)."""
+"""The worker pool: diagnoses run a bounded number at once — in threads of this process, or in
+diagnosis processes that each load the model once — and a bounded number of requests are
+admitted (the rest get ``503``)."""
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
 
 import anyio
 
 from .limits import ServiceLimits
 from .responses import HTTPError
 
+#: The model bundle of a diagnosis process, loaded once by :func:`_start_process`.
+_process_bundle = None
+
+
+def _start_process(bundle) -> None:
+    """Initialiser of a diagnosis process: keep the model, walk the diagnosis once (JIT
+    caches, compiled trees) so its first request does not pay for it."""
+    from .diagnosing import warm_up
+
+    global _process_bundle
+    _process_bundle = bundle
+    warm_up(bundle)
+
+
+def _in_process(fn, *args):
+    return fn(_process_bundle, *args)
+
+
+def _ready() -> bool:
+    return _process_bundle is not None
+
 
 class WorkerPool:
-    """At most ``limits.workers`` jobs in threads at once (:meth:`run`), and at most
+    """At most ``limits.workers`` diagnoses at once (:meth:`diagnose`), and at most
     ``limits.max_pending`` diagnose requests admitted (:meth:`admitted`).
+
+    With ``limits.processes`` = 0 a diagnosis runs in a worker thread of this process. A
+    diagnosis holds the GIL much of the time, so threads add little beyond one; with
+    ``processes`` ≥ 1 it runs in one of that many diagnosis processes (spawned, each with its
+    own copy of the model, loaded once), which use the cores in parallel (docs/service.md).
 
     Attributes
     ----------
@@ -21,14 +51,40 @@ class WorkerPool:
         Diagnose requests admitted now (receiving, waiting for a worker or running).
     """
 
-    def __init__(self, limits: ServiceLimits):
+    def __init__(self, limits: ServiceLimits, bundle):
         self.max_pending = limits.max_pending
         self.active = 0
-        self._limiter = anyio.CapacityLimiter(limits.workers)
+        self._bundle = bundle
+        self._processes = None
+        if limits.processes:
+            self._processes = ProcessPoolExecutor(
+                limits.processes,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_start_process,
+                initargs=(bundle,),
+            )
+        self._limiter = anyio.CapacityLimiter(limits.processes or limits.workers)
 
-    async def run(self, fn, *args):
-        """``fn(*args)`` in a worker thread, waiting for a free worker."""
-        return await anyio.to_thread.run_sync(fn, *args, limiter=self._limiter)
+    def start(self) -> None:
+        """Start every diagnosis process now (each loads and warms the model), not at the
+        first requests; returns when all are ready. Nothing to do with threads."""
+        if self._processes is not None:
+            n = self._processes._max_workers
+            # submitted together, so none finds an idle process and every one is started
+            for future in [self._processes.submit(_ready) for _ in range(n)]:
+                future.result()
+
+    def close(self) -> None:
+        if self._processes is not None:
+            self._processes.shutdown(wait=True, cancel_futures=True)
+
+    async def diagnose(self, fn, *args):
+        """``fn(bundle, *args)`` in a worker thread or a diagnosis process (with that
+        process's model), waiting for a free worker."""
+        async with self._limiter:
+            if self._processes is None:
+                return await anyio.to_thread.run_sync(fn, self._bundle, *args)
+            return await asyncio.wrap_future(self._processes.submit(_in_process, fn, *args))
 
     @contextlib.contextmanager
     def admitted(self):

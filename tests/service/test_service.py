@@ -687,3 +687,33 @@ def test_fuzz_openapi_no_server_errors(fuzz_schema, method, path, mode):
         case.validate_response(response, checks=checks)
 
     fuzz()
+
+
+# ----------------------------------------------------------------------------- processes
+@pytest.mark.slow  # spawns two processes that import the package and load the model
+def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, tmp_path, client):
+    # Two spawned diagnosis processes, each with its own copy of the model: the same answers as
+    # the in-process workers (the same code and model), errors crossing back as HTTP answers,
+    # and the processes gone when the server stops.
+    limits = ServiceLimits(processes=2)
+    app = create_app(None, tmp_path / "history.sqlite", None, limits, bundle=bundle)
+    with LiveServer(app) as live, live.client() as c:
+        deadline = time.monotonic() + 120  # spawn, imports, model, warm-up in each process
+        while not c.get("/v1/health").json().get("warm"):
+            assert time.monotonic() < deadline, "diagnosis processes did not start"
+            time.sleep(0.2)
+        body = _body(recording, asset_id="pump-7")
+        answer = c.post("/v1/diagnose", json=body)
+        assert answer.status_code == 200, answer.text
+        assert answer.json() == client.post("/v1/diagnose", json=_body(recording)).json()
+        with open(files["parquet"], "rb") as f:
+            upload = c.post("/v1/diagnose/file", files={"file": ("run.parquet", f)})
+        assert upload.status_code == 200, upload.text
+        bad = c.post("/v1/diagnose", json={**body, "sample_rate": 0.5})
+        assert bad.status_code == 422 and "sample_rate" in bad.json()["error"]
+        assert c.get("/v1/assets/pump-7/history").json()["count"] == 1
+        pids = [p.pid for p in app.state.workers._processes._processes.values()]
+    assert len(pids) == 2
+    for pid in pids:  # shut down with the server
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)

@@ -9,7 +9,7 @@ from ..history import utc_now
 from ..responses import HTTPError, json_response
 from ..schemas import ASSET_ID_PATTERN, ERROR_RESPONSES, Diagnosis, Error, FileDiagnosis
 from ..uploads import multipart_boundary, receive_upload, upload_directory
-from .deps import Bundle, Limits, Store, Workers
+from .deps import Limits, Store, Workers
 
 router = APIRouter()
 
@@ -65,16 +65,14 @@ def require_json(request: Request) -> None:
     },
     openapi_extra=_JSON_BODY,
 )
-async def post_diagnose(
-    request: Request, bundle: Bundle, store: Store, limits: Limits, workers: Workers
-):
+async def post_diagnose(request: Request, store: Store, limits: Limits, workers: Workers):
     """Diagnose uniformly sampled contract channels (at most `max_window_seconds`, 2 s by
     default). With `asset_id` the diagnosis is stored in the asset's history."""
     received_at = utc_now()
     require_json(request)
     with workers.admitted():
         body = await request.body()
-        req, result, encoded = await workers.run(diagnose_body, body, bundle, limits)
+        req, result, encoded = await workers.diagnose(diagnose_body, body, limits)
     if req.asset_id is not None:
         await anyio.to_thread.run_sync(
             lambda: store.add(
@@ -106,9 +104,7 @@ async def post_diagnose(
     },
     openapi_extra=_MULTIPART_BODY,
 )
-async def post_diagnose_file(
-    request: Request, bundle: Bundle, store: Store, limits: Limits, workers: Workers
-):
+async def post_diagnose_file(request: Request, store: Store, limits: Limits, workers: Workers):
     """Stream the upload into a private temporary directory (removed afterwards), read it
     with the library and diagnose every window."""
     received_at = utc_now()
@@ -116,7 +112,7 @@ async def post_diagnose_file(
     with workers.admitted():
         async with upload_directory() as directory:
             upload = await receive_upload(request, boundary, directory)
-            answer, encoded = await workers.run(diagnose_upload, upload, bundle, limits)
+            answer, encoded = await workers.diagnose(diagnose_upload, upload.received(), limits)
     asset_id = upload.fields.get("asset_id")
     if asset_id is not None:
         await anyio.to_thread.run_sync(
