@@ -53,13 +53,13 @@ CANNOT_TELL = "cannot_tell"
 #: the 99th percentile of the training windows' own scores; 1.5 leaves room for the held-out
 #: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
 OOD_LIMIT = 1.5
-#: Words for the operating indicators in warnings.
 #: A class is named when its calibrated probability reaches this: more probable than all the
 #: others together, so the named class is right more often than not (calibration figure of the
 #: model card); below it the answer is ``cannot_tell`` with the candidates in a warning.
 NAME_PROBABILITY = 0.5
 #: How the class-set part of a fault-class warning begins.
 _SET_NOTE = "not ruled out at "
+#: Words for the operating indicators in warnings.
 REGIME_WORDS = {
     "speed_mean": "speed",
     "load_mean": "mean load",
