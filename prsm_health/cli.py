@@ -667,6 +667,17 @@ def _finite_float(text: str) -> float:
     return value
 
 
+def _step(text: str) -> float | str:
+    if text == "auto":
+        return text
+    try:
+        return _finite_float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is neither a step in seconds nor 'auto'"
+        ) from None
+
+
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """Help with every option's default; an option without one says in its help what applies."""
 
@@ -1057,7 +1068,12 @@ def _add_simulate_parser(command, default_preset) -> None:
     s.add_argument(
         "--contact-law", choices=("linear", "hertz"), default="linear", help="thread flank law"
     )
-    s.add_argument("--max-step", type=_finite_float, default=5e-6, help="largest RK4 step [s]")
+    s.add_argument(
+        "--max-step",
+        type=_step,
+        default=5e-6,
+        help='largest RK4 step [s], or "auto": 0.6 of the stable step, at most 10 µs',
+    )
     s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
     s.add_argument("--seed", type=int, default=0, help="seed of variation, wear and noise")
     s.add_argument("--out", required=True, help="output file (.parquet or .mcap)")

@@ -133,6 +133,7 @@ def test_simulate_writes_parquet_and_plot(tmp_path, capsys):
         (["--out", "x.parquet", "--clearance=-1e-6"], "health.clearance_screw"),
         (["--out", "x.parquet", "--profile", "zigzag"], "--profile"),
         (["--out", "x.parquet", "--max-step", "1e-4"], "stable limit"),
+        (["--out", "x.parquet", "--max-step", "fast"], "neither a step in seconds nor 'auto'"),
         (["--out", "no/such/dir/x.parquet", "--duration", "0.001"], "does not exist"),
     ],
 )

@@ -20,7 +20,15 @@ from ..sensors import decimate
 from ..states import HealthState, OperatingProfile
 from . import _kernels
 from . import layout as L
-from .model import Model, SimulationOptions, build_model, initial_state, realised_clearances
+from .model import (
+    AUTO_MAX_STEP,
+    AUTO_STABLE_FRACTION,
+    Model,
+    SimulationOptions,
+    build_model,
+    initial_state,
+    realised_clearances,
+)
 
 #: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
 STABILITY_MARGIN = 0.9
@@ -136,6 +144,34 @@ def choose_step(max_step: float, sample_rate: float) -> tuple[float, int]:
     return 1.0 / (m * sample_rate), m
 
 
+def integration_step(
+    max_step: float | str, h_stable: float, f_max: float, sample_rate: float
+) -> tuple[float, int]:
+    """The RK4 step h = 1/(m·f_s) and m, for ``options.max_step`` and the model's stable step.
+
+    ``"auto"``: the largest such step below both :data:`AUTO_STABLE_FRACTION` of the stable step
+    and :data:`AUTO_MAX_STEP`, so a stiffer or more damped model takes a smaller step instead of
+    failing. A given
+    ``max_step`` is the user's bound: above the stable step it is refused, naming the limit.
+    """
+    if max_step == "auto":
+        if h_stable < 1e-8:
+            raise SimulationError(
+                f"stable step {h_stable:.3g} s of this model (highest natural frequency "
+                f"{f_max:.0f} Hz) is below 1e-8 s: soften the contacts or the contact damping"
+            )
+        return choose_step(min(AUTO_MAX_STEP, AUTO_STABLE_FRACTION * h_stable), sample_rate)
+    h, factor = choose_step(max_step, sample_rate)
+    if h > h_stable:
+        raise SimulationError(
+            f"integration step {h:.3g} s is above the stable limit {h_stable:.3g} s of this model "
+            f"(highest natural frequency {f_max:.0f} Hz, RK4 needs ω·h ≤ 2.8): lower "
+            'options.max_step (or "auto"), or soften the contacts (lower load, or '
+            "options.traction_stiffness_ratio)"
+        )
+    return h, factor
+
+
 def simulate(
     design: PRSMDesign | str | None = None,
     health: HealthState | None = None,
@@ -203,14 +239,8 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     design, health, profile = scenario.design, scenario.health, scenario.profile
     instrumentation, options, seed = scenario.instrumentation, scenario.options, scenario.seed
     model = build_model(design, health, profile, options, seed, scenario.drive_train)
-    h, factor = choose_step(options.max_step, instrumentation.sample_rate)
     h_stable, f_max = max_stable_step(model)
-    if h > h_stable:
-        raise SimulationError(
-            f"integration step {h:.3g} s is above the stable limit {h_stable:.3g} s of this model "
-            f"(highest natural frequency {f_max:.0f} Hz, RK4 needs ω·h ≤ 2.8): lower "
-            "options.max_step, or soften the contacts (lower load, or options.traction_stiffness_ratio)"
-        )
+    h, factor = integration_step(options.max_step, h_stable, f_max, instrumentation.sample_rate)
     n_steps = int(round(profile.duration / h))
     n_settle = int(round(options.settle_time / h))
     y = initial_state(model, -n_settle * h)

@@ -22,7 +22,13 @@ from prsm_health.drive_train import DriveTrain
 from prsm_health.dynamics import layout as L
 from prsm_health.dynamics._kernels import screw_motion
 from prsm_health.dynamics.model import build_model, initial_state
-from prsm_health.dynamics.simulate import _integrate, choose_step, linearised_modes
+from prsm_health.dynamics.simulate import (
+    _integrate,
+    choose_step,
+    integration_step,
+    linearised_modes,
+    max_stable_step,
+)
 from prsm_health.errors import ParameterError
 from prsm_health.states import LEAD_GRADES
 
@@ -33,7 +39,7 @@ def truth(profile, drive_train=None, health=None, options=None):
     model = build_model(
         preset("paper01"), health or HealthState(), profile, options, 1, drive_train
     )
-    h, _ = choose_step(options.max_step, 20_000.0)
+    h, _ = integration_step(options.max_step, *max_stable_step(model), 20_000.0)
     raw = _integrate(model, initial_state(model), h, int(round(profile.duration / h)), False)
     half = len(raw) // 2
     return {name: raw[half:, k] for k, name in enumerate(TRUTH_NAMES)}
@@ -132,7 +138,7 @@ def test_position_loop_follows_a_reversing_motion():
         drive="position_loop",
         load=50.0,
     )
-    t = truth(profile)
+    t = truth(profile, options=SimulationOptions(max_step=5e-6))  # a known step for the times
     knots = profile.motion_knots()
     h = choose_step(5e-6, 20_000.0)[0]
     n = int(round(profile.duration / h))
