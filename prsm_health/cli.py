@@ -814,7 +814,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     g = command("generate", "generate a labelled dataset from a recipe (resumable after Ctrl-C)")
     g.add_argument("recipe", help="TOML recipe (see datasets/ and docs/formats.md)")
-    g.add_argument("--out", required=True, help="dataset directory (created; rerun to resume)")
+    g.add_argument(
+        "--out",
+        required=True,
+        help="dataset directory or object-store URL, e.g. s3://bucket/prefix (created; rerun to "
+        "resume; credentials and endpoint from the environment, docs/formats.md)",
+    )
     g.add_argument(
         "--workers", type=int, default=None, help="local worker processes (None: all cores)"
     )
@@ -855,7 +860,7 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(func=_cmd_import)
 
     t = command("train", "train the clearance estimator and fault classifier on a dataset")
-    t.add_argument("dataset", help="dataset directory (prsm-health generate)")
+    t.add_argument("dataset", help="dataset directory or URL (prsm-health generate)")
     t.add_argument(
         "--out", required=True, help="model file, must end in .skops; metrics JSON beside it"
     )
@@ -883,7 +888,7 @@ def build_parser() -> argparse.ArgumentParser:
         "evaluate", "score a model on a dataset (generated or imported) through the diagnosis"
     )
     e.add_argument("model", help="model bundle (.skops)")
-    e.add_argument("dataset", help="dataset directory")
+    e.add_argument("dataset", help="dataset directory or URL")
     e.add_argument(
         "--split", choices=("test", "train", "all"), default="test", help="which runs to score"
     )

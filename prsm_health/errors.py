@@ -28,6 +28,12 @@ class RecipeError(PRSMHealthError):
     """A dataset recipe that cannot be used (the message names the key)."""
 
 
+class StorageError(PRSMHealthError):
+    """A dataset location that cannot be used: an unknown URL protocol, a storage backend that is
+    not installed, an unreachable store, a missing bucket, denied access (the message names the
+    location)."""
+
+
 class SimulationError(PRSMHealthError):
     """The integration cannot proceed (unstable step, non-finite state)."""
 
