@@ -393,7 +393,7 @@ def _cmd_diagnose(args) -> int:
     rows = [
         ("file", args.file, ""),
         ("fault class", result.fault_class, ""),
-        ("class set", ", ".join(result.class_set), "classes not ruled out"),
+        ("class set", ", ".join(result.class_set), "  not ruled out (90 %)"),
         (
             "clearance",
             f"{_um(c['estimate'])} [{_um(c['lower'])}, {_um(c['upper'])}]",
