@@ -120,8 +120,8 @@ def _cached(model, build):
     if hit is None:
         try:
             hit = build(model)
-        except (AttributeError, KeyError, ValueError, TypeError, IndexError):
-            hit = None  # internals not as expected: scikit-learn predicts
+        except Exception:  # internals not as expected, or the kernel cannot compile here:
+            hit = None  # scikit-learn predicts (slower, never different)
         _cache[model] = _UNSUPPORTED if hit is None else hit
     return None if hit is _UNSUPPORTED else hit
 
