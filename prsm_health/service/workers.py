@@ -8,6 +8,7 @@ import asyncio
 import contextlib
 import multiprocessing
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 
 import anyio
 
@@ -55,23 +56,24 @@ class WorkerPool:
         self.max_pending = limits.max_pending
         self.active = 0
         self._bundle = bundle
-        self._processes = None
-        if limits.processes:
-            self._processes = ProcessPoolExecutor(
-                limits.processes,
-                mp_context=multiprocessing.get_context("spawn"),
-                initializer=_start_process,
-                initargs=(bundle,),
-            )
+        self._n_processes = limits.processes
+        self._processes = self._new_pool() if limits.processes else None
         self._limiter = anyio.CapacityLimiter(limits.processes or limits.workers)
+
+    def _new_pool(self) -> ProcessPoolExecutor:
+        return ProcessPoolExecutor(
+            self._n_processes,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_start_process,
+            initargs=(self._bundle,),
+        )
 
     def start(self) -> None:
         """Start every diagnosis process now (each loads and warms the model), not at the
         first requests; returns when all are ready. Nothing to do with threads."""
         if self._processes is not None:
-            n = self._processes._max_workers
             # submitted together, so none finds an idle process and every one is started
-            for future in [self._processes.submit(_ready) for _ in range(n)]:
+            for future in [self._processes.submit(_ready) for _ in range(self._n_processes)]:
                 future.result()
 
     def close(self) -> None:
@@ -84,7 +86,16 @@ class WorkerPool:
         async with self._limiter:
             if self._processes is None:
                 return await anyio.to_thread.run_sync(fn, self._bundle, *args)
-            return await asyncio.wrap_future(self._processes.submit(_in_process, fn, *args))
+            try:
+                return await asyncio.wrap_future(self._processes.submit(_in_process, fn, *args))
+            except BrokenProcessPool:
+                # a diagnosis process died (killed, out of memory): a new pool for the next
+                # requests; this one is told to come back
+                broken, self._processes = self._processes, self._new_pool()
+                broken.shutdown(wait=False, cancel_futures=True)
+                raise HTTPError(
+                    503, "a diagnosis process stopped; retry in a few seconds", {"Retry-After": "2"}
+                ) from None
 
     @contextlib.contextmanager
     def admitted(self):
