@@ -23,8 +23,9 @@ References
    learning", ICML 2005 (boosted trees need calibration; Platt scaling beats isotonic
    regression when the calibration set is small).
 .. [4] M. Sadinle, J. Lei, L. Wasserman, "Least ambiguous set-valued classifiers with bounded
-   error levels", JASA 114 (2019) 223-234 (the class set {y : p_y >= t}, t from the held-out
-   probabilities of the true classes, section 2 and eq. 4).
+   error levels", JASA 114 (2019) 223-234 (the class set {y : p_y >= t_y}, t_y from the
+   held-out probabilities of class y's own samples: class-specific coverage, sections 2 and
+   4.1).
 """
 
 from __future__ import annotations
