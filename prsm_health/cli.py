@@ -363,15 +363,18 @@ def _cmd_serve(args) -> int:
         overrides["workers"] = args.workers
     if args.processes is not None:
         overrides["processes"] = args.processes
-    serve(
-        args.host,
-        args.port,
-        args.model,
-        args.db,
-        args.token,
-        limits=ServiceLimits(**overrides),
-        log_level=args.log_level,
-    )
+    try:
+        serve(
+            args.host,
+            args.port,
+            args.model,
+            args.db,
+            args.token,
+            limits=ServiceLimits(**overrides),
+            log_level=args.log_level,
+        )
+    except KeyboardInterrupt:  # Ctrl-C: uvicorn has shut down gracefully and said so
+        return 0
     return 0
 
 

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import ipaddress
 import logging
 import os
+import signal
 import socket
+import threading
 
 from ..errors import PRSMHealthError
 from .app import create_app
@@ -100,9 +103,33 @@ def serve(
         "required" if token else "not required (loopback only)",
     )
     try:
-        uvicorn.Server(config).run(sockets=[sock])
+        _server_class()(config).run(sockets=[sock])
     finally:
         sock.close()
+
+
+def _server_class():
+    import uvicorn
+
+    class Server(uvicorn.Server):
+        """uvicorn's server without its last step: after a graceful shutdown on Ctrl-C or
+        SIGTERM, uvicorn raises the signal again, and asyncio answers with a KeyboardInterrupt
+        traceback; a stopped service is a normal end of ``serve``."""
+
+        @contextlib.contextmanager
+        def capture_signals(self):
+            if threading.current_thread() is not threading.main_thread():
+                yield
+                return
+            handled = (signal.SIGINT, signal.SIGTERM)
+            original = {sig: signal.signal(sig, self.handle_exit) for sig in handled}
+            try:
+                yield
+            finally:
+                for sig, handler in original.items():
+                    signal.signal(sig, handler)
+
+    return Server
 
 
 def bind_socket(host: str, port: int) -> socket.socket:

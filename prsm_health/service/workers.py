@@ -7,6 +7,9 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import multiprocessing
+import os
+import signal
+import time
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
@@ -24,6 +27,8 @@ def _start_process(bundle) -> None:
     caches, compiled trees) so its first request does not pay for it."""
     from .diagnosing import warm_up
 
+    # Ctrl-C reaches the whole process group: the server stops these processes itself
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     global _process_bundle
     _process_bundle = bundle
     warm_up(bundle)
@@ -33,8 +38,10 @@ def _in_process(fn, *args):
     return fn(_process_bundle, *args)
 
 
-def _ready() -> bool:
-    return _process_bundle is not None
+def _ready() -> int:
+    # held a moment, so that one warm process cannot take every start-up probe alone
+    time.sleep(0.1)
+    return os.getpid()
 
 
 class WorkerPool:
@@ -72,9 +79,14 @@ class WorkerPool:
         """Start every diagnosis process now (each loads and warms the model), not at the
         first requests; returns when all are ready. Nothing to do with threads."""
         if self._processes is not None:
-            # submitted together, so none finds an idle process and every one is started
-            for future in [self._processes.submit(_ready) for _ in range(self._n_processes)]:
-                future.result()
+            # probes submitted together start every process; rounds until each has answered
+            # (its initialiser, hence its warm-up, done)
+            seen: set[int] = set()
+            for _ in range(600):
+                probes = [self._processes.submit(_ready) for _ in range(self._n_processes)]
+                seen |= {probe.result() for probe in probes}
+                if len(seen) >= self._n_processes:
+                    return
 
     def close(self) -> None:
         if self._processes is not None:

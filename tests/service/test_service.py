@@ -730,3 +730,29 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
     for pid in pids:  # shut down with the server (the killed one long gone)
         with pytest.raises(ProcessLookupError):
             os.kill(pid, 0)
+
+
+@pytest.mark.slow  # starts the command-line service in a subprocess
+@pytest.mark.parametrize("processes", ["0", "2"])
+def test_ctrl_c_stops_the_command_line_service_without_a_traceback(tmp_path, processes):
+    port = _free_port()
+    cmd = [sys.executable, "-m", "prsm_health.cli", "serve", "--port", str(port)]
+    cmd += ["--db", str(tmp_path / "h.sqlite"), "--processes", processes, "--log-level", "warning"]
+    log = tmp_path / "stderr.txt"
+    with open(log, "wb") as err:
+        proc = subprocess.Popen(cmd, stderr=err, stdout=subprocess.DEVNULL)
+        try:
+            deadline = time.monotonic() + 120
+            while True:  # warm: the diagnosis processes, if any, have loaded the model
+                try:
+                    if httpx.get(f"http://127.0.0.1:{port}/v1/health", timeout=2).json()["warm"]:
+                        break
+                except httpx.TransportError:
+                    pass
+                assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
+                time.sleep(0.2)
+        finally:
+            proc.send_signal(signal.SIGINT)
+            code = proc.wait(timeout=60)
+    text = log.read_text()
+    assert code == 0 and "Traceback" not in text, text
