@@ -90,6 +90,25 @@ def default_severity_recipes(reference: Recipe, per_class: int) -> dict[str, Rec
     return out
 
 
+def default_severity(bundle, reference: Recipe, work: Path, args) -> dict:
+    """Each class at its default severity (:func:`default_severity_recipes`) through the
+    diagnosis, pooled: fault and clearance reports."""
+    import pandas as pd
+
+    from prsm_health.evaluation import clearance_report, fault_report
+
+    parts = []
+    for recipe in default_severity_recipes(reference, args.per_class).values():
+        generate(recipe, work / recipe.name, workers=args.workers)
+        parts.append(evaluate_model(bundle, Dataset(work / recipe.name), split="all")[1])
+    pooled = pd.concat(parts, ignore_index=True)
+    return {
+        "per_class": args.per_class,
+        "fault": fault_report(pooled),
+        "clearance": clearance_report(pooled),
+    }
+
+
 def honesty_checks(bundle, reference: Recipe) -> dict:
     """Recordings the model must not answer confidently: another design, another
     instrumentation, no reversal, the accelerometer alone. Simulated from test-split points of
@@ -399,9 +418,6 @@ def experiment(reference: Recipe, instrumentation: str, work: Path, args) -> int
     """The reference recipe measured by another instrumentation profile: train, then the
     held-out split and each class at default severity through the diagnosis. Writes
     WORK/<profile>.skops and WORK/<profile>.metrics.json; the shipped model is not touched."""
-    import pandas as pd
-
-    from prsm_health.evaluation import clearance_report, fault_report
 
     source = dict(reference.source, instrumentation=instrumentation)
     source["name"] = f"{reference.name}-{instrumentation}"
@@ -415,21 +431,12 @@ def experiment(reference: Recipe, instrumentation: str, work: Path, args) -> int
     metrics = train(work / other.name, model_path, name=f"prsm-{instrumentation}", cv=3)
     bundle = load_bundle(model_path)
     held_out, _ = evaluate_model(bundle, Dataset(work / other.name))
-    parts = []
-    for recipe in default_severity_recipes(other, args.per_class).values():
-        generate(recipe, work / recipe.name, workers=args.workers)
-        parts.append(evaluate_model(bundle, Dataset(work / recipe.name), split="all")[1])
-    pooled = pd.concat(parts, ignore_index=True)
     result = {
         "instrumentation": instrumentation,
         "channels": list(bundle.channels),
         "indicators": len(bundle.feature_names),
         "held_out": held_out,
-        "default_severity": {
-            "per_class": args.per_class,
-            "fault": fault_report(pooled),
-            "clearance": clearance_report(pooled),
-        },
+        "default_severity": default_severity(bundle, other, work, args),
         "fault_importance": metrics.get("fault_importance"),
     }
     path = work / f"{instrumentation}.metrics.json"
@@ -442,9 +449,7 @@ def experiment(reference: Recipe, instrumentation: str, work: Path, args) -> int
 def evaluation(bundle, reference: Recipe, work: Path, args) -> dict:
     """The model through the diagnosis: off-grid set (and its figures), sensitivity table, each
     class at default severity, honesty checks."""
-    import pandas as pd
 
-    from prsm_health.evaluation import clearance_report, fault_report
     from prsm_health.plots import plot_evaluation
 
     out = {}
@@ -456,16 +461,7 @@ def evaluation(bundle, reference: Recipe, work: Path, args) -> dict:
     varied = [k for k in off.sweep if k not in ("mode", "samples", "repeats", "fault_case")]
     label_of = {"clearance": "clearance", "speed": "screw_speed", "load": "axial_load"}
     out["sensitivity"] = sensitivity_table(records, [label_of.get(k, k) for k in varied])
-    parts = []
-    for recipe in default_severity_recipes(reference, args.per_class).values():
-        generate(recipe, work / recipe.name, workers=args.workers)
-        parts.append(evaluate_model(bundle, Dataset(work / recipe.name), split="all")[1])
-    pooled = pd.concat(parts, ignore_index=True)
-    out["default_severity"] = {
-        "per_class": args.per_class,
-        "fault": fault_report(pooled),
-        "clearance": clearance_report(pooled),
-    }
+    out["default_severity"] = default_severity(bundle, reference, work, args)
     out["honesty"] = honesty_checks(bundle, reference)
     return out
 
