@@ -36,7 +36,7 @@ from .channels import MEASURED_TOPICS
 from .design import PRSMDesign
 from .design_files import load_design
 from .errors import PRSMHealthError
-from .features import FEATURES, NO_DESIGN, extract_features, indicator_groups, windows
+from .features import FEATURES, NO_DESIGN, extract_features_batch, indicator_groups, windows
 from .jsonable import finite_or_none
 from .run import MIN_SAMPLES, Run
 
@@ -90,7 +90,12 @@ class ModelBundle:
 
     def indicators(self, run: Run) -> dict:
         """The indicators of one window, as this model was trained to read them."""
-        return extract_features(run, self.design or NO_DESIGN, lead=self.metadata.get("lead"))
+        return self.indicators_batch([run])[0]
+
+    def indicators_batch(self, runs: list[Run]) -> list[dict]:
+        """:meth:`indicators` of several windows, computed together (equal to one by one)."""
+        design = self.design or NO_DESIGN
+        return extract_features_batch(runs, design, lead=self.metadata.get("lead"))
 
     @property
     def name(self) -> str:
@@ -500,7 +505,7 @@ def diagnose(
     bundle = bundle or load_bundle()
     run = run.without_truth().validate()
     parts, notes = split_windows(run, window or bundle.window)
-    rows = [bundle.indicators(part) for part in parts]
+    rows = bundle.indicators_batch(parts)
     per_window = diagnose_indicators(
         rows, bundle, [tuple(run.channels)] * len(rows), run.labels.get("design")
     )

@@ -38,10 +38,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
 from .errors import PRSMHealthError
-from .spectra import bandpass_sos, hann
+from .spectra import amplitude_spectrum, band_envelope, hann
 
 #: STFT window lengths of the kurtogram [samples].
 KURTOGRAM_WINDOWS = (16, 32, 64, 128, 256)
@@ -79,28 +78,51 @@ def kurtogram(x: np.ndarray, rate: float, low: float = 0.0) -> dict:
         [Hz] and SK values (for plots).
     """
     x = _check(x, rate)
-    best = (-math.inf, None, None)
+    levels = spectral_kurtosis(x[None], rate)
+    best = _best_band({n_w: (f, sk[0], k) for n_w, (f, sk, k) in levels.items()}, rate, low, len(x))
+    best["levels"] = {n_w: (f, sk[0]) for n_w, (f, sk, _) in levels.items()}
+    return best
+
+
+def spectral_kurtosis(x: np.ndarray, rate: float) -> dict[int, tuple]:
+    """Spectral kurtosis of each row of ``x`` (rows, n) at every window length of
+    :data:`KURTOGRAM_WINDOWS` that fits 8 times: n_w → (frequencies [Hz], SK (rows, bins),
+    frames K)."""
+    x = x - np.mean(x, axis=-1, keepdims=True)
     levels = {}
-    threshold = math.inf
     for n_w in KURTOGRAM_WINDOWS:
-        if len(x) < 8 * n_w:
+        if x.shape[-1] < 8 * n_w:
             continue
-        f, power = _stft_power(x - np.mean(x), rate, n_w)
-        mean2 = np.mean(power, axis=0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            sk = np.where(mean2 > 0, np.mean(power**2, axis=0) / mean2**2 - 2.0, 0.0)
+        sk = np.empty((len(x), n_w // 2 + 1))
+        # row by row: one row's frames fit the cache, a batch's do not (twice slower)
+        for row, out in zip(x, sk):
+            f, power = _stft_power(row, rate, n_w)
+            # means over the frames as products with a vector of ones: one BLAS call, where a
+            # reduction over the first axis of (frames, bins) walks it bin by bin
+            ones = np.full(len(power), 1.0 / len(power))
+            mean2 = ones @ power
+            with np.errstate(invalid="ignore", divide="ignore"):
+                out[:] = np.where(mean2 > 0, (ones @ (power * power)) / mean2**2 - 2.0, 0.0)
+        levels[n_w] = (f, sk, len(power))
+    return levels
+
+
+def _best_band(levels: dict, rate: float, low: float, n: int) -> dict:
+    """The (window length, frequency) of largest SK above its noise threshold, of one row."""
+    best = (-math.inf, None, None)
+    threshold = math.inf
+    for n_w, (f, sk, frames) in levels.items():
         half_width = rate / n_w  # Hann main lobe: ±f_s/N_w
         usable = (f - half_width >= low) & (f + half_width <= 0.45 * rate)
-        levels[n_w] = (f, sk)
         if usable.any():
             k = np.flatnonzero(usable)[np.argmax(sk[usable])]
-            level_threshold = SK_THRESHOLD_SIGMAS * 2.0 / math.sqrt(len(power))
+            level_threshold = SK_THRESHOLD_SIGMAS * 2.0 / math.sqrt(frames)
             if sk[k] - level_threshold > best[0] - threshold:
                 best = (float(sk[k]), (float(f[k] - half_width), float(f[k] + half_width)), n_w)
                 threshold = level_threshold
     if best[1] is None:
         raise PRSMHealthError(
-            f"no kurtogram band above {low:g} Hz fits below 0.45 × {rate:g} Hz in {len(x)} samples"
+            f"no kurtogram band above {low:g} Hz fits below 0.45 × {rate:g} Hz in {n} samples"
         )
     return {
         "band": best[1],
@@ -108,19 +130,20 @@ def kurtogram(x: np.ndarray, rate: float, low: float = 0.0) -> dict:
         "impulsive": best[0] > threshold,
         "threshold": threshold,
         "window": best[2],
-        "levels": levels,
     }
 
 
 def _stft_power(x: np.ndarray, rate: float, n_w: int) -> tuple[np.ndarray, np.ndarray]:
-    """(frequency [Hz], |STFT|² of shape (frames, bins)): Hann frames of ``n_w`` samples, 75 %
-    overlap, the signal extended by n_w/2 zeros at both ends and zero-padded to whole frames —
-    the frames of ``scipy.signal.stft(x, window="hann", nperseg=n_w, noverlap=3·n_w/4)``, in
-    one FFT call (its scaling, a constant factor, cancels in the spectral kurtosis)."""
+    """(frequency [Hz], |STFT|² of shape (..., frames, bins)): Hann frames of ``n_w`` samples,
+    75 % overlap, the signal extended by n_w/2 zeros at both ends and zero-padded to whole
+    frames — the frames of ``scipy.signal.stft(x, window="hann", nperseg=n_w, noverlap=3·n_w/4)``
+    in one FFT call (its scaling, a constant factor, cancels in the spectral kurtosis)."""
     step = n_w - 3 * n_w // 4
-    padded = np.concatenate([np.zeros(n_w // 2), x, np.zeros(n_w // 2)])
-    padded = np.concatenate([padded, np.zeros((-(len(padded) - n_w)) % step)])
-    frames = np.lib.stride_tricks.sliding_window_view(padded, n_w)[::step]
+    n = x.shape[-1] + 2 * (n_w // 2)
+    n += (-(n - n_w)) % step
+    padded = np.zeros(x.shape[:-1] + (n,))
+    padded[..., n_w // 2 : n_w // 2 + x.shape[-1]] = x
+    frames = np.lib.stride_tricks.sliding_window_view(padded, n_w, axis=-1)[..., ::step, :]
     z = np.fft.rfft(frames * hann(n_w), axis=-1)
     return np.fft.rfftfreq(n_w, 1.0 / rate), z.real**2 + z.imag**2
 
@@ -130,41 +153,76 @@ def envelope_amplitude_spectrum(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Amplitude spectrum of the envelope of ``x`` in ``band`` [Hz] (see the module docstring)."""
     x = _check(x, rate)
-    lo, hi = band
-    if not (0 < lo < hi < rate / 2):
-        raise PRSMHealthError(
-            f"band = {band!r} must satisfy 0 < low < high < rate/2 = {rate / 2:g} Hz"
-        )
-    sos = bandpass_sos(4, float(lo), float(hi), float(rate))
-    envelope = np.abs(signal.hilbert(signal.sosfiltfilt(sos, x - np.mean(x))))
-    window = hann(len(x))
-    amplitude = np.abs(np.fft.rfft((envelope - envelope.mean()) * window)) * 2.0 / np.sum(window)
-    return np.fft.rfftfreq(len(x), 1.0 / rate), amplitude
+    freq, amp = envelope_amplitude_spectra(x[None], rate, [band])
+    return freq, amp[0]
 
 
-def _between(freq: np.ndarray, edges: tuple) -> tuple[int, ...]:
-    """Indices of sorted ``freq``: (first ≥ lo, first > hi) for each (lo, hi) pair of ``edges``."""
-    lows = np.searchsorted(freq, edges[0::2], side="left")
-    highs = np.searchsorted(freq, edges[1::2], side="right")
-    return tuple(int(i) for pair in zip(lows, highs) for i in pair)
+def envelope_amplitude_spectra(
+    x: np.ndarray, rate: float, bands: list[tuple[float, float]]
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`envelope_amplitude_spectrum` of each row of ``x`` (rows, n) in its band."""
+    for lo, hi in bands:
+        if not (0 < lo < hi < rate / 2):
+            raise PRSMHealthError(
+                f"band = {(lo, hi)!r} must satisfy 0 < low < high < rate/2 = {rate / 2:g} Hz"
+            )
+    return amplitude_spectrum(band_envelope(x, rate, bands), rate)
 
 
 def line_and_ratio(
     freq: np.ndarray, amp: np.ndarray, target: float, limit: float
 ) -> tuple[float, float]:
     """(amplitude, line-to-floor ratio) at ``target`` [Hz]; NaN outside (0, ``limit``)."""
-    if not (math.isfinite(target) and 0 < target < limit):
-        return math.nan, math.nan
+    line, ratio = lines_and_ratios(freq, amp[None], np.array([[target]], float), np.array([limit]))
+    return float(line[0, 0]), float(ratio[0, 0])
+
+
+def lines_and_ratios(
+    freq: np.ndarray, amp: np.ndarray, targets: np.ndarray, limits: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(amplitudes, line-to-floor ratios) of shape (rows, targets) at ``targets`` [Hz] (rows,
+    targets) of the spectra ``amp`` (rows, bins); NaN outside (0, ``limits`` (rows,)).
+
+    The line is the largest amplitude within ±max(2 bins, 1 %) of the target, the floor the
+    median of the amplitudes from 0.5× to 1.5× the target without the line's bins. Every row
+    and target at once: the ranges, of different lengths, are gathered into one array padded
+    with ∓∞ (which leaves a maximum, and the middle of a sorted row, where they are)."""
     df = freq[1] - freq[0]
-    half = max(2 * df, 0.01 * target)
+    valid = np.isfinite(targets) & (targets > 0) & (targets < limits[:, None])
+    target = np.where(valid, targets, 1.0)
+    half = np.maximum(2 * df, 0.01 * target)
     # index ranges on the sorted frequencies: [a, b) near the line, [c, d) the surroundings
-    a, b, c, d = _between(freq, (target - half, target + half, 0.5 * target, 1.5 * target))
-    around = np.concatenate([amp[c:a], amp[max(b, c) : d]])
-    if b <= a or not len(around):
-        return math.nan, math.nan
-    line = float(np.max(amp[a:b]))
-    floor = float(np.median(around))
-    return line, (line / floor if floor > 0 else math.nan)
+    a = np.searchsorted(freq, target - half, side="left")
+    b = np.searchsorted(freq, target + half, side="right")
+    c = np.searchsorted(freq, 0.5 * target, side="left")
+    d = np.searchsorted(freq, 1.5 * target, side="right")
+    below = np.maximum(a - c, 0)  # [c, a)
+    above_start = np.maximum(b, c)
+    count = below + np.maximum(d - above_start, 0)  # then [max(b, c), d)
+    line_count = np.maximum(b - a, 0)
+    valid &= (line_count > 0) & (count > 0)
+    rows = np.arange(amp.shape[0])[:, None, None]
+    line_index = a[..., None] + np.arange(max(int(line_count.max(initial=0)), 1))
+    lines = _gather(amp, rows, line_index, line_count, -np.inf).max(axis=-1)
+    j = np.arange(max(int(count.max(initial=0)), 1))
+    index = np.where(
+        j < below[..., None], c[..., None] + j, above_start[..., None] + j - below[..., None]
+    )
+    around = np.sort(_gather(amp, rows, index, count, np.inf), axis=-1)
+    # np.median: the middle element, or the mean of the two middle ones
+    upper = np.take_along_axis(around, (count // 2)[..., None], axis=-1)[..., 0]
+    lower = np.take_along_axis(around, ((count - 1) // 2)[..., None], axis=-1)[..., 0]
+    floor = np.where(count % 2 == 1, upper, (lower + upper) / 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(valid & (floor > 0), lines / floor, np.nan)
+    return np.where(valid, lines, np.nan), ratio
+
+
+def _gather(amp: np.ndarray, rows: np.ndarray, index: np.ndarray, count: np.ndarray, pad: float):
+    """amp[row, index] for the first ``count`` of each (row, target)'s indices, ``pad`` after."""
+    inside = np.arange(index.shape[-1]) < count[..., None]
+    values = amp[rows, np.clip(np.where(inside, index, 0), 0, amp.shape[-1] - 1)]
+    return np.where(inside, values, pad)
 
 
 def defect_lines(
@@ -192,26 +250,80 @@ def defect_lines(
         ``band``, ``sk``, ``impulsive`` (None when the band was given) and ``lines``: name →
         {``amplitude``, ``ratio`` (at the fundamental), ``ratio_sum`` (sum of the ratios of
         the first ``harmonics`` harmonics that fit)}.
+
+    Raises
+    ------
+    PRSMHealthError
+        No kurtogram band fits (``band`` None).
     """
     x = _check(x, rate)
-    sk, impulsive = None, None
-    if band is None:
-        finite = [f for f in frequencies.values() if math.isfinite(f) and f > 0]
-        low = 3.0 * max(finite, default=0.0)
-        k = kurtogram(x, rate, low=max(low, 0.02 * rate))
-        band, sk, impulsive = k["band"], k["sk"], k["impulsive"]
-    freq, amp = envelope_amplitude_spectrum(x, rate, band)
-    limit = 0.5 * (band[1] - band[0])  # modulation a band of width B carries
-    lines = {}
-    for name, f0 in frequencies.items():
-        amplitude, ratio = line_and_ratio(freq, amp, f0, limit)
-        ratios = [ratio] + [
-            line_and_ratio(freq, amp, h * f0, limit)[1] for h in range(2, harmonics + 1)
-        ]
-        ratios = [r for r in ratios if math.isfinite(r)]
-        lines[name] = {
-            "amplitude": amplitude,
-            "ratio": ratio,
-            "ratio_sum": float(np.sum(ratios)) if ratios else math.nan,
+    result = defect_lines_batch(
+        x[None], rate, [frequencies], None if band is None else [band], harmonics
+    )[0]
+    if isinstance(result, PRSMHealthError):
+        raise result
+    return result
+
+
+def defect_lines_batch(
+    x: np.ndarray,
+    rate: float,
+    frequencies: list[dict[str, float]],
+    bands: list[tuple[float, float]] | None = None,
+    harmonics: int = HARMONICS,
+) -> list:
+    """:func:`defect_lines` of each row of ``x`` (rows, n) with its defect frequencies (and
+    band): the kurtograms, envelopes and line ratios of all rows computed together. A row
+    where no kurtogram band fits gets the :class:`PRSMHealthError` instead of a result."""
+    results: list = [None] * len(x)
+    if bands is None:
+        levels = spectral_kurtosis(x, rate)
+        bands = []
+        for i, row_frequencies in enumerate(frequencies):
+            finite = [f for f in row_frequencies.values() if math.isfinite(f) and f > 0]
+            low = max(3.0 * max(finite, default=0.0), 0.02 * rate)
+            try:
+                best = _best_band(
+                    {n_w: (f, sk[i], k) for n_w, (f, sk, k) in levels.items()},
+                    rate,
+                    low,
+                    x.shape[-1],
+                )
+            except PRSMHealthError as error:
+                results[i] = error
+                bands.append(None)
+                continue
+            results[i] = {"band": best["band"], "sk": best["sk"], "impulsive": best["impulsive"]}
+            bands.append(best["band"])
+    else:
+        results = [{"band": tuple(band), "sk": None, "impulsive": None} for band in bands]
+    rows = [i for i, band in enumerate(bands) if band is not None]
+    if not rows:
+        return results
+    freq, amp = envelope_amplitude_spectra(x[rows], rate, [bands[i] for i in rows])
+    # every harmonic of every defect of a row: targets (rows, defects × harmonics)
+    names = [list(frequencies[i]) for i in rows]
+    width = max(len(n) for n in names)
+    f0 = np.full((len(rows), width), np.nan)
+    for r, i in enumerate(rows):
+        f0[r, : len(names[r])] = list(frequencies[i].values())
+    targets = f0[:, :, None] * np.arange(1, harmonics + 1)
+    limits = np.array(
+        [0.5 * (bands[i][1] - bands[i][0]) for i in rows]
+    )  # modulation a band of width B carries
+    line, ratio = lines_and_ratios(freq, amp, targets.reshape(len(rows), -1), limits)
+    line = line.reshape(targets.shape)
+    ratio = ratio.reshape(targets.shape)
+    fits = np.isfinite(ratio)
+    # the sum of the harmonics' ratios that fit, harmonic by harmonic as np.sum adds them
+    ratio_sum = np.where(fits.any(axis=-1), np.where(fits, ratio, 0.0).sum(axis=-1), np.nan)
+    for r, i in enumerate(rows):
+        results[i]["lines"] = {
+            name: {
+                "amplitude": float(line[r, k, 0]),
+                "ratio": float(ratio[r, k, 0]),
+                "ratio_sum": float(ratio_sum[r, k]),
+            }
+            for k, name in enumerate(names[r])
         }
-    return {"band": band, "sk": sk, "impulsive": impulsive, "lines": lines}
+    return results

@@ -42,9 +42,9 @@ from scipy.ndimage import uniform_filter1d
 
 from .channels import CHANNEL_NAMES, VIBRATION
 from .design import PRSMDesign, preset
-from .envelope_analysis import defect_lines
+from .envelope_analysis import defect_lines_batch
 from .errors import PRSMHealthError
-from .gear_indicators import GEAR_INDICATORS, gear_indicators
+from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
 from .kinematics import defect_frequencies, speed_ratios
 from .run import MIN_SAMPLES, Run, ms_hint
 from .spectra import amplitude_spectrum, peak_frequency, welch_psd
@@ -75,6 +75,9 @@ DEFECTS = (
     "carrier",
 )
 ORDER_TRACKING_SPREAD = 0.05
+#: Most windows whose spectra share one FFT call in :func:`extract_features_batch` (memory:
+#: the kurtogram's frames of a window and channel take ≈ 1.5 MB).
+BATCH_WINDOWS = 16
 #: The design of a rig that is not a PRSM (imported recordings): no design-dependent indicators.
 NO_DESIGN = "none"
 
@@ -217,27 +220,32 @@ def axial_baseline_frequency(design: PRSMDesign, load: float) -> float:
     return math.sqrt(k / design.masses.nut_mass) / (2 * math.pi)
 
 
-def _classic(x: np.ndarray, rate: float, prefix: str, out: dict) -> None:
-    centred = x - np.mean(x)
+def _classic(centred: np.ndarray, rate: float) -> dict[str, np.ndarray]:
+    """Classic indicators of mean-removed signals (..., n): name suffix → array (...)."""
     # moments about the mean, biased (scipy.stats.kurtosis(fisher=False) and skew), from
     # products: numpy's general power costs ten times a multiplication
     squared = centred * centred
-    m2 = float(np.mean(squared))
-    rms = math.sqrt(m2)
-    peak = float(max(np.max(centred), -np.min(centred)))
-    out[f"{prefix}_rms"] = rms
-    out[f"{prefix}_peak"] = peak
-    out[f"{prefix}_crest"] = peak / rms if rms > 0 else np.nan
-    out[f"{prefix}_kurtosis"] = float(np.mean(squared * squared) / m2**2) if rms > 0 else np.nan
-    out[f"{prefix}_skewness"] = float(np.mean(squared * centred) / m2**1.5) if rms > 0 else np.nan
-    nperseg = min(1024, len(x))
+    m2 = np.mean(squared, axis=-1)
+    rms = np.sqrt(m2)
+    peak = np.maximum(np.max(centred, axis=-1), -np.min(centred, axis=-1))
+    live = rms > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = {
+            "rms": rms,
+            "peak": peak,
+            "crest": np.where(live, peak / rms, np.nan),
+            "kurtosis": np.where(live, np.mean(squared * squared, axis=-1) / m2**2, np.nan),
+            "skewness": np.where(live, np.mean(squared * centred, axis=-1) / m2**1.5, np.nan),
+        }
+    nperseg = min(1024, centred.shape[-1])
     f, psd = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
     df = f[1] - f[0]
     for lo, hi in BANDS:
-        band = (f >= lo) & (f < min(hi, rate / 2))
-        out[f"{prefix}_band_{int(lo)}_{int(hi)}"] = (
-            float(np.sum(psd[band]) * df) if band.any() else np.nan
+        a, b = np.searchsorted(f, (lo, min(hi, rate / 2)))  # the bins lo ≤ f < hi
+        out[f"band_{int(lo)}_{int(hi)}"] = (
+            np.sum(psd[..., a:b], axis=-1) * df if b > a else np.full(psd.shape[:-1], np.nan)
         )
+    return out
 
 
 def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
@@ -246,8 +254,9 @@ def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
     if not np.isfinite(target) or target <= 0 or target >= freq[-1]:
         return np.nan
     half = max(2 * (freq[1] - freq[0]), 0.005 * target)
-    band = (freq >= target - half) & (freq <= target + half)
-    return float(np.max(amp[band])) if band.any() else np.nan
+    a = np.searchsorted(freq, target - half, side="left")
+    b = np.searchsorted(freq, target + half, side="right")
+    return float(np.max(amp[a:b])) if b > a else np.nan
 
 
 def _order_resample(x: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, float]:
@@ -312,6 +321,40 @@ def extract_features(
     PRSMHealthError
         No nut acceleration and no nut position; an unknown or absent truth signal asked for.
     """
+    return extract_features_batch([run], design, truth=truth, lead=lead)[0]
+
+
+def extract_features_batch(
+    runs: list[Run],
+    design: PRSMDesign | str | None = None,
+    *,
+    truth: tuple[str, ...] = (),
+    lead: float | None = None,
+) -> list[dict[str, float]]:
+    """:func:`extract_features` of several windows, one dict each, equal to one at a time.
+
+    Windows of one length, sample rate, channel set and design (the windows of a recording)
+    are processed together, up to :data:`BATCH_WINDOWS` at a time: each spectral step is one
+    FFT call for all their channels.
+    """
+    prepared = [_prepare(run, design, truth, lead) for run in runs]
+    groups: dict[tuple, list[int]] = {}
+    for i, (run, run_design, run_lead) in enumerate(prepared):
+        key = (len(run), run.sample_rate, tuple(sorted(run.channels)), run_design, run_lead)
+        groups.setdefault(key, []).append(i)
+    rows: list = [None] * len(runs)
+    for index in groups.values():
+        for start in range(0, len(index), BATCH_WINDOWS):
+            chunk = index[start : start + BATCH_WINDOWS]
+            _, run_design, run_lead = prepared[chunk[0]]
+            found = _extract([prepared[i][0] for i in chunk], run_design, run_lead)
+            for i, row in zip(chunk, found):
+                rows[i] = row
+    return rows
+
+
+def _prepare(run: Run, design, truth, lead) -> tuple[Run, PRSMDesign | None, float | None]:
+    """(the window with only what is read, checked; its design; the lead without a design)."""
     truth = _truth_request(run, truth)
     # Only what is read: the measured channels and the truth signals asked for.
     run = Run(
@@ -333,76 +376,120 @@ def extract_features(
         lead = lead if lead is not None else run.labels.get("lead")
     elif isinstance(design, str):
         design = preset(design)
-    rate = run.sample_rate
-    out = dict.fromkeys(FEATURES, np.nan)
-    for name in truth:
-        out.update(dict.fromkeys(TRUTH_FEATURES[name], np.nan))
-    ch = run.channels
+    return run, design, lead
 
-    for name, prefix in SHORT.items():
-        if name in ch:
-            _classic(ch[name], rate, prefix, out)
 
-    speed = ch.get("screw_speed")
-    load = ch.get("axial_load")
+def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> list[dict]:
+    """The indicators of windows of one length, rate, channel set and design."""
+    rate = runs[0].sample_rate
+    rows = []
+    for run in runs:
+        row = dict.fromkeys(FEATURES, np.nan)
+        for name in run.truth:
+            row.update(dict.fromkeys(TRUTH_FEATURES[name], np.nan))
+        rows.append(row)
+    present = runs[0].channels
+    vibration = [name for name in SHORT if name in present]
+    # mean-removed vibration (channel, window, sample): what every spectral indicator reads
+    centred = {}
+    if vibration:
+        stacked = np.stack([[run.channels[name] for run in runs] for name in vibration])
+        stacked = stacked - np.mean(stacked, axis=-1, keepdims=True)
+        centred = dict(zip(vibration, stacked))
+        for suffix, values in _classic(stacked, rate).items():
+            for c, name in enumerate(vibration):
+                for row, value in zip(rows, values[c]):
+                    row[f"{SHORT[name]}_{suffix}"] = float(value)
+
     ratios = speed_ratios(design) if design is not None else None
+    for run, row in zip(runs, rows):
+        _operating(run, row)
+    _mesh(runs, rows, design, ratios, centred)
+    # ---- time-synchronous averages and the gear indicators (docs/gear-indicators.md)
+    if "screw_angle" in present and design is not None:
+        _gear(runs, design, ratios, rows)
+    # ---- envelope lines at the defect frequencies, band by spectral kurtosis
+    if design is not None:
+        _envelope(runs, rows, design)
+    # ---- shifted axial frequency
+    if "nut_axial_accel" in centred:
+        _axial(centred["nut_axial_accel"], rate, design, rows)
     # nut travel per screw radian: the design's kinematics, or the rig's lead
     nut_per_rad = ratios.nut if ratios is not None else (lead / (2 * math.pi) if lead else None)
+    for run, row in zip(runs, rows):
+        _torque_and_reversals(run, nut_per_rad, row)
+    return rows
+
+
+def _operating(run: Run, out: dict) -> None:
+    speed, load = run.channels.get("screw_speed"), run.channels.get("axial_load")
     if speed is not None:
         out["speed_mean"] = float(np.mean(speed))
     if load is not None:
         out["load_mean"] = float(np.mean(load))
         out["load_range"] = float(np.ptp(load))
 
-    # ---- gear mesh lines
+
+def _carrier_frequency(run: Run, ratios) -> float:
+    """Carrier rotation frequency [Hz]: measured screw speed × carrier ratio, or the truth."""
+    speed = run.channels.get("screw_speed")
     if "carrier_speed" in run.truth:
-        f_c = abs(float(np.mean(run.truth["carrier_speed"]))) / (2 * math.pi)
-    elif speed is not None:
-        f_c = abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi) if ratios else np.nan
-    else:
-        f_c = np.nan
-    if design is not None and design.gear is not None and np.isfinite(f_c) and f_c > 0:
-        z = design.gear.ring_teeth
-        out["mesh_frequency"] = z * f_c
+        return abs(float(np.mean(run.truth["carrier_speed"]))) / (2 * math.pi)
+    if speed is not None and ratios:
+        return abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi)
+    return np.nan
+
+
+def _mesh(runs, rows, design, ratios, centred: dict) -> None:
+    """Gear mesh lines: the windows at steady speed share one spectrum call per channel."""
+    if design is None or design.gear is None:
+        return
+    z = design.gear.ring_teeth
+    rate = runs[0].sample_rate
+    steady = []
+    for w, (run, row) in enumerate(zip(runs, rows)):
+        f_c = _carrier_frequency(run, ratios)
+        if not (np.isfinite(f_c) and f_c > 0):
+            continue
+        row["mesh_frequency"] = z * f_c
+        ch = run.channels
+        speed = ch.get("screw_speed")
         varying = speed is not None and np.std(speed) > ORDER_TRACKING_SPREAD * abs(np.mean(speed))
-        for name in MESH_CHANNELS:
-            if name not in ch:
-                continue
-            s = SHORT[name]
-            if (
-                varying
-                and "screw_angle" in ch
-                and np.all(np.diff(ch["screw_angle"]) * np.sign(np.mean(speed)) > 0)
-            ):
-                # order domain: mesh order = z·(carrier/screw) per screw radian
-                x, d_angle = _order_resample(ch[name], ch["screw_angle"])
-                orders, amp = amplitude_spectrum(x, 1.0 / d_angle)
-                base, side = (
-                    z * abs(ratios.carrier) / (2 * math.pi),
-                    abs(ratios.carrier) / (2 * math.pi),
-                )
-            else:
-                orders, amp = amplitude_spectrum(ch[name], rate)
-                base, side = z * f_c, f_c
-            for k in (1, 2, 3):
-                out[f"{s}_mesh_h{k}"] = _line(orders, amp, k * base)
-            out[f"{s}_mesh_sidebands"] = np.nansum(
-                [_line(orders, amp, base - side), _line(orders, amp, base + side)]
-            )
+        if (
+            varying
+            and "screw_angle" in ch
+            and np.all(np.diff(ch["screw_angle"]) * np.sign(np.mean(speed)) > 0)
+        ):
+            # order domain: mesh order = z·(carrier/screw) per screw radian
+            for name in MESH_CHANNELS:
+                if name in ch:
+                    x, d_angle = _order_resample(ch[name], ch["screw_angle"])
+                    orders, amp = amplitude_spectrum(x, 1.0 / d_angle)
+                    per_rad = abs(ratios.carrier) / (2 * math.pi)
+                    _mesh_lines(orders, amp, z * per_rad, per_rad, SHORT[name], row)
+        else:
+            steady.append((w, f_c))
+    for name in MESH_CHANNELS:
+        if name in centred and steady:
+            freq, amp = amplitude_spectrum(centred[name][[w for w, _ in steady]], rate)
+            for (w, f_c), spectrum in zip(steady, amp):
+                _mesh_lines(freq, spectrum, z * f_c, f_c, SHORT[name], rows[w])
 
-    # ---- time-synchronous averages and the gear indicators (docs/gear-indicators.md)
-    if "screw_angle" in ch and design is not None:
-        _gear(ch, design, ratios, out)
 
-    # ---- envelope lines at the defect frequencies, band by spectral kurtosis
-    if design is not None and speed is not None and abs(float(np.mean(speed))) > 0:
-        _envelope(ch, rate, defect_frequencies(design, float(np.mean(speed))), out)
+def _mesh_lines(freq, amp, base: float, side: float, prefix: str, out: dict) -> None:
+    for k in (1, 2, 3):
+        out[f"{prefix}_mesh_h{k}"] = _line(freq, amp, k * base)
+    out[f"{prefix}_mesh_sidebands"] = np.nansum(
+        [_line(freq, amp, base - side), _line(freq, amp, base + side)]
+    )
 
-    # ---- shifted axial frequency
-    if "nut_axial_accel" in ch:
-        x = ch["nut_axial_accel"]
-        nperseg = min(512, len(x))
-        f, psd = welch_psd(x - np.mean(x), rate, nperseg, 3 * nperseg // 4)
+
+def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
+    """Dominant nut axial frequency and its shift from the healthy baseline, every window's
+    Welch spectrum in one call."""
+    nperseg = min(512, centred.shape[-1])
+    f, psds = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
+    for psd, out in zip(psds, rows):
         f_dom = peak_frequency(f, psd, (100.0, min(2000.0, 0.45 * rate)))
         out["axial_dominant_frequency"] = f_dom
         band = (f > 0.9 * f_dom) & (f < 1.1 * f_dom)
@@ -416,6 +503,11 @@ def extract_features(
             out["axial_frequency_shift"] = f_dom - f0
             out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
 
+
+def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> None:
+    ch = run.channels
+    speed, load = ch.get("screw_speed"), ch.get("axial_load")
+    rate = run.sample_rate
     # ---- torque
     if "friction_torque" in run.truth:
         out["friction_torque_mean"] = float(np.mean(run.truth["friction_torque"]))
@@ -453,19 +545,27 @@ def extract_features(
             out["lost_motion"] = _lost_motion(
                 ch["nut_position"], ch["screw_angle"], nut_per_rad, side
             )
-    return out
 
 
-def _envelope(ch: dict, rate: float, frequencies: dict, out: dict) -> None:
-    names = {k: v for k, v in frequencies.items() if k in DEFECTS}
-    for name in ENVELOPE_CHANNELS:
-        if name not in ch:
+def _envelope(runs, rows, design: PRSMDesign) -> None:
+    """Envelope lines of every window with a speed: all windows' and channels' kurtograms and
+    envelope spectra together."""
+    present = [name for name in ENVELOPE_CHANNELS if name in runs[0].channels]
+    jobs = []  # (window, channel, its defect frequencies)
+    for w, run in enumerate(runs):
+        speed = run.channels.get("screw_speed")
+        if speed is not None and abs(float(np.mean(speed))) > 0:
+            frequencies = defect_frequencies(design, float(np.mean(speed)))
+            names = {k: v for k, v in frequencies.items() if k in DEFECTS}
+            jobs += [(w, name, names) for name in present]
+    if not jobs:
+        return
+    x = np.stack([runs[w].channels[name] for w, name, _ in jobs])
+    results = defect_lines_batch(x, runs[0].sample_rate, [names for _, _, names in jobs])
+    for (w, name, _), result in zip(jobs, results):
+        if isinstance(result, PRSMHealthError):  # no band fits (low sample rate, short window)
             continue
-        s = SHORT[name]
-        try:
-            result = defect_lines(ch[name], rate, names)
-        except PRSMHealthError:  # no band fits (low sample rate, very short window)
-            continue
+        s, out = SHORT[name], rows[w]
         out[f"{s}_sk_max"] = result["sk"]
         out[f"{s}_sk_band_centre"] = 0.5 * sum(result["band"])
         for defect, line in result["lines"].items():
@@ -474,20 +574,32 @@ def _envelope(ch: dict, rate: float, frequencies: dict, out: dict) -> None:
             out[f"{s}_env_{defect}_ratio_sum"] = line["ratio_sum"]
 
 
-def _gear(ch: dict, design: PRSMDesign, ratios, out: dict) -> None:
+def _gear(runs, design: PRSMDesign, ratios, rows) -> None:
+    """TSA indicators over carrier and roller periods: each period's TSAs of every window
+    and channel in one call."""
     periods = {"carrier": (ratios.carrier, None), "roller": (ratios.roller_spin_relative, None)}
     if design.gear is not None and design.variant != "recirculating":
         periods = {
             "carrier": (ratios.carrier, design.gear.ring_teeth),
             "roller": (ratios.roller_spin_relative, design.gear.roller_teeth),
         }
-    for name in TSA_CHANNELS:
-        if name not in ch:
-            continue
-        for period, (ratio, teeth) in periods.items():
-            values = gear_indicators(ch[name], ch["screw_angle"], 2 * math.pi / abs(ratio), teeth)
-            for key in TSA_INDICATORS:
-                out[f"{SHORT[name]}_tsa_{period}_{key}"] = values[key]
+    present = [name for name in TSA_CHANNELS if name in runs[0].channels]
+    if not present:
+        return
+    for period, (ratio, teeth) in periods.items():
+        by_count: dict[int, list] = {}  # periods averaged → [(window, TSAs of its channels)]
+        for w, run in enumerate(runs):
+            x = np.stack([run.channels[name] for name in present])
+            averages = synchronous_averages(
+                x, run.channels["screw_angle"], 2 * math.pi / abs(ratio)
+            )
+            if averages is not None:
+                by_count.setdefault(averages[1], []).append((w, averages[0]))
+        for count, found in by_count.items():
+            values = tsa_indicators(np.concatenate([tsa for _, tsa in found]), count, teeth)
+            for k, (w, name) in enumerate((w, name) for w, _ in found for name in present):
+                for key in TSA_INDICATORS:
+                    rows[w][f"{SHORT[name]}_tsa_{period}_{key}"] = float(values[key][k])
 
 
 def _lost_motion(position: np.ndarray, angle: np.ndarray, lead: float, side: np.ndarray) -> float:

@@ -49,9 +49,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import signal
 
 from .errors import PRSMHealthError
+from .spectra import analytic_signal
 
 #: Fewest whole periods a TSA averages before its indicators are given (NaN below): with one
 #: period nothing is averaged, and the ensemble of NA4 needs two.
@@ -70,9 +70,9 @@ def angle_resample(
 
     Parameters
     ----------
-    x : ndarray
-        Signal sampled in time.
-    angle : ndarray [rad]
+    x : ndarray (..., n)
+        Signal sampled in time; several signals of the same instants on leading axes.
+    angle : ndarray (n,) [rad]
         The measured shaft angle at the same instants; monotonic in either direction (a
         negative direction is mirrored so the grid increases).
     period : float [rad of ``angle``]
@@ -81,12 +81,12 @@ def angle_resample(
 
     Returns
     -------
-    (resampled signal of ``n_periods·samples_per_period`` samples, n_periods)
+    (resampled signal of ``n_periods·samples_per_period`` samples (..., n_periods·samples_per_period), n_periods)
         Linear interpolation: at the 20 kHz diagnostics rate a mesh cycle spans ≥ 30 samples, so
         its error (McFadden 1987: attenuation of high orders) stays below 1 % of the mesh line.
     """
     x, angle = np.asarray(x, float), np.asarray(angle, float)
-    if x.shape != angle.shape or x.ndim != 1:
+    if x.shape[-1:] != angle.shape or angle.ndim != 1:
         raise PRSMHealthError(
             f"x and angle must be 1-D of one length, got {x.shape}, {angle.shape}"
         )
@@ -103,25 +103,30 @@ def angle_resample(
     angle = angle * direction
     n_periods = int((angle[-1] - angle[0]) // period)
     if n_periods < 1:
-        return np.empty(0), 0
+        return np.empty(x.shape[:-1] + (0,)), 0
     grid = angle[0] + np.arange(n_periods * samples_per_period) * (period / samples_per_period)
-    return np.interp(grid, angle, x), n_periods
+    rows = x.reshape(-1, x.shape[-1])
+    out = np.empty((len(rows), len(grid)))
+    for row, values in zip(out, rows):
+        row[:] = np.interp(grid, angle, values)
+    return out.reshape(x.shape[:-1] + (len(grid),)), n_periods
 
 
 def time_synchronous_average(
     x: np.ndarray, angle: np.ndarray, period: float, samples_per_period: int = 1024
 ) -> tuple[np.ndarray, np.ndarray]:
-    """TSA of ``x`` over whole periods of ``angle``: (average over one period, the periods).
+    """TSA of ``x`` (..., n) over whole periods of ``angle``: (average over one period
+    (..., samples_per_period), the periods (..., n_periods, samples_per_period)).
 
     The second array holds every period's samples (rows), the ensemble NA4 and NB4 read.
     """
     resampled, n = angle_resample(x, angle, period, samples_per_period)
-    periods = resampled.reshape(n, samples_per_period) if n else np.empty((0, samples_per_period))
-    return (periods.mean(axis=0) if n else np.empty(0)), periods
+    periods = resampled.reshape(resampled.shape[:-1] + (n, samples_per_period))
+    return (periods.mean(axis=-2) if n else resampled), periods
 
 
 def _orders(tsa: np.ndarray) -> np.ndarray:
-    return np.fft.rfft(tsa)
+    return np.fft.rfft(tsa, axis=-1)
 
 
 def _keep(n_bins: int, orders: list[int]) -> np.ndarray:
@@ -141,29 +146,40 @@ def _component_orders(mesh_order: int, sidebands: bool) -> list[int]:
     return orders
 
 
+def _value(x):
+    """A float for the indicator of one record, the array of several records' as it is."""
+    return float(x) if np.ndim(x) == 0 else x
+
+
 def split_signals(tsa: np.ndarray, mesh_order: int) -> dict[str, np.ndarray]:
-    """The regular, difference and residual signals of a TSA (see the module docstring)."""
+    """The regular, difference and residual signals of a TSA (see the module docstring); of
+    every TSA on the leading axes of ``tsa`` (..., N)."""
     spectrum = _orders(tsa)
-    n = len(tsa)
-    regular_mask = _keep(len(spectrum), _component_orders(mesh_order, sidebands=True))
-    residual_mask = _keep(len(spectrum), _component_orders(mesh_order, sidebands=False))
-    regular = np.fft.irfft(np.where(regular_mask, spectrum, 0.0), n)
-    centred = tsa - np.mean(tsa)
+    n = tsa.shape[-1]
+    regular_mask = _keep(spectrum.shape[-1], _component_orders(mesh_order, sidebands=True))
+    residual_mask = _keep(spectrum.shape[-1], _component_orders(mesh_order, sidebands=False))
+    regular = np.fft.irfft(np.where(regular_mask, spectrum, 0.0), n, axis=-1)
+    centred = tsa - np.mean(tsa, axis=-1, keepdims=True)
     return {
         "regular": regular,
         "difference": centred - regular,
-        "residual": centred - np.fft.irfft(np.where(residual_mask, spectrum, 0.0), n),
+        "residual": centred - np.fft.irfft(np.where(residual_mask, spectrum, 0.0), n, axis=-1),
     }
 
 
 def _moment_ratio(d: np.ndarray, power: int) -> float:
-    """N^(p/2−1) Σ(d − d̄)^p / [Σ(d − d̄)²]^(p/2): FM4 (p = 4), M6A (6), M8A (8)."""
-    d = d - np.mean(d)
-    s2 = float(np.sum(d**2))
-    if s2 <= 0:
-        return math.nan
-    n = len(d)
-    return float(n ** (power / 2 - 1) * np.sum(d**power) / s2 ** (power / 2))
+    """N^(p/2−1) Σ(d − d̄)^p / [Σ(d − d̄)²]^(p/2): FM4 (p = 4), M6A (6), M8A (8), along the
+    last axis."""
+    d = d - np.mean(d, axis=-1, keepdims=True)
+    squared = d * d
+    s2 = np.sum(squared, axis=-1)
+    n = d.shape[-1]
+    # d^p from products: numpy's general power costs ten times a multiplication
+    fourth = squared * squared
+    d_p = fourth if power == 4 else fourth * squared if power == 6 else fourth * fourth
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = n ** (power / 2 - 1) * np.sum(d_p, axis=-1) / s2 ** (power / 2)
+    return _value(np.where(s2 > 0, ratio, math.nan))
 
 
 def fm4(difference: np.ndarray) -> float:
@@ -183,31 +199,34 @@ def m8a(difference: np.ndarray) -> float:
 
 def fm0(tsa: np.ndarray, mesh_order: int, harmonics: int = MESH_HARMONICS) -> float:
     """FM0 = peak-to-peak of the TSA / Σ amplitudes of its mesh harmonics (Stewart 1977)."""
-    amplitude = 2.0 * np.abs(_orders(tsa)) / len(tsa)
-    lines = [
-        amplitude[h * mesh_order]
-        for h in range(1, harmonics + 1)
-        if h * mesh_order < len(amplitude)
-    ]
-    total = float(np.sum(lines))
-    return float(np.ptp(tsa)) / total if total > 0 else math.nan
+    amplitude = 2.0 * np.abs(_orders(tsa)) / tsa.shape[-1]
+    total = np.zeros(tsa.shape[:-1])
+    for h in range(1, harmonics + 1):
+        if h * mesh_order < amplitude.shape[-1]:
+            total = total + amplitude[..., h * mesh_order]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return _value(np.where(total > 0, np.ptp(tsa, axis=-1) / total, math.nan))
 
 
 def ensemble_ratio(current: np.ndarray, earlier: list[float] = ()) -> float:
     """N Σ(x − x̄)⁴ / {(1/M) Σ_j Σ_i (x_ij − x̄_j)²}²: NA4 (x = residual signal) and NB4
     (x = mesh-band envelope) of the current record, ``earlier`` the Σ_i (x_ij − x̄_j)² of the
     run's earlier records (Zakrajsek et al. 1993; Decker et al. 1994). Without earlier records
-    (M = 1) it is the current record's kurtosis, as at the start of a run."""
-    c = current - np.mean(current)
-    variance = float(np.mean([np.sum(c**2), *earlier]))
-    if variance <= 0:
-        return math.nan
-    return float(len(c) * np.sum(c**4) / variance**2)
+    (M = 1) it is the current record's kurtosis, as at the start of a run. Several current
+    records on the leading axes of ``current`` (..., N): each as the first of its run."""
+    c = current - np.mean(current, axis=-1, keepdims=True)
+    squared = c * c
+    variance = np.sum(squared, axis=-1)
+    if len(earlier):
+        variance = np.mean([float(variance), *earlier])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = c.shape[-1] * np.sum(squared * squared, axis=-1) / variance**2
+    return _value(np.where(variance > 0, ratio, math.nan))
 
 
 def sum_of_squares(x: np.ndarray) -> float:
     """Σ_i (x_i − x̄)², a record's entry in the run ensemble of NA4/NB4."""
-    return float(np.sum((x - np.mean(x)) ** 2))
+    return _value(np.sum((x - np.mean(x, axis=-1, keepdims=True)) ** 2, axis=-1))
 
 
 def mesh_band_envelope(tsa: np.ndarray, mesh_order: int) -> np.ndarray:
@@ -217,16 +236,18 @@ def mesh_band_envelope(tsa: np.ndarray, mesh_order: int) -> np.ndarray:
     of the first-order sidebands only would smooth a one-tooth burst away)."""
     spectrum = _orders(tsa)
     half = max(1, mesh_order // 2)
-    band = _keep(len(spectrum), list(range(mesh_order - half, mesh_order + half + 1)))
-    return np.abs(signal.hilbert(np.fft.irfft(np.where(band, spectrum, 0.0), len(tsa))))
+    band = _keep(spectrum.shape[-1], list(range(mesh_order - half, mesh_order + half + 1)))
+    banded = np.fft.irfft(np.where(band, spectrum, 0.0), tsa.shape[-1], axis=-1)
+    return np.abs(analytic_signal(banded))
 
 
 def sideband_amplitudes(tsa: np.ndarray, mesh_order: int) -> tuple[float, float]:
     """Amplitudes of the first-order sidebands of the mesh fundamental (S₋₁, S₊₁)."""
-    amplitude = 2.0 * np.abs(_orders(tsa)) / len(tsa)
-    if mesh_order + 1 >= len(amplitude) or mesh_order < 2:
-        return math.nan, math.nan
-    return float(amplitude[mesh_order - 1]), float(amplitude[mesh_order + 1])
+    amplitude = 2.0 * np.abs(_orders(tsa)) / tsa.shape[-1]
+    if mesh_order + 1 >= amplitude.shape[-1] or mesh_order < 2:
+        nan = _value(np.full(tsa.shape[:-1], math.nan))
+        return nan, nan
+    return _value(amplitude[..., mesh_order - 1]), _value(amplitude[..., mesh_order + 1])
 
 
 #: The indicators :func:`gear_indicators` returns, in order.
@@ -261,35 +282,72 @@ def gear_indicators(
     what came before it. ``mesh_order`` None (a period without a gear mesh): only the TSA's RMS
     and the period count.
     """
-    out = dict.fromkeys(GEAR_INDICATORS, math.nan)
+    averages = synchronous_averages(x, angle, period, samples_per_period)
+    if averages is None:
+        return dict.fromkeys(GEAR_INDICATORS, math.nan)
+    tsa, n_periods = averages
+    values = tsa_indicators(tsa[None], n_periods, mesh_order, ensemble)
+    return {name: float(values[name][0]) for name in GEAR_INDICATORS}
+
+
+def synchronous_averages(
+    x: np.ndarray, angle: np.ndarray, period: float, samples_per_period: int = 1024
+) -> tuple[np.ndarray, int] | None:
+    """(TSA (..., samples_per_period), periods averaged) of the signals ``x`` (..., n) over
+    ``angle``, or None when the shaft stopped or turned back in the window (no angle domain).
+
+    Raises
+    ------
+    PRSMHealthError
+        Non-finite input, a bad period.
+    """
     try:
         tsa, periods = time_synchronous_average(x, angle, period, samples_per_period)
     except PRSMHealthError:
         if np.all(np.isfinite(angle)) and np.all(np.isfinite(x)):
-            return out  # the shaft stopped or turned back in this window: no angle domain
+            return None
         raise
-    out["periods"] = float(len(periods))
-    if len(periods) < MIN_PERIODS:
+    return tsa, periods.shape[-2]
+
+
+def tsa_indicators(
+    tsa: np.ndarray,
+    n_periods: int,
+    mesh_order: int | None,
+    ensemble: dict[str, list[float]] | None = None,
+) -> dict[str, np.ndarray]:
+    """:data:`GEAR_INDICATORS` of the TSAs on the rows of ``tsa`` (rows, N), each over
+    ``n_periods`` periods, as arrays (rows,); see :func:`gear_indicators` (``ensemble`` only
+    for one row)."""
+    rows = tsa.shape[0]
+    out = {name: np.full(rows, math.nan) for name in GEAR_INDICATORS}
+    out["periods"][:] = n_periods
+    if n_periods < MIN_PERIODS:
         return out
-    out["tsa_rms"] = float(np.std(tsa))
-    if mesh_order is None or not 2 <= mesh_order < samples_per_period // 2 - 1:
+    out["tsa_rms"] = np.std(tsa, axis=-1)
+    if mesh_order is None or not 2 <= mesh_order < tsa.shape[-1] // 2 - 1:
         return out
     parts = split_signals(tsa, mesh_order)
     d = parts["difference"]
-    out["fm0"] = fm0(tsa, mesh_order)
-    out["fm4"], out["m6a"], out["m8a"] = fm4(d), m6a(d), m8a(d)
-    rms_regular = float(np.sqrt(np.mean(parts["regular"] ** 2)))
-    out["energy_ratio"] = (
-        float(np.sqrt(np.mean(d**2))) / rms_regular if rms_regular > 0 else math.nan
-    )
-    ensemble = ensemble if ensemble is not None else {"residual": [], "envelope": []}
+    out["fm0"] = np.atleast_1d(fm0(tsa, mesh_order))
+    out["fm4"], out["m6a"], out["m8a"] = (np.atleast_1d(ratio(d)) for ratio in (fm4, m6a, m8a))
+    rms_regular = np.sqrt(np.mean(parts["regular"] ** 2, axis=-1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out["energy_ratio"] = np.where(
+            rms_regular > 0, np.sqrt(np.mean(d**2, axis=-1)) / rms_regular, math.nan
+        )
     envelope = mesh_band_envelope(tsa, mesh_order)
-    out["na4"] = ensemble_ratio(parts["residual"], ensemble["residual"])
-    out["nb4"] = ensemble_ratio(envelope, ensemble["envelope"])
-    ensemble["residual"].append(sum_of_squares(parts["residual"]))
-    ensemble["envelope"].append(sum_of_squares(envelope))
-    lower, upper = sideband_amplitudes(tsa, mesh_order)
+    if ensemble is None:
+        out["na4"] = np.atleast_1d(ensemble_ratio(parts["residual"]))
+        out["nb4"] = np.atleast_1d(ensemble_ratio(envelope))
+    else:
+        out["na4"][0] = ensemble_ratio(parts["residual"][0], ensemble["residual"])
+        out["nb4"][0] = ensemble_ratio(envelope[0], ensemble["envelope"])
+        ensemble["residual"].append(sum_of_squares(parts["residual"][0]))
+        ensemble["envelope"].append(sum_of_squares(envelope[0]))
+    lower, upper = (np.atleast_1d(s) for s in sideband_amplitudes(tsa, mesh_order))
     out["sideband_index"] = 0.5 * (lower + upper)
-    sigma = float(np.std(tsa))
-    out["sideband_level_factor"] = (lower + upper) / sigma if sigma > 0 else math.nan
+    sigma = out["tsa_rms"]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out["sideband_level_factor"] = np.where(sigma > 0, (lower + upper) / sigma, math.nan)
     return out
