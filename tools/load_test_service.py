@@ -3,13 +3,15 @@
 Starts the service in a subprocess on 127.0.0.1 (a free port, a bearer token, a throw-away
 history database), sends a fixed number of ``POST /v1/diagnose`` requests from concurrent
 clients (each a simulated recording of ``--window`` seconds at ``--sample-rate``, stored in an
-asset's history), polls ``GET /v1/health`` meanwhile, then stops the service. The run ends
+asset's history; ``--body`` json, arrow, parquet, mcap, or multipart for a Parquet upload to
+``/v1/diagnose/file``), polls ``GET /v1/health`` meanwhile, then stops the service. The run ends
 when every request is answered or at ``--time-cap`` seconds, whichever comes first.
 
 Prints throughput, latency percentiles, errors, and the /v1/health latency under load::
 
     python tools/load_test_service.py                 # 8 clients, 160 requests, 1 s at 20 kHz
     python tools/load_test_service.py --clients 4 --requests 40 --json
+    python tools/load_test_service.py --body arrow --processes 2
 
 Targets only 127.0.0.1: the service it measures is the one it starts.
 """
@@ -63,6 +65,52 @@ def _recording(window: float, sample_rate: float):
     )
 
 
+#: Content types of the binary bodies of POST /v1/diagnose.
+BODY_TYPES = {
+    "arrow": "application/vnd.apache.arrow.stream",
+    "parquet": "application/vnd.apache.parquet",
+    "mcap": "application/vnd.mcap",
+}
+
+
+def _binary(rec, fmt: str) -> bytes:
+    """The measured recording (truth left out) as a file of format ``fmt``, in memory."""
+    measured = rec.without_truth()
+    if fmt == "arrow":
+        from prsm_health.io.arrow import write_run_arrow
+
+        return write_run_arrow(measured)
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"recording.{fmt}"
+        if fmt == "parquet":
+            from prsm_health.io.parquet import write_run_parquet
+
+            write_run_parquet(measured, path)
+        else:
+            from prsm_health.mcap import write_mcap
+
+            write_mcap(measured, path)
+        return path.read_bytes()
+
+
+def _cpu_seconds(server_pid: int) -> dict | None:
+    """CPU time [s] used so far by the server process, its diagnosis processes and this load
+    generator (None without psutil)."""
+    try:
+        import psutil
+    except ImportError:
+        return None
+    try:
+        server = psutil.Process(server_pid)
+        children = server.children(recursive=True)
+        used = {"server": sum(server.cpu_times()[:2])}
+        used["diagnosis_processes"] = sum(sum(c.cpu_times()[:2]) for c in children)
+        used["load_generator"] = sum(psutil.Process().cpu_times()[:2])
+    except psutil.Error:
+        return None
+    return used
+
+
 def _percentiles(values: list[float]) -> dict:
     if not values:
         return {"n": 0}
@@ -79,18 +127,26 @@ def _percentiles(values: list[float]) -> dict:
 class _Service:
     """``serve`` in a subprocess; stopped with SIGINT (uvicorn's graceful shutdown)."""
 
-    def __init__(self, db: Path, model: str | None, workers: int | None, processes: int):
+    def __init__(
+        self,
+        db: Path,
+        model: str | None,
+        workers: int | None,
+        processes: int,
+        profile: str | None = None,
+    ):
         self.port = _free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         self.token = secrets.token_urlsafe(24)
         settings = {"workers": workers, "processes": processes}
         limits = f"ServiceLimits(**{ {k: v for k, v in settings.items() if v}!r})"
-        code = (
-            "import sys\n"
-            "from prsm_health.service import ServiceLimits, serve\n"
+        call = (
             f"serve('127.0.0.1', {self.port}, sys.argv[1] or None, sys.argv[2], "
-            f"limits={limits}, log_level='warning')\n"
+            f"limits={limits}, log_level='warning')"
         )
+        if profile:  # the server's main thread (event loop) under cProfile, stats on exit
+            call = f"import cProfile\ncProfile.run({call!r}, {str(profile)!r})"
+        code = f"import sys\nfrom prsm_health.service import ServiceLimits, serve\n{call}\n"
         env = {**os.environ, "PRSM_HEALTH_TOKEN": self.token}
         self.log_path = db.with_name("service.log")
         self._log = open(self.log_path, "wb")  # noqa: SIM115 - closed in stop()
@@ -138,7 +194,13 @@ def run(args) -> dict:
 
     from prsm_health.service import ServiceLimits
 
-    rec = _recording(args.window, args.sample_rate)
+    if args.recording:
+        from prsm_health.io import read_recording
+
+        rec = read_recording(args.recording).without_truth()
+        args.window = len(rec) / rec.sample_rate
+    else:
+        rec = _recording(args.window, args.sample_rate)
     if args.body == "json":
         payloads = [
             json.dumps(
@@ -151,13 +213,8 @@ def run(args) -> dict:
             for c in range(args.clients)
         ]
         body_bytes = len(payloads[0])
-    else:  # the recording as a Parquet file, uploaded as multipart form data
-        from prsm_health.io.parquet import write_run_parquet
-
-        with tempfile.TemporaryDirectory() as tmp:
-            path = Path(tmp) / "recording.parquet"
-            write_run_parquet(rec.without_truth(), path)  # a measured recording
-            parquet = path.read_bytes()
+    elif args.body == "multipart":  # a Parquet file uploaded as multipart form data
+        parquet = _binary(rec, "parquet")
         payloads = [
             {
                 "files": {"file": ("recording.parquet", parquet)},
@@ -166,8 +223,25 @@ def run(args) -> dict:
             for c in range(args.clients)
         ]
         body_bytes = len(parquet)
+    else:  # the recording as a binary body of POST /v1/diagnose, asset in the query
+        binary = _binary(rec, args.body)
+        payloads = [
+            {
+                "content": binary,
+                "headers": {"content-type": BODY_TYPES[args.body]},
+                "params": {"asset_id": f"load-test-{c}"},
+            }
+            for c in range(args.clients)
+        ]
+        body_bytes = len(binary)
     with tempfile.TemporaryDirectory(prefix="prsm-health-load-") as tmp:
-        service = _Service(Path(tmp) / "history.sqlite", args.model, args.workers, args.processes)
+        service = _Service(
+            Path(tmp) / "history.sqlite",
+            args.model,
+            args.workers,
+            args.processes,
+            args.profile_server,
+        )
         try:
             ready = service.wait_ready(args.startup_timeout)
             headers = {"Authorization": f"Bearer {service.token}"}
@@ -199,8 +273,10 @@ def run(args) -> dict:
                                     content=payloads[k],
                                     headers={"content-type": "application/json"},
                                 )
-                            else:
+                            elif args.body == "multipart":
                                 r = c.post("/v1/diagnose/file", **payloads[k])
+                            else:
+                                r = c.post("/v1/diagnose", **payloads[k])
                             ok = r.status_code == 200
                             problem = None if ok else f"{r.status_code}: {r.text[:200]}"
                         except httpx.HTTPError as exc:
@@ -227,6 +303,7 @@ def run(args) -> dict:
                         done.wait(args.health_interval)
 
             poller = threading.Thread(target=poll_health, daemon=True)
+            cpu_before = _cpu_seconds(service.proc.pid)
             poller.start()
             clients = [threading.Thread(target=client, args=(k,)) for k in range(args.clients)]
             for t in clients:
@@ -234,6 +311,7 @@ def run(args) -> dict:
             for t in clients:
                 t.join()
             elapsed = time.perf_counter() - start
+            cpu_after = _cpu_seconds(service.proc.pid)
             done.set()
             poller.join()
             with httpx.Client(base_url=service.url, headers=headers, timeout=30) as c:
@@ -271,6 +349,11 @@ def run(args) -> dict:
         "stored_in_history": stored,
         "health_under_load": _percentiles(health),
         "health_errors": len(health_errors),
+        "cpu_ms_per_request": {
+            k: 1e3 * (cpu_after[k] - cpu_before[k]) / max(n_ok, 1) for k in cpu_before
+        }
+        if cpu_before and cpu_after
+        else None,
         "server_log_tail": server_log if (errors or health_errors) else "",
     }
 
@@ -298,6 +381,13 @@ def _report(r: dict) -> str:
             f"  /v1/health under load ({h['n']} polls): p50 {h['p50_ms']:.1f} ms, "
             f"p99 {h['p99_ms']:.1f} ms, max {h['max_ms']:.1f} ms, errors {r['health_errors']}"
         )
+    if r.get("cpu_ms_per_request"):
+        lines.append(
+            "  CPU per answered request: "
+            + ", ".join(
+                f"{k.replace('_', ' ')} {v:.1f} ms" for k, v in r["cpu_ms_per_request"].items()
+            )
+        )
     if r["server_log_tail"]:
         lines.append("  server log (tail):")
         lines.extend("    " + line for line in r["server_log_tail"].splitlines())
@@ -312,6 +402,12 @@ def main(argv=None) -> int:
     p.add_argument("--requests", type=int, default=160, help="diagnose requests in total")
     p.add_argument("--time-cap", type=float, default=180.0, help="stop issuing after this [s]")
     p.add_argument("--window", type=float, default=1.0, help="recording per request [s]")
+    p.add_argument(
+        "--recording",
+        default=None,
+        help="send this recording (.parquet, .mcap or .csv) instead of simulating one "
+        "(--window and --sample-rate then come from it)",
+    )
     p.add_argument("--sample-rate", type=float, default=20000.0, help="[Hz]")
     p.add_argument("--health-interval", type=float, default=0.05, help="/v1/health poll period [s]")
     p.add_argument(
@@ -327,10 +423,19 @@ def main(argv=None) -> int:
     p.add_argument("--startup-timeout", type=float, default=180.0, help="[s]")
     p.add_argument("--json", action="store_true", help="machine-readable result")
     p.add_argument(
+        "--profile-server",
+        metavar="FILE",
+        default=None,
+        help="run the server's main thread (event loop) under cProfile and write the stats "
+        "to FILE when it stops (read with python -m pstats FILE)",
+    )
+    p.add_argument(
         "--body",
-        choices=("json", "parquet"),
+        choices=("json", "arrow", "parquet", "mcap", "multipart"),
         default="json",
-        help="request body: the JSON contract, or a Parquet file as multipart upload",
+        help="request body of POST /v1/diagnose: the JSON contract, or the recording as an "
+        "Arrow IPC stream, a Parquet file or an MCAP file; multipart: a Parquet file uploaded "
+        "to POST /v1/diagnose/file",
     )
     args = p.parse_args(argv)
     if not (1 <= args.clients <= 64 and 1 <= args.requests <= 10_000 and 0 < args.time_cap <= 3600):

@@ -35,14 +35,21 @@ def write_run_parquet(run: Run, path: str | Path) -> Path:
     return path
 
 
-def read_run_parquet(path: str | Path) -> Run:
+def read_run_parquet(path: str | Path | bytes, *, name: str | None = None) -> Run:
     """Read a run written by :func:`write_run_parquet`, or any Parquet file with a ``time``
-    column [s] and measured channel columns; ``truth_<name>`` columns go to ``Run.truth``."""
+    column [s] and measured channel columns; ``truth_<name>`` columns go to ``Run.truth``.
+
+    ``path`` may also be the file's bytes (a buffer); ``name`` then names it in messages."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
-    path = Path(path)
+    if isinstance(path, (bytes, bytearray, memoryview, pa.Buffer)):
+        source, path = pa.BufferReader(path), Path(name or "recording")
+    else:
+        path = Path(path)
+        source = path
     try:
-        table = pq.read_table(path)
+        table = pq.read_table(source)
     except FileNotFoundError:
         raise PRSMHealthError(f"{path}: no such file") from None
     except Exception as exc:  # pyarrow raises several types for damaged files

@@ -4,9 +4,11 @@ The service only parses requests, calls the diagnosis library (:mod:`prsm_health
 and formats its results; no physics and no feature logic live here. Endpoints (API reference
 and curl examples in docs/service.md):
 
-* ``POST /v1/diagnose`` — JSON body with ``sample_rate`` [Hz] and contract ``channels``;
-  returns the Diagnosis contract (docs/service.md; ``windows`` only when the recording spans
-  more than one model window);
+* ``POST /v1/diagnose`` — JSON body with ``sample_rate`` [Hz] and contract ``channels``, or
+  the recording as a binary body (Arrow IPC stream, Parquet, MCAP: decoded by
+  :mod:`prsm_health.io`, asset and operating point as query parameters); returns the Diagnosis
+  contract (docs/service.md; ``windows`` only when the recording spans more than one model
+  window);
 * ``POST /v1/diagnose/file`` — multipart upload of a ``.mcap`` or ``.parquet`` recording;
   returns the whole-recording diagnosis and the per-window diagnoses;
 * ``GET /v1/assets/{asset_id}/history`` — diagnoses stored for an asset, oldest first;
@@ -16,8 +18,9 @@ Safety: the service binds 127.0.0.1 by default; with a bearer token (``token`` a
 the ``PRSM_HEALTH_TOKEN`` environment variable) every endpoint requires
 ``Authorization: Bearer <token>``, and :func:`serve` refuses a non-loopback address without
 one. Request bodies, recording lengths and sample rates are bounded (:class:`ServiceLimits`);
-user errors are 4xx responses ``{"error": "…"}``. Uploads are streamed into a private
-temporary directory removed after the request. Parsing and diagnosis run in worker threads
+user errors are 4xx responses ``{"error": "…"}``; a compressed body or upload is checked
+against the limits from the sizes it declares before it is decoded. Uploads are streamed into a
+private temporary directory removed after the request. Parsing and diagnosis run in worker threads
 (at most :attr:`ServiceLimits.workers` at once) so ``/v1/health`` answers while they run.
 
 History is kept in SQLite (:class:`HistoryStore`): WAL journal, one transaction per request,

@@ -1,27 +1,38 @@
-"""The work done in worker threads: a request body or an upload → a :class:`~prsm_health.run.Run`
-→ the library's diagnosis → JSON. The service's calls into :mod:`prsm_health.diagnosis`
-(``diagnose`` in :func:`diagnosis_json`, ``read_recording`` in :func:`read_upload`) are here;
-recording checks are :meth:`Run.validate <prsm_health.run.Run.validate>`'s.
+"""The work done in worker threads or diagnosis processes: a request body (JSON, or a binary
+recording decoded by :mod:`prsm_health.io`) or an upload → a :class:`~prsm_health.run.Run` →
+the library's diagnosis → the encoded answer and its history rows (:class:`Answer`). The
+service's calls into :mod:`prsm_health.diagnosis` and :mod:`prsm_health.io` are here; recording
+checks are :meth:`Run.validate <prsm_health.run.Run.validate>`'s.
+
+Everything that crosses to and from a diagnosis process is plain data: the request body as
+bytes (decoded in the process: cheaper to send than decoded arrays), and back the answer's
+JSON bytes and the history rows (built there too, so the server process never encodes a
+diagnosis).
 """
 
 from __future__ import annotations
 
 import logging
+import math
+import re
 import threading
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..channels import CHANNEL_NAMES
+from ..design import PRESETS
 from ..diagnosis import diagnose
-from ..errors import PRSMHealthError
-from ..io import read_recording
+from ..errors import PRSMHealthError, TruncatedRecordingWarning
+from ..io import read_recording, read_recording_bytes
 from ..jsonable import json_ready
 from ..run import MIN_SAMPLES, Run
+from .history import history_rows
 from .limits import MAX_ABS_VALUE, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
-from .schemas import DiagnoseRequest, parse_diagnose_request
-from .uploads import ReceivedUpload, precheck_upload
+from .schemas import ASSET_ID_PATTERN, DiagnoseRequest, parse_diagnose_request
+from .uploads import ReceivedUpload, precheck_recording, precheck_upload
 
 log = logging.getLogger("prsm_health.service")
 
@@ -56,7 +67,69 @@ def warm_up(bundle) -> None:
     diagnosis_json(Run(np.arange(n) / rate, blank, rate), bundle)
 
 
-# ----------------------------------------------------------------------------- JSON body
+@dataclass(frozen=True)
+class Answer:
+    """What a diagnose request gives back to the route: the encoded JSON answer and, when the
+    request named an asset, its history rows (:func:`~.history.history_rows`)."""
+
+    encoded: bytes
+    history: list | None = None
+
+
+@dataclass(frozen=True)
+class BodyParams:
+    """The query parameters of a binary body (a JSON body carries them as fields)."""
+
+    asset_id: str | None = None
+    speed: float | None = None
+    load: float | None = None
+    design: str | None = None
+
+    FIELDS = ("asset_id", "speed", "load", "design")
+
+    @classmethod
+    def from_query(cls, items: list[tuple[str, str]]) -> BodyParams:
+        """Parsed and checked query parameters; 422 naming the parameter otherwise."""
+        values: dict = {}
+        for name, text in items:
+            if name not in cls.FIELDS:
+                raise HTTPError(
+                    422,
+                    f"unknown query parameter {name!r}; a binary body takes "
+                    f"{', '.join(cls.FIELDS)}",
+                )
+            if name in values:
+                raise HTTPError(422, f"query parameter {name!r} given twice")
+            if name in ("speed", "load"):
+                try:
+                    number = float(text)
+                except ValueError:
+                    number = math.nan
+                if not math.isfinite(number):
+                    raise HTTPError(422, f"{name} = {text[:40]!r}: a finite number expected")
+                values[name] = number
+            elif name == "asset_id":
+                if not re.fullmatch(ASSET_ID_PATTERN, text):
+                    raise HTTPError(422, f"asset_id {text[:140]!r} must match {ASSET_ID_PATTERN}")
+                values[name] = text
+            else:
+                if text not in PRESETS:
+                    raise HTTPError(
+                        422, f"design = {text[:40]!r}: one of {', '.join(sorted(PRESETS))}"
+                    )
+                values[name] = text
+        return cls(**values)
+
+
+def check_design(design: str | None, bundle) -> None:
+    if design is not None and design != bundle.design_name:
+        raise HTTPError(
+            422,
+            f"design = {design!r}: model {bundle.name!r} was trained on design "
+            f"{bundle.design_name!r}; load a model for {design!r} (prsm-health serve --model)",
+        )
+
+
 def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     """The recording a validated request describes (channels of equal length, the model's
     design); the nominal speed and load become labels."""
@@ -74,12 +147,7 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     if len(set(lengths.values())) > 1:
         described = ", ".join(f"{k} {v}" for k, v in lengths.items())
         raise HTTPError(422, f"channels must have equal lengths; got {described}")
-    if req.design is not None and req.design != bundle.design_name:
-        raise HTTPError(
-            422,
-            f"design = {req.design!r}: model {bundle.name!r} was trained on design "
-            f"{bundle.design_name!r}; load a model for {req.design!r} (prsm-health serve --model)",
-        )
+    check_design(req.design, bundle)
     n = next(iter(lengths.values()))
     rate = float(req.sample_rate)  # range checked by the request's validation
     labels = {"design": bundle.design_name}
@@ -90,32 +158,108 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     return Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
 
 
-def diagnose_body(bundle, body: bytes, limits: ServiceLimits):
-    """``POST /v1/diagnose``: ``(request, diagnosis dict, encoded answer)``; ``windows`` only
-    when the recording spans more than one model window."""
-    req = parse_diagnose_request(body, limits)
-    run = run_from_request(req, bundle)
+def _too_long(n: int, rate: float, limits: ServiceLimits) -> HTTPError:
+    return HTTPError(
+        413,
+        f"recording too long: {n} samples = {n / rate:.6g} s at {rate:g} Hz; /v1/diagnose "
+        f"accepts at most {limits.max_window_seconds:g} s per request (upload longer "
+        "recordings to /v1/diagnose/file)",
+    )
+
+
+def read_body(body: bytes, fmt: str, limits: ServiceLimits) -> tuple[Run, list[str]]:
+    """A binary body of ``POST /v1/diagnose`` (``fmt``: ``arrow``, ``parquet``, ``mcap``) as
+    a measured recording, and the reader's notes. What the body declares (rows, decompressed
+    size) is checked against the limits before it is decoded."""
+    name = f"{fmt} body"
+    if not body:
+        raise HTTPError(400, f"empty request body: send the recording ({fmt})")
+    precheck_recording(
+        body,
+        fmt,
+        max_samples=limits.max_body_samples,
+        max_decoded_bytes=limits.max_body_decoded_bytes,
+        samples_hint=(
+            f" by /v1/diagnose ({limits.max_window_seconds:g} s at "
+            f"{limits.max_sample_rate:g} Hz; upload longer recordings to /v1/diagnose/file)"
+        ),
+        decoded_hint=" (max_body_decoded_bytes)",
+        name=name,
+    )
+    with _warnings_lock, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TruncatedRecordingWarning)
+        try:
+            run = read_recording_bytes(body, fmt, name)
+        except PRSMHealthError as exc:
+            raise HTTPError(422, str(exc)) from None
+        except (ValueError, TypeError, OverflowError, KeyError, IndexError) as exc:
+            log.warning("unreadable %s", name, exc_info=True)
+            raise HTTPError(
+                422, f"{name}: not a readable recording ({type(exc).__name__}: {exc})"
+            ) from None
+    notes = [str(w.message) for w in caught if issubclass(w.category, TruncatedRecordingWarning)]
+    return run.without_truth(), notes
+
+
+def diagnose_body(
+    bundle,
+    body: bytes,
+    fmt: str,
+    params: BodyParams | None,
+    limits: ServiceLimits,
+    received_at: str,
+) -> Answer:
+    """``POST /v1/diagnose``: a JSON body (``fmt`` ``"json"``, fields in the body) or a binary
+    recording (``params`` from the query) → the Diagnosis contract (``windows`` only when the
+    recording spans more than one model window) and, with an ``asset_id``, its history row."""
+    notes: list[str] = []
+    if fmt == "json":
+        req = parse_diagnose_request(body, limits)
+        run = run_from_request(req, bundle)
+        params = BodyParams(req.asset_id, req.speed, req.load, req.design)
+    else:
+        params = params or BodyParams()
+        check_design(params.design, bundle)
+        run, notes = read_body(body, fmt, limits)
+        labels = dict(run.labels)
+        if params.design is not None:
+            labels["design"] = params.design
+        if params.speed is not None:
+            labels["screw_speed"] = params.speed
+        if params.load is not None:
+            labels["axial_load"] = params.load
+        run = Run(run.time, run.channels, run.sample_rate, labels, run.scenario)
+        limits.check_sample_rate(run.sample_rate, _what(fmt))  # a JSON body's is validated
     max_samples = limits.max_json_samples(run.sample_rate)
     if len(run) > max_samples:
-        raise HTTPError(
-            413,
-            f"recording too long: {len(run)} samples = {len(run) / run.sample_rate:.6g} s at "
-            f"{run.sample_rate:g} Hz; /v1/diagnose accepts at most "
-            f"{limits.max_window_seconds:g} s per request (upload longer recordings to "
-            "/v1/diagnose/file)",
-        )
-    check_run(run, limits, max_samples=max(max_samples, MIN_SAMPLES))
+        raise _too_long(len(run), run.sample_rate, limits)
+    check_run(run, limits, max_samples=max(max_samples, MIN_SAMPLES), what=_what(fmt))
     result = diagnosis_json(run, bundle)
     if len(result.get("windows", [])) <= 1:
         result.pop("windows", None)
-    return req, result, encode(result)
+    if notes:
+        result["warnings"] = [*notes, *result.get("warnings", [])]
+    history = None
+    if params.asset_id is not None:
+        history = history_rows(
+            params.asset_id,
+            [result],
+            received_at=received_at,
+            source=fmt,
+            speed=params.speed,
+            load=params.load,
+        )
+    return Answer(encode(result), history)
+
+
+def _what(fmt: str) -> str:
+    return "" if fmt == "json" else f"{fmt} body"
 
 
 # ----------------------------------------------------------------------------- upload
 def read_upload(upload: ReceivedUpload, limits: ServiceLimits) -> tuple[Run, list[str]]:
     """The uploaded recording and the reader's notes (truncated recording); messages name the
     client's file name, never the server path."""
-    from ..errors import TruncatedRecordingWarning
 
     def hide_path(text: str) -> str:
         return text.replace(str(upload.path), upload.filename or "upload")
@@ -147,9 +291,15 @@ def read_upload(upload: ReceivedUpload, limits: ServiceLimits) -> tuple[Run, lis
     return run.without_truth(), notes
 
 
-def diagnose_upload(bundle, upload: ReceivedUpload, limits: ServiceLimits):
-    """``POST /v1/diagnose/file``: ``(answer dict, encoded answer)`` — the whole-recording
-    diagnosis, the per-window ones, what was read and the reader's notes."""
+def diagnose_upload(
+    bundle,
+    upload: ReceivedUpload,
+    limits: ServiceLimits,
+    asset_id: str | None = None,
+    received_at: str | None = None,
+) -> Answer:
+    """``POST /v1/diagnose/file``: the whole-recording diagnosis, the per-window ones, what
+    was read and the reader's notes; with an ``asset_id``, the windows' history rows."""
     run, notes = read_upload(upload, limits)
     check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
     result = diagnosis_json(run, bundle)
@@ -162,4 +312,13 @@ def diagnose_upload(bundle, upload: ReceivedUpload, limits: ServiceLimits):
         "channels": [c for c in CHANNEL_NAMES if c in run.channels],
     }
     answer = {"diagnosis": result, "windows": per_window, "recording": recording, "warnings": notes}
-    return answer, encode(answer)
+    history = None
+    if asset_id is not None:
+        history = history_rows(
+            asset_id,
+            per_window,
+            received_at=received_at,
+            source="file",
+            filename=upload.filename,
+        )
+    return Answer(encode(answer), history)

@@ -32,7 +32,7 @@ CREATE TABLE IF NOT EXISTS diagnoses (
     id                  INTEGER PRIMARY KEY AUTOINCREMENT,
     asset_id            TEXT    NOT NULL,
     received_at         TEXT    NOT NULL,  -- server receive time, UTC ISO-8601 (microseconds)
-    source              TEXT    NOT NULL,  -- 'json' or 'file'
+    source              TEXT    NOT NULL,  -- 'json', 'arrow', 'parquet', 'mcap' or 'file'
     filename            TEXT,              -- uploaded file name (source 'file')
     window_index        INTEGER,           -- per-window rows of an upload
     window_start        REAL,              -- [s]
@@ -154,33 +154,21 @@ class HistoryStore:
     ) -> list[int]:
         """Store diagnoses (contract dicts; a ``window`` key places one in its recording) in
         one transaction; returns their ids."""
-        received_at = received_at or utc_now()
-        rows = []
-        for d in diagnoses:
-            c = d.get("clearance") or {}
-            w = d.get("window") or {}
-            model = d.get("model") or {}
-            rows.append(
-                (
-                    asset_id,
-                    received_at,
-                    source,
-                    filename,
-                    w.get("index"),
-                    w.get("start"),
-                    w.get("end"),
-                    speed,
-                    load,
-                    c.get("estimate"),
-                    c.get("lower"),
-                    c.get("upper"),
-                    d.get("fault_class"),
-                    dumps(d.get("class_probabilities", {})),
-                    str(model.get("name", "")),
-                    str(model.get("version", "")),
-                    dumps(d),
-                )
+        return self.add_rows(
+            history_rows(
+                asset_id,
+                diagnoses,
+                received_at=received_at,
+                source=source,
+                filename=filename,
+                speed=speed,
+                load=load,
             )
+        )
+
+    def add_rows(self, rows: list[tuple]) -> list[int]:
+        """Store rows made by :func:`history_rows` (possibly in another process) in one
+        transaction; returns their ids."""
         ids = []
         with self._lock, self._transaction():
             for row in rows:
@@ -246,3 +234,46 @@ class HistoryStore:
     def close(self) -> None:
         with self._lock:
             self._conn.close()
+
+
+def history_rows(
+    asset_id: str,
+    diagnoses: list[dict],
+    *,
+    received_at: str | None = None,
+    source: str = "json",
+    filename: str | None = None,
+    speed: float | None = None,
+    load: float | None = None,
+) -> list[tuple]:
+    """The database rows of diagnoses (contract dicts; a ``window`` key places one in its
+    recording): plain tuples of numbers and text, JSON already encoded, for
+    :meth:`HistoryStore.add_rows`. The service builds them where the diagnosis ran."""
+    received_at = received_at or utc_now()
+    rows = []
+    for d in diagnoses:
+        c = d.get("clearance") or {}
+        w = d.get("window") or {}
+        model = d.get("model") or {}
+        rows.append(
+            (
+                asset_id,
+                received_at,
+                source,
+                filename,
+                w.get("index"),
+                w.get("start"),
+                w.get("end"),
+                speed,
+                load,
+                c.get("estimate"),
+                c.get("lower"),
+                c.get("upper"),
+                d.get("fault_class"),
+                dumps(d.get("class_probabilities", {})),
+                str(model.get("name", "")),
+                str(model.get("version", "")),
+                dumps(d),
+            )
+        )
+    return rows

@@ -23,7 +23,11 @@ class ServiceLimits:
     Attributes
     ----------
     max_body_bytes : int [bytes]
-        Largest JSON body of ``POST /v1/diagnose``.
+        Largest body of ``POST /v1/diagnose`` (JSON, Arrow IPC, Parquet or MCAP).
+    max_body_decoded_bytes : int [bytes]
+        Most bytes a binary body of ``POST /v1/diagnose`` may decompress to (Arrow IPC
+        buffers, Parquet row groups, MCAP chunks), checked from what the body declares
+        before it is decoded.
     max_upload_bytes : int [bytes]
         Largest multipart body of ``POST /v1/diagnose/file``.
     max_small_body_bytes : int [bytes]
@@ -57,6 +61,7 @@ class ServiceLimits:
     """
 
     max_body_bytes: int = 16 * 2**20
+    max_body_decoded_bytes: int = 64 * 2**20
     max_upload_bytes: int = 128 * 2**20
     max_small_body_bytes: int = 64 * 2**10
     max_window_seconds: float = 2.0
@@ -72,6 +77,7 @@ class ServiceLimits:
     def __post_init__(self):
         for name in (
             "max_body_bytes",
+            "max_body_decoded_bytes",
             "max_upload_bytes",
             "max_small_body_bytes",
             "max_upload_samples",
@@ -110,3 +116,9 @@ class ServiceLimits:
     def max_json_samples(self, rate: float) -> int:
         """Most samples ``POST /v1/diagnose`` accepts at ``rate`` [Hz]."""
         return int(self.max_window_seconds * rate)
+
+    @property
+    def max_body_samples(self) -> int:
+        """Most samples any ``POST /v1/diagnose`` body may hold (at ``max_sample_rate``):
+        the bound a binary body's declared row count is checked against before decoding."""
+        return self.max_json_samples(self.max_sample_rate)

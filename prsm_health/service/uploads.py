@@ -5,7 +5,10 @@
 from __future__ import annotations
 
 import contextlib
+import mmap
+import os
 import re
+import struct
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,6 +18,7 @@ from python_multipart.multipart import MultipartParser, parse_options_header
 from starlette.requests import Request
 
 from ..channels import UNITS
+from ..errors import PRSMHealthError
 from .limits import ServiceLimits
 from .responses import HTTPError
 from .schemas import ASSET_ID_PATTERN
@@ -25,45 +29,107 @@ UPLOAD_SUFFIXES = (".mcap", ".parquet")
 def precheck_upload(path: Path, suffix: str, limits: ServiceLimits) -> None:
     """Refuse uploads whose metadata already announce more than the limits allow, before the
     library decodes them (a small compressed file can inflate to gigabytes)."""
-    if suffix == ".parquet":
+    precheck_recording(
+        path,
+        suffix.lstrip("."),
+        max_samples=limits.max_upload_samples,
+        max_decoded_bytes=limits.max_upload_decoded_bytes,
+    )
+
+
+def precheck_recording(
+    source: Path | bytes,
+    fmt: str,
+    *,
+    max_samples: int,
+    max_decoded_bytes: int,
+    samples_hint: str = "",
+    decoded_hint: str = "",
+    name: str = "recording",
+) -> None:
+    """Refuse a recording (a file, or a body in memory) whose metadata already announce more
+    than ``max_samples`` rows or ``max_decoded_bytes`` decompressed (413), or an implausible
+    number of columns (422), before anything is decompressed or decoded. ``fmt``:
+    ``"parquet"`` (footer: rows, row-group sizes), ``"mcap"`` (chunk headers: uncompressed
+    sizes), ``"arrow"`` (message headers: rows, buffer sizes). The hints end the messages
+    (which limit, what to do). A body the metadata cannot be read from is left to the reader,
+    which reports it with its own message — except an Arrow stream, whose headers are the
+    reader's first step (422 here; ``name`` names the recording)."""
+    rows = None
+    columns = 0
+    if fmt == "parquet":
         try:
+            import pyarrow as pa
             import pyarrow.parquet as pq
 
-            meta = pq.read_metadata(path)
+            meta = pq.read_metadata(source if isinstance(source, Path) else pa.BufferReader(source))
         except Exception:
             return  # not readable: the library's reader reports it with its own message
         decoded = sum(meta.row_group(i).total_byte_size for i in range(meta.num_row_groups))
-        if meta.num_columns > 4 * len(UNITS):
-            raise HTTPError(
-                422,
-                f"Parquet file has {meta.num_columns} columns; a recording has time, channels "
-                "and (simulated) truth columns",
-            )
-        if meta.num_rows > limits.max_upload_samples:
-            raise HTTPError(
-                413,
-                f"recording too long: {meta.num_rows} samples, at most "
-                f"{limits.max_upload_samples} accepted",
-            )
-    else:
-        decoded = 0
-        try:
-            from mcap.records import Chunk
-            from mcap.stream_reader import StreamReader
+        rows, columns, kind = meta.num_rows, meta.num_columns, "Parquet file"
+    elif fmt == "arrow":
+        from ..io.arrow import arrow_stream_sizes
 
-            with open(path, "rb") as f:
-                for record in StreamReader(f, emit_chunks=True).records:
-                    if isinstance(record, Chunk):
-                        decoded += int(record.uncompressed_size)
-                        if decoded > limits.max_upload_decoded_bytes:
-                            break
-        except Exception:
-            pass  # damaged or not MCAP: the library's tolerant reader decides
-    if decoded > limits.max_upload_decoded_bytes:
+        try:
+            data = source.read_bytes() if isinstance(source, Path) else source
+            sizes = arrow_stream_sizes(data, name)
+        except PRSMHealthError as exc:
+            raise HTTPError(422, str(exc)) from None
+        rows, decoded, columns = sizes.rows, sizes.decoded_bytes, sizes.columns
+        kind = "Arrow stream"
+    else:
+        decoded = _mcap_chunk_bytes(source, max_decoded_bytes)
+    if columns > 4 * len(UNITS):
+        raise HTTPError(
+            422,
+            f"{kind} has {columns} columns; a recording has time, channels "
+            "and (simulated) truth columns",
+        )
+    if rows is not None and rows > max_samples:
         raise HTTPError(
             413,
-            f"recording decompresses to more than {limits.max_upload_decoded_bytes} bytes",
+            f"recording too long: {rows} samples, at most {max_samples} accepted{samples_hint}",
         )
+    if decoded > max_decoded_bytes:
+        raise HTTPError(
+            413,
+            f"recording decompresses to more than {max_decoded_bytes} bytes{decoded_hint}",
+        )
+
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+_MCAP_CHUNK = 0x06
+_RECORD = struct.Struct("<BQ")
+_U64 = struct.Struct("<Q")
+
+
+def _mcap_chunk_bytes(source: Path | bytes, stop_above: int) -> int:
+    """Sum of the uncompressed sizes the chunk records of an MCAP recording declare (stops
+    once above ``stop_above``), from the record headers alone: nothing is decompressed. 0 for
+    what is not MCAP; the scan ends at the first record running past the end (the library's
+    tolerant reader decides about damage)."""
+    if isinstance(source, Path):
+        with open(source, "rb") as f:
+            if os.fstat(f.fileno()).st_size == 0:
+                return 0
+            with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
+                return _mcap_chunk_bytes(memoryview(data), stop_above)
+    data = source
+    if bytes(data[: len(_MCAP_MAGIC)]) != _MCAP_MAGIC:
+        return 0
+    total, pos, size = 0, len(_MCAP_MAGIC), len(data)
+    while pos + _RECORD.size <= size:
+        opcode, length = _RECORD.unpack_from(data, pos)
+        body = pos + _RECORD.size
+        if body + length > size:
+            break
+        if opcode == _MCAP_CHUNK and length >= 24:
+            # chunk: message start time u64, end time u64, uncompressed size u64, ...
+            total += _U64.unpack_from(data, body + 16)[0]
+            if total > stop_above:
+                break
+        pos = body + length
+    return total
 
 
 @dataclass(frozen=True)

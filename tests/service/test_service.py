@@ -30,6 +30,7 @@ from prsm_health import (
 )
 from prsm_health.channels import CHANNEL_NAMES
 from prsm_health.diagnosis import DEFAULT_MODEL, diagnose, load_bundle
+from prsm_health.io.arrow import write_run_arrow
 from prsm_health.io.parquet import write_run_parquet
 from prsm_health.mcap import write_mcap
 from prsm_health.run import MIN_SAMPLES, Run
@@ -711,7 +712,18 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
         assert upload.status_code == 200, upload.text
         bad = c.post("/v1/diagnose", json={**body, "sample_rate": 0.5})
         assert bad.status_code == 422 and "sample_rate" in bad.json()["error"]
-        assert c.get("/v1/assets/pump-7/history").json()["count"] == 1
+        # a binary body crosses to the process as bytes and is decoded there
+        arrow = {"content-type": "application/vnd.apache.arrow.stream"}
+        binary = c.post(
+            "/v1/diagnose",
+            content=write_run_arrow(recording.without_truth()),
+            headers=arrow,
+            params={"asset_id": "pump-7"},
+        )
+        assert binary.status_code == 200 and binary.json() == answer.json()
+        garbage = c.post("/v1/diagnose", content=b"garbage" * 20, headers=arrow)
+        assert garbage.status_code == 422 and garbage.json()["error"].startswith("arrow body: ")
+        assert c.get("/v1/assets/pump-7/history").json()["count"] == 2
         pids = [p.pid for p in app.state.workers._processes._processes.values()]
         # a diagnosis process killed (out of memory, say): 503 with Retry-After while a new
         # pool starts, then answers again (seen [503, 200]; a request that beats the pool's
