@@ -1,15 +1,34 @@
-"""What the column-table readers (CSV, Parquet) share: picking the measured channels and the
-truth columns, and the sample rate from the time axis."""
+"""What the column-table formats (CSV, Parquet, Arrow IPC) share: a run as one Arrow table
+with its metadata, picking the measured channels and the truth columns, and the sample rate
+from the time axis."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import numpy as np
 
-from ..channels import CHANNEL_NAMES, TRUTH_NAMES, TRUTH_PREFIX, truth_column
+from ..channels import CHANNEL_NAMES, TRUTH_NAMES, TRUTH_PREFIX, UNITS, truth_column
 from ..errors import PRSMHealthError
+from ..jsonable import dumps
+
+
+def run_table(run):
+    """``run`` as a pyarrow Table (``time``, channels, ``truth_<name>``) whose schema metadata
+    carries the units, sample rate, labels and scenario (what the Parquet and Arrow writers
+    store)."""
+    import pyarrow as pa
+
+    table = pa.Table.from_pandas(run.to_frame(), preserve_index=False)
+    meta = {
+        b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
+        b"prsm_health.sample_rate": repr(float(run.sample_rate)).encode(),
+        b"prsm_health.labels": dumps(run.labels).encode(),
+        b"prsm_health.scenario": dumps(run.scenario).encode(),
+    }
+    return table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
 
 
 def contract_channels(path: Path, columns: Iterable[str], column: Callable) -> dict:

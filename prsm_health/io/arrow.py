@@ -19,9 +19,8 @@ from pathlib import Path
 
 from ..channels import UNITS
 from ..errors import PRSMHealthError
-from ..jsonable import dumps
 from ..run import Run
-from ._columns import contract_channels, rate_from_time, truth_columns
+from ._columns import contract_channels, rate_from_time, run_table, truth_columns
 
 #: Media type of an Arrow IPC stream (IANA registration).
 ARROW_STREAM_MEDIA_TYPE = "application/vnd.apache.arrow.stream"
@@ -36,14 +35,7 @@ def write_run_arrow(run: Run, path: str | Path | None = None, *, compression: st
     """
     import pyarrow as pa
 
-    table = pa.Table.from_pandas(run.to_frame(), preserve_index=False)
-    meta = {
-        b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
-        b"prsm_health.sample_rate": repr(float(run.sample_rate)).encode(),
-        b"prsm_health.labels": dumps(run.labels).encode(),
-        b"prsm_health.scenario": dumps(run.scenario).encode(),
-    }
-    table = table.replace_schema_metadata(meta)
+    table = run_table(run)
     sink = pa.BufferOutputStream()
     options = pa.ipc.IpcWriteOptions(compression=compression)
     with pa.ipc.new_stream(sink, table.schema, options=options) as writer:

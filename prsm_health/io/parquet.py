@@ -8,27 +8,17 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..channels import UNITS
 from ..errors import PRSMHealthError
-from ..jsonable import dumps
 from ..run import Run
-from ._columns import contract_channels, rate_from_time, truth_columns
+from ._columns import contract_channels, rate_from_time, run_table, truth_columns
 
 
 def write_run_parquet(run: Run, path: str | Path) -> Path:
     """Write ``run`` to ``path`` atomically (temporary file, then rename)."""
-    import pyarrow as pa
     import pyarrow.parquet as pq
 
     path = Path(path)
-    table = pa.Table.from_pandas(run.to_frame(), preserve_index=False)
-    meta = {
-        b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
-        b"prsm_health.sample_rate": repr(float(run.sample_rate)).encode(),
-        b"prsm_health.labels": dumps(run.labels).encode(),
-        b"prsm_health.scenario": dumps(run.scenario).encode(),
-    }
-    table = table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+    table = run_table(run)
     tmp = path.with_name(path.name + ".partial")
     pq.write_table(table, tmp, compression="zstd")
     tmp.replace(path)
