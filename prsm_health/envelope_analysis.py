@@ -40,6 +40,7 @@ import math
 import numpy as np
 
 from .errors import PRSMHealthError
+from .signal_kernels import frame_power_sums, line_floors
 from .spectra import amplitude_spectrum, band_envelope, hann
 
 #: STFT window lengths of the kurtogram [samples].
@@ -87,23 +88,31 @@ def kurtogram(x: np.ndarray, rate: float, low: float = 0.0) -> dict:
 def spectral_kurtosis(x: np.ndarray, rate: float) -> dict[int, tuple]:
     """Spectral kurtosis of each row of ``x`` (rows, n) at every window length of
     :data:`KURTOGRAM_WINDOWS` that fits 8 times: n_w → (frequencies [Hz], SK (rows, bins),
-    frames K)."""
-    x = x - np.mean(x, axis=-1, keepdims=True)
+    frames K).
+
+    The STFT is ``scipy.signal.stft(x, window="hann", nperseg=n_w, noverlap=3·n_w/4)``'s: Hann
+    frames, the signal extended by n_w/2 zeros at both ends and zero-padded to whole frames
+    (its scaling, a constant factor, cancels in the SK). Only Σ|X|² and Σ|X|⁴ over the frames
+    are kept, summed block by block as the frames are transformed
+    (:func:`prsm_health.signal_kernels.frame_power_sums`)."""
+    x = np.ascontiguousarray(x - np.mean(x, axis=-1, keepdims=True))
     levels = {}
     for n_w in KURTOGRAM_WINDOWS:
         if x.shape[-1] < 8 * n_w:
             continue
+        step = n_w - 3 * n_w // 4
+        extended = x.shape[-1] + 2 * (n_w // 2)
+        extended += (-(extended - n_w)) % step
+        frames = (extended - n_w) // step + 1
         sk = np.empty((len(x), n_w // 2 + 1))
-        # row by row: one row's frames fit the cache, a batch's do not (twice slower)
         for row, out in zip(x, sk):
-            f, power = _stft_power(row, rate, n_w)
-            # means over the frames as products with a vector of ones: one BLAS call, where a
-            # reduction over the first axis of (frames, bins) walks it bin by bin
-            ones = np.full(len(power), 1.0 / len(power))
-            mean2 = ones @ power
+            s2, s4 = frame_power_sums(
+                row, hann(n_w), step, -(n_w // 2), frames, detrend=False, fourth=True
+            )
+            mean2 = s2 / frames
             with np.errstate(invalid="ignore", divide="ignore"):
-                out[:] = np.where(mean2 > 0, (ones @ (power * power)) / mean2**2 - 2.0, 0.0)
-        levels[n_w] = (f, sk, len(power))
+                out[:] = np.where(mean2 > 0, (s4 / frames) / mean2**2 - 2.0, 0.0)
+        levels[n_w] = (np.fft.rfftfreq(n_w, 1.0 / rate), sk, frames)
     return levels
 
 
@@ -133,21 +142,6 @@ def _best_band(levels: dict, rate: float, low: float, n: int) -> dict:
     }
 
 
-def _stft_power(x: np.ndarray, rate: float, n_w: int) -> tuple[np.ndarray, np.ndarray]:
-    """(frequency [Hz], |STFT|² of shape (..., frames, bins)): Hann frames of ``n_w`` samples,
-    75 % overlap, the signal extended by n_w/2 zeros at both ends and zero-padded to whole
-    frames — the frames of ``scipy.signal.stft(x, window="hann", nperseg=n_w, noverlap=3·n_w/4)``
-    in one FFT call (its scaling, a constant factor, cancels in the spectral kurtosis)."""
-    step = n_w - 3 * n_w // 4
-    n = x.shape[-1] + 2 * (n_w // 2)
-    n += (-(n - n_w)) % step
-    padded = np.zeros(x.shape[:-1] + (n,))
-    padded[..., n_w // 2 : n_w // 2 + x.shape[-1]] = x
-    frames = np.lib.stride_tricks.sliding_window_view(padded, n_w, axis=-1)[..., ::step, :]
-    z = np.fft.rfft(frames * hann(n_w), axis=-1)
-    return np.fft.rfftfreq(n_w, 1.0 / rate), z.real**2 + z.imag**2
-
-
 def envelope_amplitude_spectrum(
     x: np.ndarray, rate: float, band: tuple[float, float]
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -166,7 +160,12 @@ def envelope_amplitude_spectra(
             raise PRSMHealthError(
                 f"band = {(lo, hi)!r} must satisfy 0 < low < high < rate/2 = {rate / 2:g} Hz"
             )
-    return amplitude_spectrum(band_envelope(x, rate, bands), rate)
+    freq = np.fft.rfftfreq(x.shape[-1], 1.0 / rate)
+    amp = np.empty((len(x), len(freq)))
+    # row by row: one row's envelope and spectrum stay in the cache, a batch's do not
+    for i, band in enumerate(bands):
+        amp[i] = amplitude_spectrum(band_envelope(x[i : i + 1], rate, [band]), rate)[1]
+    return freq, amp
 
 
 def line_and_ratio(
@@ -184,9 +183,8 @@ def lines_and_ratios(
     targets) of the spectra ``amp`` (rows, bins); NaN outside (0, ``limits`` (rows,)).
 
     The line is the largest amplitude within ±max(2 bins, 1 %) of the target, the floor the
-    median of the amplitudes from 0.5× to 1.5× the target without the line's bins. Every row
-    and target at once: the ranges, of different lengths, are gathered into one array padded
-    with ∓∞ (which leaves a maximum, and the middle of a sorted row, where they are)."""
+    median of the amplitudes from 0.5× to 1.5× the target without the line's bins (every row
+    and target in one compiled loop: :func:`prsm_health.signal_kernels.line_floors`)."""
     df = freq[1] - freq[0]
     valid = np.isfinite(targets) & (targets > 0) & (targets < limits[:, None])
     target = np.where(valid, targets, 1.0)
@@ -196,33 +194,13 @@ def lines_and_ratios(
     b = np.searchsorted(freq, target + half, side="right")
     c = np.searchsorted(freq, 0.5 * target, side="left")
     d = np.searchsorted(freq, 1.5 * target, side="right")
-    below = np.maximum(a - c, 0)  # [c, a)
-    above_start = np.maximum(b, c)
-    count = below + np.maximum(d - above_start, 0)  # then [max(b, c), d)
-    line_count = np.maximum(b - a, 0)
-    valid &= (line_count > 0) & (count > 0)
-    rows = np.arange(amp.shape[0])[:, None, None]
-    line_index = a[..., None] + np.arange(max(int(line_count.max(initial=0)), 1))
-    lines = _gather(amp, rows, line_index, line_count, -np.inf).max(axis=-1)
-    j = np.arange(max(int(count.max(initial=0)), 1))
-    index = np.where(
-        j < below[..., None], c[..., None] + j, above_start[..., None] + j - below[..., None]
-    )
-    around = np.sort(_gather(amp, rows, index, count, np.inf), axis=-1)
-    # np.median: the middle element, or the mean of the two middle ones
-    upper = np.take_along_axis(around, (count // 2)[..., None], axis=-1)[..., 0]
-    lower = np.take_along_axis(around, ((count - 1) // 2)[..., None], axis=-1)[..., 0]
-    floor = np.where(count % 2 == 1, upper, (lower + upper) / 2)
+    a, b, c, d = (np.where(valid, k, 0) for k in (a, b, c, d))  # empty ranges where not valid
+    lines = np.full(targets.shape, np.nan)
+    floor = np.full(targets.shape, np.nan)
+    line_floors(np.ascontiguousarray(amp, float), a, b, c, d, lines, floor)
     with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = np.where(valid & (floor > 0), lines / floor, np.nan)
-    return np.where(valid, lines, np.nan), ratio
-
-
-def _gather(amp: np.ndarray, rows: np.ndarray, index: np.ndarray, count: np.ndarray, pad: float):
-    """amp[row, index] for the first ``count`` of each (row, target)'s indices, ``pad`` after."""
-    inside = np.arange(index.shape[-1]) < count[..., None]
-    values = amp[rows, np.clip(np.where(inside, index, 0), 0, amp.shape[-1] - 1)]
-    return np.where(inside, values, pad)
+        ratio = np.where(floor > 0, lines / floor, np.nan)
+    return lines, ratio
 
 
 def defect_lines(

@@ -51,7 +51,8 @@ import math
 import numpy as np
 
 from .errors import PRSMHealthError
-from .spectra import analytic_signal
+from .signal_kernels import interp_rows
+from .spectra import hilbert_envelope
 
 #: Fewest whole periods a TSA averages before its indicators are given (NaN below): with one
 #: period nothing is averaged, and the ensemble of NA4 needs two.
@@ -107,8 +108,7 @@ def angle_resample(
     grid = angle[0] + np.arange(n_periods * samples_per_period) * (period / samples_per_period)
     rows = x.reshape(-1, x.shape[-1])
     out = np.empty((len(rows), len(grid)))
-    for row, values in zip(out, rows):
-        row[:] = np.interp(grid, angle, values)
+    interp_rows(grid, angle, rows, out)  # np.interp of every row, bitwise, one walk for all
     return out.reshape(x.shape[:-1] + (len(grid),)), n_periods
 
 
@@ -151,10 +151,13 @@ def _value(x):
     return float(x) if np.ndim(x) == 0 else x
 
 
-def split_signals(tsa: np.ndarray, mesh_order: int) -> dict[str, np.ndarray]:
+def split_signals(
+    tsa: np.ndarray, mesh_order: int, spectrum: np.ndarray | None = None
+) -> dict[str, np.ndarray]:
     """The regular, difference and residual signals of a TSA (see the module docstring); of
-    every TSA on the leading axes of ``tsa`` (..., N)."""
-    spectrum = _orders(tsa)
+    every TSA on the leading axes of ``tsa`` (..., N). ``spectrum``: the TSA's order spectrum
+    (``np.fft.rfft(tsa, axis=-1)``) when the caller has it (here and below)."""
+    spectrum = _orders(tsa) if spectrum is None else spectrum
     n = tsa.shape[-1]
     regular_mask = _keep(spectrum.shape[-1], _component_orders(mesh_order, sidebands=True))
     residual_mask = _keep(spectrum.shape[-1], _component_orders(mesh_order, sidebands=False))
@@ -170,16 +173,24 @@ def split_signals(tsa: np.ndarray, mesh_order: int) -> dict[str, np.ndarray]:
 def _moment_ratio(d: np.ndarray, power: int) -> float:
     """N^(p/2−1) Σ(d − d̄)^p / [Σ(d − d̄)²]^(p/2): FM4 (p = 4), M6A (6), M8A (8), along the
     last axis."""
+    return _moment_ratios(d, (power,))[0]
+
+
+def _moment_ratios(d: np.ndarray, powers=(4, 6, 8)) -> list:
+    """:func:`_moment_ratio` of each power, the signal centred and squared once."""
     d = d - np.mean(d, axis=-1, keepdims=True)
     squared = d * d
     s2 = np.sum(squared, axis=-1)
     n = d.shape[-1]
     # d^p from products: numpy's general power costs ten times a multiplication
     fourth = squared * squared
-    d_p = fourth if power == 4 else fourth * squared if power == 6 else fourth * fourth
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = n ** (power / 2 - 1) * np.sum(d_p, axis=-1) / s2 ** (power / 2)
-    return _value(np.where(s2 > 0, ratio, math.nan))
+    out = []
+    for power in powers:
+        d_p = fourth if power == 4 else fourth * squared if power == 6 else fourth * fourth
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ratio = n ** (power / 2 - 1) * np.sum(d_p, axis=-1) / s2 ** (power / 2)
+        out.append(_value(np.where(s2 > 0, ratio, math.nan)))
+    return out
 
 
 def fm4(difference: np.ndarray) -> float:
@@ -197,9 +208,14 @@ def m8a(difference: np.ndarray) -> float:
     return _moment_ratio(difference, 8)
 
 
-def fm0(tsa: np.ndarray, mesh_order: int, harmonics: int = MESH_HARMONICS) -> float:
+def fm0(
+    tsa: np.ndarray,
+    mesh_order: int,
+    harmonics: int = MESH_HARMONICS,
+    spectrum: np.ndarray | None = None,
+) -> float:
     """FM0 = peak-to-peak of the TSA / Σ amplitudes of its mesh harmonics (Stewart 1977)."""
-    amplitude = 2.0 * np.abs(_orders(tsa)) / tsa.shape[-1]
+    amplitude = 2.0 * np.abs(_orders(tsa) if spectrum is None else spectrum) / tsa.shape[-1]
     total = np.zeros(tsa.shape[:-1])
     for h in range(1, harmonics + 1):
         if h * mesh_order < amplitude.shape[-1]:
@@ -229,21 +245,25 @@ def sum_of_squares(x: np.ndarray) -> float:
     return _value(np.sum((x - np.mean(x, axis=-1, keepdims=True)) ** 2, axis=-1))
 
 
-def mesh_band_envelope(tsa: np.ndarray, mesh_order: int) -> np.ndarray:
+def mesh_band_envelope(
+    tsa: np.ndarray, mesh_order: int, spectrum: np.ndarray | None = None
+) -> np.ndarray:
     """Envelope (Hilbert magnitude) of the TSA band-passed around the mesh fundamental (the
     NB4 signal, Zakrajsek et al. 1993): orders mesh ± mesh/2, half-way to the neighbouring
     harmonics, so the sidebands a local tooth fault spreads around the mesh are kept (a band
     of the first-order sidebands only would smooth a one-tooth burst away)."""
-    spectrum = _orders(tsa)
+    spectrum = _orders(tsa) if spectrum is None else spectrum
     half = max(1, mesh_order // 2)
     band = _keep(spectrum.shape[-1], list(range(mesh_order - half, mesh_order + half + 1)))
-    banded = np.fft.irfft(np.where(band, spectrum, 0.0), tsa.shape[-1], axis=-1)
-    return np.abs(analytic_signal(banded))
+    kept = np.where(band, spectrum, 0.0)
+    return hilbert_envelope(np.fft.irfft(kept, tsa.shape[-1], axis=-1), kept)
 
 
-def sideband_amplitudes(tsa: np.ndarray, mesh_order: int) -> tuple[float, float]:
+def sideband_amplitudes(
+    tsa: np.ndarray, mesh_order: int, spectrum: np.ndarray | None = None
+) -> tuple[float, float]:
     """Amplitudes of the first-order sidebands of the mesh fundamental (S₋₁, S₊₁)."""
-    amplitude = 2.0 * np.abs(_orders(tsa)) / tsa.shape[-1]
+    amplitude = 2.0 * np.abs(_orders(tsa) if spectrum is None else spectrum) / tsa.shape[-1]
     if mesh_order + 1 >= amplitude.shape[-1] or mesh_order < 2:
         nan = _value(np.full(tsa.shape[:-1], math.nan))
         return nan, nan
@@ -327,16 +347,17 @@ def tsa_indicators(
     out["tsa_rms"] = np.std(tsa, axis=-1)
     if mesh_order is None or not 2 <= mesh_order < tsa.shape[-1] // 2 - 1:
         return out
-    parts = split_signals(tsa, mesh_order)
+    spectrum = _orders(tsa)  # one order spectrum for every indicator that reads it
+    parts = split_signals(tsa, mesh_order, spectrum)
     d = parts["difference"]
-    out["fm0"] = np.atleast_1d(fm0(tsa, mesh_order))
-    out["fm4"], out["m6a"], out["m8a"] = (np.atleast_1d(ratio(d)) for ratio in (fm4, m6a, m8a))
+    out["fm0"] = np.atleast_1d(fm0(tsa, mesh_order, spectrum=spectrum))
+    out["fm4"], out["m6a"], out["m8a"] = (np.atleast_1d(r) for r in _moment_ratios(d))
     rms_regular = np.sqrt(np.mean(parts["regular"] ** 2, axis=-1))
     with np.errstate(invalid="ignore", divide="ignore"):
         out["energy_ratio"] = np.where(
             rms_regular > 0, np.sqrt(np.mean(d**2, axis=-1)) / rms_regular, math.nan
         )
-    envelope = mesh_band_envelope(tsa, mesh_order)
+    envelope = mesh_band_envelope(tsa, mesh_order, spectrum)
     if ensemble is None:
         out["na4"] = np.atleast_1d(ensemble_ratio(parts["residual"]))
         out["nb4"] = np.atleast_1d(ensemble_ratio(envelope))
@@ -345,7 +366,7 @@ def tsa_indicators(
         out["nb4"][0] = ensemble_ratio(envelope[0], ensemble["envelope"])
         ensemble["residual"].append(sum_of_squares(parts["residual"][0]))
         ensemble["envelope"].append(sum_of_squares(envelope[0]))
-    lower, upper = (np.atleast_1d(s) for s in sideband_amplitudes(tsa, mesh_order))
+    lower, upper = (np.atleast_1d(s) for s in sideband_amplitudes(tsa, mesh_order, spectrum))
     out["sideband_index"] = 0.5 * (lower + upper)
     sigma = out["tsa_rms"]
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -11,6 +11,8 @@ from functools import lru_cache
 import numpy as np
 from scipy import signal
 
+from .signal_kernels import frame_power_sums, sosfiltfilt_rows
+
 
 @lru_cache(maxsize=64)
 def hann(n: int) -> np.ndarray:
@@ -56,9 +58,10 @@ def band_envelope(
     signal (Hilbert) of the mean-removed row, band-passed by a zero-phase Butterworth.
 
     The band-pass is ``scipy.signal.sosfiltfilt(sos, row)`` (odd extension of 3·(2·sections
-    + 1) samples, steady-state initial conditions) with the filter and its initial conditions
-    designed once per band, rows of one band filtered in one call; the analytic signal is
-    ``scipy.signal.hilbert``'s from the one-sided spectrum (equal to rounding).
+    + 1) samples, steady-state initial conditions), equal bitwise, by a compiled kernel
+    (:func:`prsm_health.signal_kernels.sosfiltfilt_rows`) with each band's filter and initial
+    conditions designed once; the envelope is ``abs(scipy.signal.hilbert(row))`` from one
+    real FFT pair (:func:`hilbert_envelope`, equal to rounding).
 
     Parameters
     ----------
@@ -74,69 +77,63 @@ def band_envelope(
     """
     x = np.asarray(x, float)
     x = x - np.mean(x, axis=-1, keepdims=True)
+    if not len(bands):
+        return np.empty_like(x)
+    designs = [_bandpass(order, float(lo), float(hi), float(sample_rate)) for lo, hi in bands]
+    sos, zi, edge = (np.array([d[k] for d in designs]) for k in range(3))
+    if x.shape[-1] <= (padlen := int(edge.max())):
+        raise ValueError(
+            f"The length of the input vector x must be greater than padlen, which is {padlen}."
+        )
     filtered = np.empty_like(x)
-    rows: dict[tuple[float, float], list[int]] = {}
-    for i, band in enumerate(bands):
-        rows.setdefault((float(band[0]), float(band[1])), []).append(i)
-    for (low, high), index in rows.items():
-        sos, zi, edge = _bandpass(order, low, high, float(sample_rate))
-        filtered[index] = _filtfilt(sos, zi, edge, x[index])
-    return np.abs(analytic_signal(filtered))
+    sosfiltfilt_rows(x, sos, zi, edge, filtered)
+    return hilbert_envelope(filtered)
 
 
-def analytic_signal(x: np.ndarray) -> np.ndarray:
-    """``scipy.signal.hilbert(x, axis=-1)`` from the one-sided spectrum (half the FFT work):
-    the positive frequencies doubled, DC and Nyquist kept, the negative ones zero."""
+def hilbert_envelope(x: np.ndarray, spectrum: np.ndarray | None = None) -> np.ndarray:
+    """``abs(scipy.signal.hilbert(x, axis=-1))`` with one real FFT pair: the analytic signal
+    is x + i·H(x), H(x) the inverse real FFT of −i·X without DC and Nyquist, so the envelope
+    is √(x² + H(x)²) — without hilbert's complex inverse FFT, three times a real one.
+    ``spectrum``: ``np.fft.rfft(x, axis=-1)`` when the caller has it."""
     n = x.shape[-1]
-    half = np.fft.rfft(x, axis=-1)
-    full = np.zeros(x.shape[:-1] + (n,), complex)
-    full[..., : half.shape[-1]] = half
-    full[..., 1 : (n + 1) // 2] *= 2.0
-    return np.fft.ifft(full, axis=-1)
+    quadrature = -1j * (np.fft.rfft(x, axis=-1) if spectrum is None else spectrum)
+    quadrature[..., 0] = 0.0
+    if n % 2 == 0:
+        quadrature[..., -1] = 0.0
+    h = np.fft.irfft(quadrature, n, axis=-1)
+    # not np.hypot: its overflow-safe scaling costs six times the arithmetic here
+    return np.sqrt(x * x + h * h)
 
 
 @lru_cache(maxsize=256)
 def _bandpass(order: int, low: float, high: float, sample_rate: float):
-    """(sos, steady-state initial conditions, edge) of ``sosfiltfilt`` for a band, read-only."""
+    """(sos, steady-state initial conditions, edge) of ``sosfiltfilt`` for a band, read-only;
+    sos and zi padded with identity sections to a multiple of four (the kernel's groups)."""
     sos = _bandpass_sos(order, low, high, sample_rate)
     ntaps = 2 * len(sos) + 1 - min(np.sum(sos[:, 2] == 0), np.sum(sos[:, 5] == 0))
-    zi = signal.sosfilt_zi(sos)
+    sections = -(-len(sos) // 4) * 4
+    padded = np.zeros((sections, 6))
+    padded[:, [0, 3]] = 1.0  # identity: y = x, states stay 0
+    padded[: len(sos)] = sos
+    zi = np.zeros((sections, 2))
+    zi[: len(sos)] = signal.sosfilt_zi(sos)
+    padded.flags.writeable = False
     zi.flags.writeable = False
-    return sos, zi, 3 * int(ntaps)
-
-
-def _filtfilt(sos: np.ndarray, zi: np.ndarray, edge: int, x: np.ndarray) -> np.ndarray:
-    """``scipy.signal.sosfiltfilt(sos, x, axis=-1)`` (padtype "odd") for rows of one filter,
-    with its initial conditions ``zi`` computed once (scipy recomputes them on every call)."""
-    if x.shape[-1] <= edge:
-        raise ValueError(
-            f"The length of the input vector x must be greater than padlen, which is {edge}."
-        )
-    ext = np.concatenate(
-        (
-            2 * x[:, :1] - x[:, edge:0:-1],
-            x,
-            2 * x[:, -1:] - x[:, -2 : -(edge + 2) : -1],
-        ),
-        axis=-1,
-    )
-    zi = zi[:, None, :]  # (sections, rows, 2)
-    y, _ = signal.sosfilt(sos.copy(), ext, axis=-1, zi=zi * ext[:, :1])
-    y, _ = signal.sosfilt(sos.copy(), y[:, ::-1], axis=-1, zi=zi * y[:, -1:])
-    return y[:, ::-1][:, edge:-edge]
+    return padded, zi, 3 * int(ntaps)
 
 
 def welch_psd(
     x: np.ndarray, sample_rate: float, nperseg: int, noverlap: int | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Welch power spectral density, every segment in one FFT call [units²/Hz].
+    """Welch power spectral density, a signal's segments in one FFT call [units²/Hz].
 
     The estimate of ``scipy.signal.welch(x, fs, window="hann", nperseg, noverlap)`` (periodic
     Hann window, each segment's mean removed, density scaling, one-sided, mean of the segments,
-    no padding) computed on a strided view of all segments at once: scipy ≥ 1.12 detrends and
-    transforms segment by segment in Python, which made the Welch spectra half the time of
-    the indicators (docs/performance.md). ``x`` may hold several signals of equal length on its
-    leading axes (channels, windows).
+    no padding): the segments detrended and windowed, and their power summed, by compiled
+    loops around one FFT call (:func:`prsm_health.signal_kernels.frame_power_sums`); scipy
+    ≥ 1.12 detrends and transforms segment by segment in Python, which made the Welch spectra
+    half the time of the indicators (docs/performance.md). ``x`` may hold several signals of
+    equal length on its leading axes (channels, windows).
 
     Parameters
     ----------
@@ -160,13 +157,13 @@ def welch_psd(
     nperseg = min(int(nperseg), x.shape[-1])
     noverlap = nperseg // 2 if noverlap is None else int(noverlap)
     window = hann(nperseg)
-    rows = x.reshape(-1, x.shape[-1])
+    step = nperseg - noverlap
+    frames = (x.shape[-1] - nperseg) // step + 1
+    rows = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
     psd = np.empty((len(rows), nperseg // 2 + 1))
     # signal by signal: one signal's segments fit the cache, a batch's do not (twice slower)
     for row, out in zip(rows, psd):
-        frames = np.lib.stride_tricks.sliding_window_view(row, nperseg)[:: nperseg - noverlap]
-        spectrum = np.fft.rfft((frames - frames.mean(axis=-1, keepdims=True)) * window, axis=-1)
-        out[:] = np.mean(spectrum.real**2 + spectrum.imag**2, axis=0)
+        out[:] = frame_power_sums(row, window, step, 0, frames, detrend=True)[0] / frames
     psd /= sample_rate * np.sum(window**2)
     # one-sided: every bin but DC (and Nyquist for an even length) carries both signs' power
     psd[..., 1 : None if nperseg % 2 else -1] *= 2.0

@@ -33,6 +33,7 @@ LAYERS = {
     "spectra": 1,
     "gear_indicators": 1,
     "envelope_analysis": 1,
+    "signal_kernels": 1,
     "dynamics": 2,
     "scenario": 2,
     "io": 3,
