@@ -16,6 +16,7 @@ import tempfile
 import threading
 import time
 from contextlib import contextmanager
+from multiprocessing.shared_memory import SharedMemory
 from pathlib import Path
 
 import httpx
@@ -41,6 +42,8 @@ from prsm_health.service import (
     is_loopback,
     serve,
 )
+from prsm_health.service.server import http_implementation
+from prsm_health.service.workers import SHARED_BODY_PREFIX
 
 TOKEN = "test-token-3f9a1c0e"
 CONTRACT_KEYS = {"clearance", "fault_class", "class_probabilities", "indicators", "model"}
@@ -604,6 +607,20 @@ def test_bind_rules(monkeypatch):
         create_app(None, ":memory:", "has space", bundle=object(), warmup=False)
 
 
+def test_http_parser_choice(monkeypatch):
+    # httptools (C parser) when installed, else h11; asked for by name, or refused
+    assert http_implementation("h11") == "h11"
+    assert http_implementation("auto") == http_implementation("httptools") == "httptools"
+    with pytest.raises(PRSMHealthError, match="one of"):
+        http_implementation("zttp")
+    monkeypatch.setitem(sys.modules, "httptools", None)  # as if not installed
+    assert http_implementation("auto") == "h11"
+    with pytest.raises(PRSMHealthError, match="not installed"):
+        http_implementation("httptools")
+    with pytest.raises(PRSMHealthError, match="not installed"):
+        serve("127.0.0.1", 0, http="httptools")  # refused before the model loads
+
+
 # ----------------------------------------------------------------------------- concurrency
 def test_health_answers_while_diagnoses_run(client, recording):
     body = json.dumps(_body(recording)).encode()
@@ -721,6 +738,9 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
             params={"asset_id": "pump-7"},
         )
         assert binary.status_code == 200 and binary.json() == answer.json()
+        # the bodies crossed through shared memory segments, kept for the next requests
+        segments = set(app.state.workers._bodies.names)
+        assert segments and all(n.startswith(SHARED_BODY_PREFIX) for n in segments)
         garbage = c.post("/v1/diagnose", content=b"garbage" * 20, headers=arrow)
         assert garbage.status_code == 422 and garbage.json()["error"].startswith("arrow body: ")
         assert c.get("/v1/assets/pump-7/history").json()["count"] == 2
@@ -738,7 +758,12 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
                 assert r.headers["retry-after"] == "2"
         assert statuses[-1] == 200 and set(statuses) <= {200, 503}, statuses
         pids += [p.pid for p in app.state.workers._processes._processes.values()]
+        segments |= set(app.state.workers._bodies.names)
     assert len(pids) >= 2
+    # no segment left behind by the killed process or the stopped server
+    for name in segments:
+        with pytest.raises(FileNotFoundError):
+            SharedMemory(name).close()
     for pid in pids:  # shut down with the server (the killed one long gone)
         with pytest.raises(ProcessLookupError):
             os.kill(pid, 0)
@@ -746,7 +771,7 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
 
 @pytest.mark.slow  # starts the command-line service in a subprocess
 @pytest.mark.parametrize("processes", ["0", "2"])
-def test_ctrl_c_stops_the_command_line_service_without_a_traceback(tmp_path, processes):
+def test_ctrl_c_stops_the_command_line_service_without_a_traceback(tmp_path, processes, recording):
     port = _free_port()
     cmd = [sys.executable, "-m", "prsm_health.cli", "serve", "--port", str(port)]
     cmd += ["--db", str(tmp_path / "h.sqlite"), "--processes", processes, "--log-level", "warning"]
@@ -763,8 +788,17 @@ def test_ctrl_c_stops_the_command_line_service_without_a_traceback(tmp_path, pro
                     pass
                 assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
                 time.sleep(0.2)
+            # a body large enough to cross to a diagnosis process through shared memory
+            r = httpx.post(
+                f"http://127.0.0.1:{port}/v1/diagnose",
+                content=write_run_arrow(recording.without_truth()),
+                headers={"content-type": "application/vnd.apache.arrow.stream"},
+                timeout=60,
+            )
+            assert r.status_code == 200, r.text
         finally:
             proc.send_signal(signal.SIGINT)
             code = proc.wait(timeout=60)
     text = log.read_text()
-    assert code == 0 and "Traceback" not in text, text
+    # nothing leaked (the resource tracker would warn of leftover shared memory segments)
+    assert code == 0 and "Traceback" not in text and "leaked" not in text, text
