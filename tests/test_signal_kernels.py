@@ -24,16 +24,17 @@ rng = np.random.default_rng(11)
 
 
 @pytest.mark.parametrize("order", [2, 4, 6])
-def test_sosfiltfilt_rows_is_scipys_bitwise(order):
+def test_sosfiltfilt_rows_is_scipys(order):
     x = rng.standard_normal((3, 3_000))
     bands = [(1000.0, 3000.0), (200.0, 400.0), (5000.0, 8000.0)]
     designs = [_bandpass(order, lo, hi, RATE) for lo, hi in bands]
     out = np.empty_like(x)
     sosfiltfilt_rows(x, *(np.array([d[k] for d in designs]) for k in range(3)), out)
     for row, band, got in zip(x, bands, out):
-        np.testing.assert_array_equal(
-            got, signal.sosfiltfilt(_bandpass_sos(order, *band, RATE), row)
-        )
+        # bitwise equal to scipy today (same operations in the same order); a tolerance, so a
+        # scipy release that reorders its arithmetic does not fail a correct kernel
+        expected = signal.sosfiltfilt(_bandpass_sos(order, *band, RATE), row)
+        np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-14 * np.abs(expected).max())
 
 
 @pytest.mark.parametrize("n", [4_000, 4_001])
@@ -91,13 +92,14 @@ def test_moment_sums():
     np.testing.assert_allclose(out, expected, rtol=1e-12, atol=1e-12)
 
 
-def test_interp_rows_is_numpys_bitwise():
+def test_interp_rows_is_numpys():
     xp = np.cumsum(rng.random(500) + 0.01)
     fp = rng.standard_normal((2, 500))
     x = np.sort(np.concatenate([np.linspace(xp[0] - 1, xp[-1] + 1, 800), xp[10:20], xp[-1:]]))
     out = np.empty((2, len(x)))
     interp_rows(x, xp, fp, out)
-    np.testing.assert_array_equal(out, [np.interp(x, xp, row) for row in fp])
+    # bitwise equal to numpy today; a tolerance for a numpy release with another formula
+    np.testing.assert_allclose(out, [np.interp(x, xp, row) for row in fp], rtol=1e-14, atol=1e-15)
 
 
 def test_hysteresis_crossings():
