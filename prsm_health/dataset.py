@@ -37,7 +37,7 @@ import os
 import tempfile
 from collections.abc import Callable, Iterable
 from contextlib import contextmanager
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -83,6 +83,19 @@ SWEPT_GROUPS = ("profile", "options", "drive_train", "instrumentation")
 FAULT_CASE_KEY = "fault_case"
 NO_FAULT = "none"
 DEFAULT_BATCH = 8
+#: Health fields a life recipe's units set themselves (not sweepable there).
+LIFE_SETS = (
+    "clearance",
+    "clearance_screw",
+    "clearance_nut",
+    "clearance_gear",
+    "wear_spread",
+    "preload",
+    "lubricant_degradation",
+    "lubricant_starvation",
+)
+#: Fleets of life recipes computed in this process, by recipe fingerprint.
+_FLEETS: dict[str, list] = {}
 
 
 @dataclass(frozen=True)
@@ -104,6 +117,7 @@ class Recipe:
     test_fraction: float = 0.2
     batch_size: int = DEFAULT_BATCH
     dtype: str = "float32"
+    life: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict, compare=False)
 
     @classmethod
@@ -252,7 +266,7 @@ class Recipe:
                     value,
                     f"must be a range [min, max] [{unit}] in {mode} mode",
                 )
-        if mode != "grid":
+        if mode != "grid" and not self.life:
             samples = sweep.get("samples")
             check(
                 isinstance(samples, int) and samples >= 1,
@@ -260,10 +274,59 @@ class Recipe:
                 samples,
                 f"must be an integer ≥ 1 in {mode} mode",
             )
+        if self.life:
+            self._validate_life(check, mode)
         # Build every run's scenario once (≈ 0.2 ms each), so a bad value anywhere in a sweep
         # fails now, naming the run, not later in a worker.
         for spec in self.runs():
             spec.scenario()
+
+    def _validate_life(self, check, mode: str) -> None:
+        try:
+            self.fleet()  # parses [life] and simulates every unit's life (≈ 5 ms a unit)
+        except ParameterError as exc:
+            raise RecipeError(f"recipe [life]: {exc}") from None
+        check(
+            mode == "random",
+            "sweep.mode",
+            mode,
+            "must be random in a life recipe (each snapshot draws its recording conditions)",
+        )
+        set_by_life = sorted(
+            k for k in self.sweep if k in LIFE_SETS or k in (FAULT_CASE_KEY, "severity")
+        )
+        check(
+            not set_by_life,
+            "sweep",
+            set_by_life,
+            "the life simulation sets clearances, wear spread, lubricant state and faults "
+            "in a life recipe: sweep recording conditions only (speed, load, …)",
+        )
+        check(
+            "samples" not in self.sweep,
+            "sweep.samples",
+            self.sweep.get("samples"),
+            "a life recipe has units × snapshots runs; remove samples",
+        )
+
+    @property
+    def life_spec(self):
+        """The parsed ``[life]`` table (:class:`~prsm_health.life.LifeSpec`), None without one."""
+        if not self.life:
+            return None
+        from .life import LifeSpec
+
+        return LifeSpec.from_dict(self.life)
+
+    def fleet(self) -> list:
+        """The units' lives of a life recipe (:func:`prsm_health.life.fleet_lives`), computed
+        once per process and recipe."""
+        key = self.fingerprint
+        if key not in _FLEETS:
+            from .life import fleet_lives
+
+            _FLEETS[key] = fleet_lives(load_design(self.design), self.life_spec, self.seed)
+        return _FLEETS[key]
 
     def _validate_fault_cases(self, check) -> None:
         cases = self.fault_cases
@@ -301,6 +364,8 @@ class Recipe:
     # ------------------------------------------------------------------ runs
     def runs(self) -> list[RunSpec]:
         """Every run of the recipe, in run-id order (deterministic)."""
+        if self.life:
+            return self._life_runs()
         points = self._points()
         repeats = self.sweep.get("repeats", 1)
         specs = []
@@ -321,6 +386,29 @@ class Recipe:
                     RunSpec(self, run_id, run_point, seed, "test" if run_id in test else "train")
                 )
                 run_id += 1
+        return specs
+
+    def _life_runs(self) -> list[RunSpec]:
+        # Unit-major: unit u's snapshots are runs u·n … u·n + n − 1. The unit as built (its
+        # manufacturing variation and roller wear pattern) is its seed, the same in every
+        # snapshot; each snapshot's sensors draw their own noise (sensor_seed). The test split
+        # holds out whole units.
+        spec = self.life_spec
+        test_units = _test_set(spec.units, self.test_fraction, self.seed)
+        keys = _swept_keys(self.sweep)
+        specs = []
+        for unit in self.fleet():
+            for k, age in enumerate(unit.snapshot_ages(spec.snapshots)):
+                run_id = unit.unit_id * spec.snapshots + k
+                unit_draw = np.random.default_rng([self.seed, run_id, 0x534E4150]).random(len(keys))
+                point = {
+                    key: float(self.sweep[key][0] + u * (self.sweep[key][1] - self.sweep[key][0]))
+                    for u, key in zip(unit_draw, keys)
+                }
+                point.update(unit_id=unit.unit_id, age_hours=float(age))
+                seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
+                split = "test" if unit.unit_id in test_units else "train"
+                specs.append(RunSpec(self, run_id, point, seed, split))
         return specs
 
     def _points(self) -> list[dict]:
@@ -419,6 +507,9 @@ class RunSpec:
     def scenario(self) -> Scenario:
         """The :class:`~prsm_health.scenario.Scenario` of this run (validates)."""
         r, p = self.recipe, self.point
+        unit = self.unit()
+        if unit is not None:
+            return self._life_scenario(unit)
         health = {"clearance": p.get("clearance", 10e-6)}
         health.update({k: p[k] for k in SWEPT if k.startswith("clearance_") and k in p})
         health_keys = (
@@ -439,6 +530,10 @@ class RunSpec:
         for key in ("load_amplitude", "temperature"):
             if key in p:
                 profile[key] = p[key]
+        return self._build(health, profile, seed=self.seed)
+
+    def _build(self, health, profile: dict, *, seed: int, sensor_seed: int | None = None):
+        r, p = self.recipe, self.point
         groups = {
             "profile": profile,
             "instrumentation": copy.deepcopy(_with_sample_rate(r.instrumentation, r.sample_rate)),
@@ -451,10 +546,40 @@ class RunSpec:
                 _set_path(groups[group], path, value)
         try:
             return Scenario.from_dict(
-                {"design": r.design, "health": health, **groups, "seed": self.seed}
+                {
+                    "design": r.design,
+                    "health": health,
+                    **groups,
+                    "seed": seed,
+                    "sensor_seed": sensor_seed,
+                }
             )
         except ParameterError as exc:
             raise RecipeError(f"recipe (run {self.run_id}): {exc}") from None
+
+    def unit(self):
+        """The :class:`~prsm_health.life.UnitLife` of a life recipe's snapshot, else None."""
+        if "unit_id" not in self.point:
+            return None
+        return self.recipe.fleet()[self.point["unit_id"]]
+
+    def _life_scenario(self, unit) -> Scenario:
+        # The unit's health at this age; its temperature unless the sweep draws one.
+        r, p = self.recipe, self.point
+        health = unit.health_at(p["age_hours"])
+        if "friction_scale" in p:
+            health = replace(health, friction_scale=p["friction_scale"])
+        profile = {
+            "duration": r.duration,
+            "speed": p.get("speed", 100.0),
+            "load": p.get("load", 100.0),
+            "temperature": unit.temperature,
+        }
+        profile.update(r.profile)
+        for key in ("load_amplitude", "temperature"):
+            if key in p:
+                profile[key] = p[key]
+        return self._build(health, profile, seed=unit.seed, sensor_seed=self.seed)
 
     def faults(self) -> list[dict]:
         """The faults of this run's case, their severities scaled by its ``severity``."""
@@ -482,6 +607,9 @@ class RunSpec:
             # domain-randomised fields, under their dotted names
             **{k: v for k, v in self.point.items() if "." in k},
         }
+        unit = self.unit()
+        if unit is not None:
+            out.update(unit.labels(self.point["age_hours"]))
         if run is not None:
             out.update({k: v for k, v in run.labels.items() if "_realised_" in k})
             out["n_samples"] = len(run)

@@ -213,13 +213,16 @@ def stribeck_curve(
     temperature : float [K]
         Oil temperature in the contact inlet.
     degradation, starvation : float [-]
-        Lubricant health, 0 … 1 (module docstring).
+        Lubricant health, 0 … 1 (module docstring); ``degradation`` may be an array that
+        broadcasts with ``speeds`` (one curve per degradation).
     """
     from .stiffness.thread_geometry import normal_load, thread_contacts
 
     oil = lubricant(lube)
     require_range("profile.temperature", temperature, 223.15, 473.15, unit="K")
-    require_range("health.lubricant_degradation", degradation, 0.0, 1.0)
+    degradation = np.asarray(degradation, dtype=float)  # may be an array: broadcast with speeds
+    for bound in (degradation.min(initial=0.0), degradation.max(initial=0.0)):
+        require_range("health.lubricant_degradation", float(bound), 0.0, 1.0)
     require_range("health.lubricant_starvation", starvation, 0.0, 1.0)
     contact = thread_contacts(design)[0]
     e_prime = 2.0 * contact.contact_modulus

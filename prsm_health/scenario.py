@@ -70,6 +70,10 @@ class Scenario:
         Seeds manufacturing variation, uneven wear and sensor errors (same seed, same run).
     drive_train : DriveTrain
         Motor, coupling, thrust bearing, linkage and payload (default: a flight EMA).
+    sensor_seed : int or None
+        Seeds the sensors' noise and errors instead of ``seed`` (None: ``seed``). The
+        snapshots of one unit over its life (:mod:`prsm_health.life`) share ``seed`` — the
+        unit as built — and each draws its own sensor noise.
     """
 
     design: PRSMDesign = field(default_factory=preset)
@@ -81,6 +85,7 @@ class Scenario:
     options: SimulationOptions = field(default_factory=SimulationOptions)
     seed: int = 0
     drive_train: DriveTrain = field(default_factory=DriveTrain)
+    sensor_seed: int | None = None
 
     def __post_init__(self):
         if not isinstance(self.design, PRSMDesign):
@@ -93,6 +98,22 @@ class Scenario:
             self.seed,
             "must be an integer ≥ 0",
         )
+        require(
+            self.sensor_seed is None
+            or (
+                isinstance(self.sensor_seed, int)
+                and not isinstance(self.sensor_seed, bool)
+                and self.sensor_seed >= 0
+            ),
+            "sensor_seed",
+            self.sensor_seed,
+            "must be an integer ≥ 0 (or absent: the seed's)",
+        )
+
+    @property
+    def sensors_seed(self) -> int:
+        """The seed of the sensors' noise and errors."""
+        return self.seed if self.sensor_seed is None else self.sensor_seed
 
     # ------------------------------------------------------------------ dict / TOML
     @classmethod
@@ -113,12 +134,13 @@ class Scenario:
                 f"{', '.join(list_profiles())}) or an [instrumentation] table with profile = … "
                 "and overrides (docs/instrumentation.md)",
             )
-        unknown = sorted(set(data) - {"design", "instrumentation", "seed", *_GROUPS})
+        unknown = sorted(set(data) - {"design", "instrumentation", "seed", "sensor_seed", *_GROUPS})
         if unknown:
             raise ParameterError(
                 "scenario",
                 ", ".join(unknown),
-                f"unknown key(s); allowed: design, instrumentation, seed, {', '.join(_GROUPS)}",
+                "unknown key(s); allowed: design, instrumentation, seed, sensor_seed, "
+                f"{', '.join(_GROUPS)}",
             )
         groups = {name: _group(name, kind, data.get(name, {})) for name, kind in _GROUPS.items()}
         design = load_design(data.get("design", DEFAULT_PRESET), base=base)
@@ -126,7 +148,11 @@ class Scenario:
             data.get("instrumentation", DEFAULT_PROFILE), base=base
         )
         return cls(
-            design=design, instrumentation=instrumentation, seed=data.get("seed", 0), **groups
+            design=design,
+            instrumentation=instrumentation,
+            seed=data.get("seed", 0),
+            sensor_seed=data.get("sensor_seed"),
+            **groups,
         )
 
     @classmethod
@@ -149,6 +175,7 @@ class Scenario:
             "options": self.options.as_dict(),
             "drive_train": self.drive_train.as_dict(),
             "seed": self.seed,
+            **({} if self.sensor_seed is None else {"sensor_seed": self.sensor_seed}),
         }
 
     def design_ref(self) -> str | dict:
@@ -164,6 +191,8 @@ class Scenario:
         design = data.pop("design")
         instrumentation = data.pop("instrumentation")
         lines = [f"seed = {data.pop('seed')}"]
+        if "sensor_seed" in data:
+            lines.append(f"sensor_seed = {data.pop('sensor_seed')}")
         if isinstance(instrumentation, str):
             lines.insert(0, f"instrumentation = {toml_value(instrumentation)}")
         if isinstance(design, str):
@@ -212,6 +241,7 @@ class Scenario:
             "duration": p.duration,
             "temperature": p.temperature,
             "seed": self.seed,
+            "sensor_seed": self.sensors_seed,
         }
 
     def simulate(self, *, progress: bool = False):

@@ -253,7 +253,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     channels = instrumentation.measure(
         truth_raw,
         1.0 / h,
-        np.random.default_rng([seed, 0x53454E53]),  # "SENS": this seed's sensors
+        np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
     )
     truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
     n_out = len(next(iter(truth.values())))
