@@ -145,10 +145,13 @@ class FleetScatter:
         Uneven load sharing between rollers, hence uneven wear (uniform; the health state's
         ``wear_spread`` is this times the share of the clearance that is wear).
     usage : float [-]
-        Coefficient of variation, at the unit's mean life, of the wear it has accumulated: the
-        month-to-month variation of its usage (missions, loads, idle spells) as a gamma
-        process of wear increments (van Noortwijk 2009), so that no two units, and no unit's
-        two halves of life, wear quite alike. 0: the duty cycle exactly.
+        σ of the log of the unit's usage intensity (how hard it works compared with the duty
+        cycle: missions, loads, idle spells), which wanders as a mean-reverting
+        (Ornstein–Uhlenbeck) process with correlation time ``usage_time``: wear speeds up and
+        slows down over a unit's life, so no two units, and no unit's two halves of life, wear
+        alike. 0: the duty cycle exactly.
+    usage_time : float [h]
+        Correlation time of the usage intensity (a season of operation).
     """
 
     initial_clearance: tuple = (3e-6, 8e-6)
@@ -157,7 +160,8 @@ class FleetScatter:
     temperature: tuple = (-10.0, 10.0)
     lubricant_life: float = 0.3
     wear_spread: tuple = (0.0, 0.3)
-    usage: float = 0.15
+    usage: float = 0.3
+    usage_time: float = 200.0
 
     def __post_init__(self):
         t = "life.scatter"
@@ -174,6 +178,7 @@ class FleetScatter:
         require_range(f"{t}.wear_coefficient", self.wear_coefficient, 0.0, 3.0)
         require_range(f"{t}.lubricant_life", self.lubricant_life, 0.0, 3.0)
         require_range(f"{t}.usage", self.usage, 0.0, 2.0)
+        require_range(f"{t}.usage_time", self.usage_time, 1e-3, 1e6, unit="h")
 
 
 @dataclass(frozen=True)
@@ -413,11 +418,11 @@ def unit_life(
             )
 
     # Deterministic wear first (exact on the degradation grid), to size the age grid; then the
-    # unit's usage as a gamma process of wear increments along it.
+    # unit's wandering usage intensity along it.
     expected = _expected_failure(rates, b0, t_lube, spec)
     span = min(spec.max_age, 4.0 * expected)
     ages = np.linspace(0.0, span, _AGE_STEPS + 1)
-    usage = _usage_increments(rng, np.diff(ages), sc.usage, expected)
+    usage = _usage_increments(rng, np.diff(ages), sc.usage, sc.usage_time)
     mid = 0.5 * (ages[1:] + ages[:-1])
     d_mid = np.minimum(mid / t_lube, 1.0)
     worn = {
@@ -495,13 +500,20 @@ def _expected_failure(rates: dict, b0: float, t_lube: float, spec: LifeSpec) -> 
     return min(t_lube + (needed - aged[-1]) / mean_rate[-1], spec.max_age)
 
 
-def _usage_increments(rng, steps: np.ndarray, cv: float, horizon: float) -> np.ndarray:
-    """Usage [h] in each step: a gamma process with mean = the step and coefficient of
-    variation ``cv`` of its total at ``horizon`` (shape rate α = 1/(cv²·horizon) per hour)."""
-    if cv == 0.0:
+def _usage_increments(rng, steps: np.ndarray, sigma: float, correlation: float) -> np.ndarray:
+    """Usage [h] in each step: the step times the intensity exp(σX − σ²/2) (mean 1), X a
+    unit-variance Ornstein–Uhlenbeck process with correlation time ``correlation`` [h]
+    (exact discretisation)."""
+    if sigma == 0.0:
         return steps
-    alpha = 1.0 / (cv * cv * horizon)
-    return rng.gamma(alpha * steps, 1.0 / alpha)
+    keep = np.exp(-steps / correlation)
+    shocks = rng.standard_normal(len(steps) + 1)
+    x = np.empty(len(steps))
+    state = shocks[0]
+    for i, (a, z) in enumerate(zip(keep, shocks[1:])):
+        state = a * state + math.sqrt(1.0 - a * a) * z
+        x[i] = state
+    return steps * np.exp(sigma * x - 0.5 * sigma * sigma)
 
 
 def _crossing(life: UnitLife, threshold: float) -> float:

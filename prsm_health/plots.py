@@ -259,3 +259,43 @@ def _save(fig, path: Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def plot_fleet_lives(lives, path: str | Path, *, test_units=(), snapshots: int = 0) -> Path:
+    """Wear trajectories of a fleet (:func:`prsm_health.life.fleet_lives`): mean thread
+    half-clearance, screw and nut sides, and lubricant degradation over operating hours, with
+    the failure threshold and the snapshot ages; saved as PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_b, ax_s, ax_d) = plt.subplots(1, 3, figsize=(15, 4.2))
+    test_units = set(test_units)
+    for unit in lives:
+        ages = np.linspace(0.0, unit.failure_age, 200)
+        screw, nut = unit.clearances(ages)
+        color = "tab:red" if unit.unit_id in test_units else "tab:blue"
+        ax_b.plot(ages, 0.5 * (screw + nut) * 1e6, color=color, lw=0.9, alpha=0.8)
+        if snapshots:
+            at = unit.snapshot_ages(snapshots)
+            ax_b.plot(at, unit.clearance(at) * 1e6, ".", color=color, ms=2.5)
+        ax_s.plot(ages, screw * 1e6, color="tab:purple", lw=0.7, alpha=0.6)
+        ax_s.plot(ages, nut * 1e6, color="tab:green", lw=0.7, alpha=0.6)
+        ax_d.plot(ages, unit.degradation(ages), color=color, lw=0.8, alpha=0.7)
+        if unit.failure_mode == "spall":  # failed by its spall before the wear limit
+            ax_b.plot(unit.failure_age, float(unit.clearance(unit.failure_age)) * 1e6, "kx")
+    threshold = lives[0].failure_clearance * 1e6
+    ax_b.axhline(threshold, color="k", ls="--", lw=0.8)
+    ax_b.set_title(
+        f"mean thread half-clearance (blue: train, red: test units; failure at {threshold:g} µm)",
+        fontsize=9,
+    )
+    ax_s.set_title("screw side (purple) and nut side (green)", fontsize=9)
+    ax_d.set_title("lubricant degradation (additives used up at 1)", fontsize=9)
+    for ax, label in ((ax_b, "µm"), (ax_s, "µm"), (ax_d, "-")):
+        ax.set_xlabel("age [operating hours]")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return _save(fig, Path(path))
