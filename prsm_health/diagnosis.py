@@ -512,18 +512,38 @@ def diagnose(
     window : float or None [s]
         Window length; default the model's training window (see :func:`split_windows`).
     """
+    return diagnose_runs([run], bundle, window=window)[0]
+
+
+def diagnose_runs(
+    runs: list[Run], bundle: ModelBundle | None = None, *, window: float | None = None
+) -> list[Diagnosis]:
+    """Diagnose several recordings in one batch (every window's indicators in one call):
+    one :class:`Diagnosis` per run, each as :func:`diagnose` gives it."""
     bundle = bundle or load_bundle()
-    run = run.without_truth().validate()
-    parts, notes = split_windows(run, window or bundle.window)
-    rows = bundle.indicators_batch(parts)
-    per_window = diagnose_indicators(
-        rows, bundle, [tuple(run.channels)] * len(rows), run.labels.get("design")
-    )
-    for k, (part, d) in enumerate(zip(parts, per_window)):
-        d.window = {"index": k, "start": float(part.time[0]), "end": float(part.time[-1])}
-    result = aggregate(per_window, bundle)
-    result.warnings.extend(notes)
-    return result
+    runs = [run.without_truth().validate() for run in runs]
+    split = [split_windows(run, window or bundle.window) for run in runs]
+    rows = bundle.indicators_batch([part for parts, _ in split for part in parts])
+    channels = [tuple(run.channels) for run, (parts, _) in zip(runs, split) for _ in parts]
+    designs = [run.labels.get("design") for run, (parts, _) in zip(runs, split) for _ in parts]
+    per_window = []
+    for design in dict.fromkeys(designs):  # one call per design (usually one)
+        at = [i for i, d in enumerate(designs) if d == design]
+        found = diagnose_indicators(
+            [rows[i] for i in at], bundle, [channels[i] for i in at], design
+        )
+        per_window.extend(zip(at, found))
+    per_window = [d for _, d in sorted(per_window, key=lambda pair: pair[0])]
+    results, start = [], 0
+    for parts, notes in split:
+        mine = per_window[start : start + len(parts)]
+        start += len(parts)
+        for k, (part, d) in enumerate(zip(parts, mine)):
+            d.window = {"index": k, "start": float(part.time[0]), "end": float(part.time[-1])}
+        result = aggregate(mine, bundle)
+        result.warnings.extend(notes)
+        results.append(result)
+    return results
 
 
 @dataclass

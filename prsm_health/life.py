@@ -421,34 +421,40 @@ def unit_life(
     # unit's wandering usage intensity along it.
     expected = _expected_failure(rates, b0, t_lube, spec)
     span = min(spec.max_age, 4.0 * expected)
-    ages = np.linspace(0.0, span, _AGE_STEPS + 1)
-    usage = _usage_increments(rng, np.diff(ages), sc.usage, sc.usage_time)
-    mid = 0.5 * (ages[1:] + ages[:-1])
-    d_mid = np.minimum(mid / t_lube, 1.0)
-    worn = {
-        side: np.concatenate([[0.0], np.cumsum(np.interp(d_mid, _DEGRADATION_GRID, r) * usage)])
-        for side, r in rates.items()
-    }
-    life = UnitLife(
-        unit_id=unit_id,
-        seed=int(np.random.SeedSequence([fleet_seed, unit_id, 0x554E4954]).generate_state(1)[0]),
-        initial_clearance=b0,
-        wear_spread=spread,
-        load_scale=load_scale,
-        temperature=temperature,
-        lubricant_life=t_lube,
-        ages=ages,
-        worn_screw=worn["screw"],
-        worn_nut=worn["nut"],
-        spall=None,
-        spall_age=math.inf,
-        spall_doubling=math.inf,
-        failure_age=math.inf,
-        failure_mode="wear",
-        failure_clearance=spec.failure_clearance,
-        failure_spall_length=spec.failure_spall_length,
-    )
-    wear_failure = _crossing(life, spec.failure_clearance)
+    while True:  # a unit whose usage ran low may need a longer grid (same draws otherwise)
+        ages = np.linspace(0.0, span, _AGE_STEPS + 1)
+        usage = _usage_increments(rng, np.diff(ages), sc.usage, sc.usage_time)
+        mid = 0.5 * (ages[1:] + ages[:-1])
+        d_mid = np.minimum(mid / t_lube, 1.0)
+        worn = {
+            side: np.concatenate([[0.0], np.cumsum(np.interp(d_mid, _DEGRADATION_GRID, r) * usage)])
+            for side, r in rates.items()
+        }
+        life = UnitLife(
+            unit_id=unit_id,
+            seed=int(
+                np.random.SeedSequence([fleet_seed, unit_id, 0x554E4954]).generate_state(1)[0]
+            ),
+            initial_clearance=float(b0),
+            wear_spread=float(spread),
+            load_scale=float(load_scale),
+            temperature=float(temperature),
+            lubricant_life=t_lube,
+            ages=ages,
+            worn_screw=worn["screw"],
+            worn_nut=worn["nut"],
+            spall=None,
+            spall_age=math.inf,
+            spall_doubling=math.inf,
+            failure_age=math.inf,
+            failure_mode="wear",
+            failure_clearance=spec.failure_clearance,
+            failure_spall_length=spec.failure_spall_length,
+        )
+        wear_failure = _crossing(life, spec.failure_clearance)
+        if math.isfinite(wear_failure) or span >= spec.max_age:
+            break
+        span = min(spec.max_age, 4.0 * span)
 
     # Spall: ISO 281 survival of the surfaces together, S = exp(ln 0.9·Σ (D_i)^e), D_i the
     # L10 lives consumed; initiation where S reaches the unit's drawn survival.

@@ -22,9 +22,9 @@ Sliding speeds:
 * roller–nut: rolling synchronised by the ring gear, no gross sliding (paper 02 has none
   there): spin only;
 * spin of a contact whose normal is inclined by the flank angle β to the rolling axis: angular
-  velocity ω_sp = (u_e/r_r)·sin β about the normal, mean sliding speed over the Hertz pressure
-  distribution (3π/16)·√(ab)·ω_sp (Johnson 1985, §8.4; the pressure-weighted mean radius of a
-  Hertz contact is 3π/16 of its radius).
+  velocity ω_sp = (u_e/r_r)·sin β about the normal (Johnson 1985, §8.4); a point of the track's
+  centre line crossing the contact at x slides at |x|·ω_sp, which over the Hertz pressure along
+  it, ∫p|x|dx/∫p dx, is 4b/(3π)·ω_sp (b the semi-axis along rolling).
 
 Tracks: a roller thread turn carries one contact per flank on a track of length 2πr_r; the
 nut's flank track (2πr_n) is passed by n_R rollers; the screw's by n_R rollers per turn of the
@@ -206,7 +206,7 @@ def contact_states(
         q = float(normal_load(design, per_turn, side))
         a, b = (float(v) for v in hertz.semi_axes(q))
         spin = entrainment[side] / geometry.roller_radius * geometry.sin_beta
-        spin_sliding = 3.0 * math.pi / 16.0 * math.sqrt(a * b) * spin
+        spin_sliding = 4.0 * b / (3.0 * math.pi) * spin  # pressure-weighted, centre line
         out[side] = ContactState(
             normal_load=q,
             semi_major=a,
