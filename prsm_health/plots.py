@@ -299,3 +299,99 @@ def plot_fleet_lives(lives, path: str | Path, *, test_units=(), snapshots: int =
         ax.grid(alpha=0.3)
     fig.tight_layout()
     return _save(fig, Path(path))
+
+
+def plot_prognostics(histories, predictions, model, directory, *, alpha: float = 0.2) -> list[Path]:
+    """Figures of a prognostics evaluation (tools/train_prognostics_model.py): each held-out
+    unit's predicted RUL against its true RUL with the α cone, and its diagnosed health
+    indicator against the true clearance; saved as PNG in ``directory``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(directory)
+    units = sorted(int(u) for u in predictions["unit_id"].unique())
+    cols = min(3, len(units))
+    rows = -(-len(units) // cols)
+    written = []
+
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.4 * rows), squeeze=False)
+    for ax, unit in zip(axes.flat, units):
+        mine = predictions[predictions["unit_id"] == unit]
+        deg = mine[mine["method"] == "degradation"]
+        sim = mine[mine["method"] == "similarity"]
+        ax.plot(deg["age_hours"], deg["true_rul"], "k-", lw=1, label="true RUL")
+        ax.fill_between(
+            deg["age_hours"],
+            (1 - alpha) * deg["true_rul"],
+            (1 + alpha) * deg["true_rul"],
+            color="0.85",
+            label=f"±{alpha:g}·true (α cone)",
+        )
+        ax.fill_between(
+            deg["age_hours"], deg["lower"], deg["upper"], color="tab:blue", alpha=0.25, lw=0
+        )
+        ax.plot(
+            deg["age_hours"],
+            deg["estimate"],
+            "o-",
+            color="tab:blue",
+            ms=2.5,
+            lw=1,
+            label="degradation (90 % interval)",
+        )
+        ax.plot(
+            sim["age_hours"],
+            sim["estimate"],
+            "s--",
+            color="tab:orange",
+            ms=2,
+            lw=0.8,
+            label="similarity",
+        )
+        life = float(deg["age_hours"].max() + deg["true_rul"].min())
+        ax.axvline(0.5 * life, color="0.5", ls=":", lw=0.8)
+        ax.set_title(f"unit {unit} (life {life:.0f} h)", fontsize=9)
+        ax.set_xlabel("age [h]")
+        ax.set_ylabel("RUL [h]")
+        ax.set_ylim(0, 1.6 * float(deg["true_rul"].max()))
+        ax.grid(alpha=0.3)
+    axes.flat[0].legend(fontsize=6.5, loc="upper right")
+    for ax in list(axes.flat)[len(units) :]:
+        ax.axis("off")
+    written.append(_save(fig, out / "prognostics_rul.png"))
+
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.2 * rows), squeeze=False)
+    for ax, unit in zip(axes.flat, units):
+        h = histories[histories["unit_id"] == unit]
+        ax.errorbar(
+            h["age_hours"],
+            h["clearance"] * 1e6,
+            yerr=[
+                (h["clearance"] - h["clearance_lower"]) * 1e6,
+                (h["clearance_upper"] - h["clearance"]) * 1e6,
+            ],
+            fmt=".",
+            ms=3,
+            lw=0.6,
+            color="tab:blue",
+            label="diagnosed (90 % interval)",
+        )
+        ax.plot(h["age_hours"], h["clearance_mean_true"] * 1e6, "k-", lw=1, label="true (mean)")
+        ax.axhline(
+            model.threshold * 1e6,
+            color="tab:red",
+            ls="--",
+            lw=0.8,
+            label="model threshold (diagnosed)",
+        )
+        ax.set_title(f"unit {unit}", fontsize=9)
+        ax.set_xlabel("age [h]")
+        ax.set_ylabel("clearance [µm]")
+        ax.grid(alpha=0.3)
+    axes.flat[0].legend(fontsize=6.5, loc="upper left")
+    for ax in list(axes.flat)[len(units) :]:
+        ax.axis("off")
+    written.append(_save(fig, out / "prognostics_indicator.png"))
+    return written
