@@ -149,7 +149,9 @@ class FleetScatter:
         cycle: missions, loads, idle spells), which wanders as a mean-reverting
         (Ornstein–Uhlenbeck) process with correlation time ``usage_time``: wear speeds up and
         slows down over a unit's life, so no two units, and no unit's two halves of life, wear
-        alike. 0: the duty cycle exactly.
+        alike. 0: the duty cycle exactly. Default 0.15: a season's usage of units flying the
+        same missions differs by ≈ ±15 % (engineering estimate; docs/prognostics.md shows the
+        RUL scores at 0 … 0.3).
     usage_time : float [h]
         Correlation time of the usage intensity (a season of operation).
     """
@@ -160,7 +162,7 @@ class FleetScatter:
     temperature: tuple = (-10.0, 10.0)
     lubricant_life: float = 0.3
     wear_spread: tuple = (0.0, 0.3)
-    usage: float = 0.3
+    usage: float = 0.15
     usage_time: float = 200.0
 
     def __post_init__(self):

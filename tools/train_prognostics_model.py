@@ -47,6 +47,10 @@ RECIPE = ROOT / "datasets" / "fleet.toml"
 CARD = ROOT / "models" / "PROGNOSTICS_CARD.md"
 FIGURES = ROOT / "models" / "figures"
 ALPHA = 0.2
+#: Sensitivity study: usage variability and health-indicator noise (life model only, no
+#: dynamics): 60 units each, 40 to fit, 20 to score.
+USAGE_LEVELS = (0.0, 0.15, 0.3)
+NOISE_LEVELS = (0.0, 1e-6, 2e-6)  # m, 1σ of a diagnosis' error (the shipped one: ≈ 2 µm)
 #: Diagnoses of a unit's last share of life used to read the indicator at failure.
 LAST_SHARE = 0.25
 
@@ -114,10 +118,65 @@ def main() -> None:
             f"  (all {s['coverage']:.3f})  RMSE after half {s['rmse_after']:.0f} h"
             f"  PH {s['prognostic_horizon']:.0f} h"
         )
-    _write_card(recipe, model, histories, predictions, summary, generation, report)
+    sensitivity = sensitivity_table(recipe)
+    _write_card(recipe, model, histories, predictions, summary, generation, report, sensitivity)
 
 
-def _write_card(recipe, model, histories, predictions, summary, generation, report) -> None:
+def sensitivity_table(recipe) -> list[str]:
+    """α–λ accuracy and coverage (degradation / similarity) against usage variability and
+    health-indicator noise: the life model's trajectories observed with Gaussian errors of a
+    given σ (intervals ±1.645σ, at least ±0.2 µm), so what limits a RUL is seen apart from
+    the diagnosis."""
+    from dataclasses import replace
+
+    from prsm_health.design_files import load_design
+    from prsm_health.life import fleet_lives
+
+    spec0 = recipe.life_spec
+    rows = []
+    for usage in USAGE_LEVELS:
+        spec = replace(spec0, units=60, scatter=replace(spec0.scatter, usage=usage))
+        lives = fleet_lives(load_design(recipe.design), spec, recipe.seed + 1)
+        failure = {u.unit_id: u.failure_age for u in lives}
+        cells = []
+        for noise in NOISE_LEVELS:
+            rng = np.random.default_rng([recipe.seed, int(noise * 1e9)])
+            frames = []
+            for unit in lives:
+                ages = unit.snapshot_ages(spec.snapshots)
+                value = unit.clearance(ages) + rng.normal(0.0, noise, len(ages))
+                half = max(1.645 * noise, 0.2e-6)
+                frames.append(
+                    pd.DataFrame(
+                        {
+                            "unit_id": unit.unit_id,
+                            "age_hours": ages,
+                            "clearance": value,
+                            "clearance_lower": value - half,
+                            "clearance_upper": value + half,
+                        }
+                    )
+                )
+            table = pd.concat(frames, ignore_index=True)
+            train, test = table[table["unit_id"] < 40], table[table["unit_id"] >= 40]
+            model = PrognosticsModel(threshold=spec.failure_clearance, design=recipe.design)
+            model.fit(train, {u: failure[u] for u in range(40)})
+            _, summary = evaluate_units(
+                test, {u: failure[u] for u in range(40, 60)}, model, alpha=ALPHA
+            )
+            d, s = summary["degradation"], summary["similarity"]
+            cells.append(
+                f"{d['alpha_lambda']:.2f} / {s['alpha_lambda']:.2f} — "
+                f"{d['coverage_after']:.2f} / {s['coverage_after']:.2f}"
+            )
+        rows.append(f"| {usage:g} | " + " | ".join(cells) + " |")
+        print(rows[-1])
+    return rows
+
+
+def _write_card(
+    recipe, model, histories, predictions, summary, generation, report, sensitivity
+) -> None:
     from prsm_health.plots import plot_prognostics
 
     FIGURES.mkdir(parents=True, exist_ok=True)
@@ -140,8 +199,13 @@ def _write_card(recipe, model, histories, predictions, summary, generation, repo
         "Bayesian updating (Gebraeel et al. 2005); baseline: similarity (Wang et al. 2008).",
         "",
         f"**Data.** `datasets/fleet.toml`: {spec.units} units × {spec.snapshots} snapshots of "
-        f"{recipe.duration:g} s ({report.total_runs} runs; generated in {generation:.0f} s "
-        f"on 2 workers, {report.resumed_runs} of them in an earlier call). Each unit wears by Archard wear of its thread contacts, "
+        f"{recipe.duration:g} s ({report.total_runs} runs"
+        + (
+            f"; generated in {generation:.0f} s on 2 workers"
+            if report.resumed_runs == 0
+            else "; generation timed in docs/prognostics.md"
+        )
+        + "). Each unit wears by Archard wear of its thread contacts, "
         "faster as its lubricant's additives deplete, with unit-to-unit scatter of build, wear "
         "coefficient, lubricant life, temperature, loads and a wandering usage intensity "
         "(docs/prognostics.md); it fails when its true mean half-clearance reaches "
@@ -180,6 +244,24 @@ def _write_card(recipe, model, histories, predictions, summary, generation, repo
     ]
     lines += by_unit
     lines += [
+        "",
+        "### What limits it: usage variability and indicator noise",
+        "",
+        "The life model's own trajectories (60 units, 40 fitted, 20 scored; no dynamics), "
+        "observed with Gaussian errors of σ (the shipped diagnosis: bias ≈ +2.4 µm, learnt "
+        "into the threshold, and scatter ≈ 2 µm); cells: α–λ accuracy degradation / "
+        "similarity — 90 % coverage degradation / similarity, after half of life.",
+        "",
+        "| usage σ | " + " | ".join(f"indicator σ {n * 1e6:g} µm" for n in NOISE_LEVELS) + " |",
+        "|---|" + "---|" * len(NOISE_LEVELS),
+        *sensitivity,
+        "",
+        "Reading it: the first column is the models' own error with a perfect indicator — for "
+        "the degradation model, the misfit of one fleet-wide baseline φ to units whose initial "
+        "clearance and wear amplitude differ (its intervals are then too narrow); the other "
+        "columns add the diagnosis' scatter, which at the end of life, where the clearance "
+        "grows by 0.01–0.02 µm/h, is worth ±100–200 h against an α bound of ±0.2·RUL. The usage "
+        "rows add the unpredictable future of a unit's usage.",
         "",
         "Figures: " + ", ".join(f"[{p.stem}](figures/{p.name})" for p in figures) + ".",
         "",
