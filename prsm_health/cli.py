@@ -372,6 +372,7 @@ def _cmd_serve(args) -> int:
             args.token,
             limits=ServiceLimits(**overrides),
             log_level=args.log_level,
+            prognostics_model_path=args.prognostics_model,
         )
     except KeyboardInterrupt:  # Ctrl-C: uvicorn has shut down gracefully and said so
         return 0
@@ -514,6 +515,99 @@ def _cmd_train(args) -> int:
 def _scaled(value, factor: float = 1.0):
     """A metric for the table; '–' where it could not be computed (None)."""
     return "–" if value is None else factor * value
+
+
+# ----------------------------------------------------------------------------- prognose
+#: The methods ``prognose --method`` offers (those of prsm_health.prognostics.METHODS; kept
+#: here so that building the parser does not import pandas and scipy).
+PROGNOSIS_METHODS = ("degradation", "similarity", "degradation-exponential", "degradation-linear")
+
+
+def _is_dataset(source: str) -> bool:
+    """A fleet dataset (a directory, or an object-store URL) rather than a history file."""
+    from pathlib import Path
+
+    return "://" in source or Path(source).is_dir()
+
+
+def _cmd_prognose(args) -> int:
+    from .prognostics import load_prognostics_model, prognose, read_history
+
+    fleet = _is_dataset(args.source)
+    if not fleet:
+        for option, value in (
+            ("--unit", args.unit),
+            ("--until-age", args.until_age),
+            ("--diagnosis-model", args.diagnosis_model),
+        ):
+            if value is not None:
+                raise PRSMHealthError(
+                    f"{option} applies to a fleet dataset; {args.source} is a history file"
+                )
+    elif args.unit is None:
+        raise PRSMHealthError(
+            f"{args.source} is a fleet dataset: choose the unit to prognose with --unit ID"
+        )
+    model = load_prognostics_model(args.model)  # before the diagnoses: a bad file fails fast
+    true_rul = None
+    if fleet:
+        from .diagnosis import load_bundle
+        from .prognostics import fleet_histories
+
+        # the shipped model is loaded by fleet_histories, after its checks of the unit and age
+        bundle = None if args.diagnosis_model is None else load_bundle(args.diagnosis_model)
+        history = fleet_histories(
+            args.source,
+            bundle,
+            units=[args.unit],
+            until_age=args.until_age,
+            progress=not args.json and sys.stderr.isatty(),  # a person is watching
+        )
+        true_rul = float(history["rul_hours"].iloc[-1])
+    else:
+        history = read_history(args.source)
+    prognosis = prognose(history, model, args.method)
+    if args.json:
+        _print_json(prognosis.as_dict())
+        return 0
+    _print_table(_prognosis_rows(args, prognosis, history, true_rul))
+    return 0
+
+
+def _hours(value: float) -> str:
+    """Hours for the summary: whole hours from 100 h, else 3 significant digits."""
+    return f"{value:.0f}" if abs(value) >= 100 else f"{value:.3g}"
+
+
+def _prognosis_rows(args, prognosis, history, true_rul) -> list:
+    rul, hi, m = prognosis.rul_hours, prognosis.health_indicator, prognosis.model
+    latest = history.iloc[-1]  # the latest diagnosis, with its own (maybe uneven) interval
+    ages = hi["ages_hours"]
+    source = f"{args.source}, unit {args.unit}" if args.unit is not None else args.source
+    rows = [
+        ("history", source, ""),
+        ("diagnoses", f"{len(ages)} from {_hours(ages[0])} to {_hours(ages[-1])}", "h"),
+        (
+            "RUL",
+            f"{_hours(rul['estimate'])} [{_hours(rul['lower'])}, {_hours(rul['upper'])}]",
+            "h (median, 90 % interval)",
+        ),
+    ]
+    if true_rul is not None:
+        rows.append(("true RUL", _hours(true_rul), "h (the simulator's truth, dataset labels)"))
+    rows += [
+        (
+            "clearance now",
+            f"{_um(hi['current']).strip()} [{_um(float(latest['clearance_lower'])).strip()}, "
+            f"{_um(float(latest['clearance_upper'])).strip()}]",
+            "µm (90 % interval)",
+        ),
+        ("failure threshold", _um(hi["threshold"]).strip(), "µm"),
+        ("method", m["name"], ""),
+        ("model", f"{m['design']}, {m['units_trained']} training units, v{m['version']}", ""),
+    ]
+    rows += [("warning", text, "") for text in prognosis.warnings]
+    return rows
 
 
 # ----------------------------------------------------------------------------- simulate
@@ -887,6 +981,46 @@ def build_parser() -> argparse.ArgumentParser:
     _add_json(d, "the Diagnosis contract")
     d.set_defaults(func=_cmd_diagnose)
 
+    g = command(
+        "prognose",
+        "remaining useful life from a history of diagnoses, or of a fleet dataset's unit",
+    )
+    g.add_argument(
+        "source",
+        metavar="HISTORY_OR_DATASET",
+        help="history table (.csv or .parquet: age_hours, clearance, clearance_lower, "
+        "clearance_upper [h, m]; optional design, fault_class, unit_id), or a fleet dataset "
+        "directory or URL (prsm-health generate on a recipe with [life]) with --unit",
+    )
+    g.add_argument(
+        "--unit", type=int, default=None, metavar="ID", help="fleet dataset: the unit's unit_id"
+    )
+    g.add_argument(
+        "--until-age",
+        type=_finite_float,
+        default=None,
+        metavar="H",
+        help="fleet dataset: only the snapshots at ages <= H [h] (what was known then)",
+    )
+    g.add_argument(
+        "--model", default=None, help="prognostics model JSON (None: models/prognostics.json)"
+    )
+    g.add_argument(
+        "--diagnosis-model",
+        default=None,
+        metavar="D",
+        help="fleet dataset: model bundle that diagnoses the snapshots (None: the shipped model)",
+    )
+    g.add_argument(
+        "--method",
+        choices=PROGNOSIS_METHODS,
+        default=None,
+        help="degradation (the form chosen at fit time), similarity, or a forced degradation "
+        "form (None: the model's default)",
+    )
+    _add_json(g, "the prognosis")
+    g.set_defaults(func=_cmd_prognose)
+
     e = command(
         "evaluate", "score a model on a dataset (generated or imported) through the diagnosis"
     )
@@ -929,6 +1063,13 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("--host", default="127.0.0.1", help="bind address (non-loopback needs a token)")
     v.add_argument("--port", type=int, default=8000, help="TCP port")
     v.add_argument("--model", default=None, help="model bundle (None: the shipped model)")
+    v.add_argument(
+        "--prognostics-model",
+        default=None,
+        metavar="FILE",
+        help="prognostics model for GET /v1/assets/{id}/prognosis (None: the shipped "
+        "models/prognostics.json if present, else that endpoint answers 503)",
+    )
     v.add_argument("--db", default=None, help="SQLite history database (None: see docs/service.md)")
     v.add_argument("--token", default=None, help="bearer token (None: $PRSM_HEALTH_TOKEN)")
     v.add_argument(

@@ -12,6 +12,9 @@ and curl examples in docs/service.md):
 * ``POST /v1/diagnose/file`` — multipart upload of a ``.mcap`` or ``.parquet`` recording;
   returns the whole-recording diagnosis and the per-window diagnoses;
 * ``GET /v1/assets/{asset_id}/history`` — diagnoses stored for an asset, oldest first;
+* ``GET /v1/assets/{asset_id}/prognosis`` — remaining useful life from the asset's diagnoses
+  sent with ``operating_hours`` (:mod:`prsm_health.prognostics`, the prognostics model loaded
+  at start);
 * ``GET /v1/health``, ``GET /v1/model``, and the OpenAPI document at ``/openapi.json``.
 
 Safety: the service binds 127.0.0.1 by default; with a bearer token (``token`` argument or
@@ -24,7 +27,7 @@ private temporary directory removed after the request. Parsing and diagnosis run
 (at most :attr:`ServiceLimits.workers` at once) so ``/v1/health`` answers while they run.
 
 History is kept in SQLite (:class:`HistoryStore`): WAL journal, one transaction per request,
-the schema created when missing.
+the schema created when missing and migrated when older (version 1 → 2: ``operating_hours``).
 
 Modules: :mod:`.limits` (ServiceLimits), :mod:`.history` (HistoryStore), :mod:`.schemas`
 (pydantic models), :mod:`.uploads` (multipart streaming), :mod:`.security` (token and body

@@ -1,5 +1,5 @@
-"""The ASGI application: :func:`create_app` loads the model, opens the history store and
-assembles the routers (:mod:`.routes`), error handlers, OpenAPI document and the guard."""
+"""The ASGI application: :func:`create_app` loads the model and the prognostics model, opens
+the history store and assembles the routers (:mod:`.routes`), error handlers, OpenAPI document and the guard."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from fastapi.openapi.utils import get_openapi
 
 from .. import __version__
 from ..diagnosis import load_bundle
+from ..errors import PRSMHealthError
 from .diagnosing import warm_up
 from .handlers import install_error_handlers
 from .history import HistoryStore, default_db_path
@@ -43,6 +44,8 @@ def create_app(
     *,
     bundle=None,
     warmup: bool = True,
+    prognostics_model_path: str | os.PathLike | None = None,
+    prognostics_model=None,
 ) -> FastAPI:
     """The ASGI application.
 
@@ -61,15 +64,29 @@ def create_app(
     warmup : bool
         Diagnose a blank recording in the background at start-up, so the first request does
         not pay for one-time compilation and caches.
+    prognostics_model_path : path or None
+        Prognostics model (:func:`prsm_health.prognostics.save_prognostics_model`) for
+        ``GET /v1/assets/{asset_id}/prognosis``, loaded once, here. None: the shipped
+        ``models/prognostics.json`` if it exists, else none (that endpoint answers 503).
+    prognostics_model : PrognosticsModel or None
+        An already loaded model (overrides ``prognostics_model_path``).
 
     Raises
     ------
     PRSMHealthError
-        Unreadable model or database, empty token.
+        Unreadable model, prognostics model or database, empty token.
     """
     limits = limits or ServiceLimits()
     check_token(token)
     bundle, model_file = _load_model(model_path, bundle)
+    prognostics_model = _load_prognostics_model(prognostics_model_path, prognostics_model)
+    if prognostics_model is not None and prognostics_model.design != bundle.design_name:
+        log.warning(
+            "the prognostics model is for design %r, the diagnosis model for %r: every "
+            "prognosis will be refused (422)",
+            prognostics_model.design,
+            bundle.design_name,
+        )
     store = _open_store(db_path)
     app = FastAPI(
         title=TITLE,
@@ -81,6 +98,7 @@ def create_app(
         responses={401: ERROR_RESPONSES[401]},
     )
     app.state.bundle = bundle
+    app.state.prognostics = prognostics_model
     app.state.store = store
     app.state.limits = limits
     app.state.workers = WorkerPool(limits, bundle)
@@ -108,6 +126,30 @@ def _load_model(model_path, bundle):
     if bundle is None:
         bundle = load_bundle(model_path)
     return bundle, model_file
+
+
+def _load_prognostics_model(path, model):
+    """The prognostics model: ``model`` if given, else the file at ``path``, else the shipped
+    one if it exists, else None (logged)."""
+    from .. import prognostics
+
+    if model is None:
+        if path is None:
+            path = prognostics.DEFAULT_PROGNOSTICS_MODEL
+            if not Path(path).is_file():
+                log.warning(
+                    "no prognostics model (%s not found): GET /v1/assets/{asset_id}/prognosis "
+                    "answers 503; give one with --prognostics-model",
+                    path,
+                )
+                return None
+        model = prognostics.load_prognostics_model(path)
+        what = str(path)
+    else:
+        what = "the prognostics model given"
+    if not isinstance(model, prognostics.PrognosticsModel) or not hasattr(model, "form_"):
+        raise PRSMHealthError(f"{what}: not a fitted prognostics model")
+    return model
 
 
 def _open_store(db_path) -> HistoryStore:

@@ -29,7 +29,7 @@ from ..io import read_recording, read_recording_bytes
 from ..jsonable import json_ready
 from ..run import MIN_SAMPLES, Run
 from .history import history_rows
-from .limits import MAX_ABS_VALUE, MAX_TIME, ServiceLimits
+from .limits import MAX_ABS_VALUE, MAX_OPERATING_HOURS, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
 from .schemas import ASSET_ID_PATTERN, DiagnoseRequest, parse_diagnose_request
 from .uploads import ReceivedUpload, precheck_recording, precheck_upload
@@ -92,8 +92,9 @@ class BodyParams:
     speed: float | None = None
     load: float | None = None
     design: str | None = None
+    operating_hours: float | None = None
 
-    FIELDS = ("asset_id", "speed", "load", "design")
+    FIELDS = ("asset_id", "speed", "load", "design", "operating_hours")
 
     @classmethod
     def from_query(cls, items: list[tuple[str, str]]) -> BodyParams:
@@ -108,13 +109,19 @@ class BodyParams:
                 )
             if name in values:
                 raise HTTPError(422, f"query parameter {name!r} given twice")
-            if name in ("speed", "load"):
+            if name in ("speed", "load", "operating_hours"):
                 try:
                     number = float(text)
                 except ValueError:
                     number = math.nan
                 if not math.isfinite(number):
                     raise HTTPError(422, f"{name} = {text[:40]!r}: a finite number expected")
+                if name == "operating_hours" and not 0 <= number <= MAX_OPERATING_HOURS:
+                    raise HTTPError(
+                        422,
+                        f"operating_hours = {text[:40]!r}: hours in [0, {MAX_OPERATING_HOURS:g}] "
+                        "expected",
+                    )
                 values[name] = number
             elif name == "asset_id":
                 if not re.fullmatch(ASSET_ID_PATTERN, text):
@@ -224,7 +231,7 @@ def diagnose_body(
     if fmt == "json":
         req = parse_diagnose_request(body, limits)
         run = run_from_request(req, bundle)
-        params = BodyParams(req.asset_id, req.speed, req.load, req.design)
+        params = BodyParams(req.asset_id, req.speed, req.load, req.design, req.operating_hours)
     else:
         params = params or BodyParams()
         check_design(params.design, bundle)
@@ -256,6 +263,7 @@ def diagnose_body(
             source=fmt,
             speed=params.speed,
             load=params.load,
+            operating_hours=params.operating_hours,
         )
     return Answer(encode(result), history)
 

@@ -1,6 +1,6 @@
 """Diagnoses per asset over time: :class:`HistoryStore` (embedded SQLite, WAL journal), its
-default location (:func:`default_db_path`) and its time format (:func:`utc_now`,
-:func:`parse_time`)."""
+default location (:func:`default_db_path`), its time format (:func:`utc_now`,
+:func:`parse_time`) and the table a prognosis is made from (:func:`prognosis_history`)."""
 
 from __future__ import annotations
 
@@ -39,6 +39,7 @@ CREATE TABLE IF NOT EXISTS diagnoses (
     window_end          REAL,              -- [s]
     speed               REAL,              -- nominal screw speed given by the client [rad/s]
     load                REAL,              -- nominal axial load given by the client [N]
+    operating_hours     REAL,              -- asset's operating hours at the recording [h]
     clearance_estimate  REAL,              -- [m]
     clearance_lower     REAL,              -- [m]
     clearance_upper     REAL,              -- [m]
@@ -50,7 +51,9 @@ CREATE TABLE IF NOT EXISTS diagnoses (
 );
 CREATE INDEX IF NOT EXISTS diagnoses_asset_time ON diagnoses (asset_id, received_at, id);
 """
-_SCHEMA_VERSION = 1
+#: Version 1: the table above without ``operating_hours``; version 2 added it (a version 1
+#: database gets the column on open, its existing rows NULL).
+_SCHEMA_VERSION = 2
 
 
 def utc_now() -> str:
@@ -121,6 +124,7 @@ class HistoryStore:
                 for statement in _SCHEMA.split(";"):
                     if statement.strip():
                         self._conn.execute(statement)
+                self._migrate()
                 self._conn.execute(f"PRAGMA user_version = {_SCHEMA_VERSION}")
         except BaseException as exc:
             self._conn.close()
@@ -129,6 +133,14 @@ class HistoryStore:
                     f"{self.path}: not a usable history database ({exc})"
                 ) from None
             raise
+
+    def _migrate(self) -> None:
+        """Bring an older table up to the current schema (inside the opening transaction, so
+        two processes opening the same file migrate it once): version 1 → 2 adds the nullable
+        ``operating_hours`` column."""
+        columns = {row[1] for row in self._conn.execute("PRAGMA table_info(diagnoses)")}
+        if "operating_hours" not in columns:
+            self._conn.execute("ALTER TABLE diagnoses ADD COLUMN operating_hours REAL")
 
     @contextlib.contextmanager
     def _transaction(self):
@@ -151,6 +163,7 @@ class HistoryStore:
         filename: str | None = None,
         speed: float | None = None,
         load: float | None = None,
+        operating_hours: float | None = None,
     ) -> list[int]:
         """Store diagnoses (contract dicts; a ``window`` key places one in its recording) in
         one transaction; returns their ids."""
@@ -163,6 +176,7 @@ class HistoryStore:
                 filename=filename,
                 speed=speed,
                 load=load,
+                operating_hours=operating_hours,
             )
         )
 
@@ -174,9 +188,10 @@ class HistoryStore:
             for row in rows:
                 cur = self._conn.execute(
                     "INSERT INTO diagnoses (asset_id, received_at, source, filename, window_index,"
-                    " window_start, window_end, speed, load, clearance_estimate, clearance_lower,"
-                    " clearance_upper, fault_class, class_probabilities, model_name, model_version,"
-                    " diagnosis) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    " window_start, window_end, speed, load, operating_hours, clearance_estimate,"
+                    " clearance_lower, clearance_upper, fault_class, class_probabilities,"
+                    " model_name, model_version, diagnosis)"
+                    " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                     row,
                 )
                 ids.append(cur.lastrowid)
@@ -195,13 +210,14 @@ class HistoryStore:
             ).fetchone()[0]
             rows = self._conn.execute(
                 "SELECT id, received_at, source, filename, window_index, window_start, window_end,"
-                f" speed, load, diagnosis FROM diagnoses WHERE {where}"
+                f" speed, load, operating_hours, diagnosis FROM diagnoses WHERE {where}"
                 " ORDER BY received_at DESC, id DESC LIMIT ?",
                 [*args, int(limit)],
             ).fetchall()
         entries = []
         for row in reversed(rows):
-            id_, received_at, source, filename, w_index, w_start, w_end, speed, load, blob = row
+            id_, received_at, source, filename, w_index, w_start, w_end, speed, load = row[:9]
+            hours, blob = row[9:]
             entries.append(
                 {
                     "id": id_,
@@ -213,6 +229,7 @@ class HistoryStore:
                     else {"index": w_index, "start": w_start, "end": w_end},
                     "speed": speed,
                     "load": load,
+                    "operating_hours": hours,
                     "diagnosis": json.loads(blob),
                 }
             )
@@ -223,6 +240,20 @@ class HistoryStore:
             "truncated": total > len(entries),
             "diagnoses": entries,
         }
+
+    def operating_history(self, asset_id: str) -> list[tuple]:
+        """The asset's diagnoses stored with operating hours, by operating hours, then by
+        receive time and id (the latest received last): rows ``(operating_hours,
+        clearance_estimate, clearance_lower, clearance_upper, fault_class, design)``, the
+        design being the diagnosing model's (``model.design`` of the stored diagnosis)."""
+        with self._lock:
+            return self._conn.execute(
+                "SELECT operating_hours, clearance_estimate, clearance_lower, clearance_upper,"
+                " fault_class, json_extract(diagnosis, '$.model.design') FROM diagnoses"
+                " WHERE asset_id = ? AND operating_hours IS NOT NULL"
+                " ORDER BY operating_hours, received_at, id",
+                (asset_id,),
+            ).fetchall()
 
     def has_asset(self, asset_id: str) -> bool:
         with self._lock:
@@ -245,6 +276,7 @@ def history_rows(
     filename: str | None = None,
     speed: float | None = None,
     load: float | None = None,
+    operating_hours: float | None = None,
 ) -> list[tuple]:
     """The database rows of diagnoses (contract dicts; a ``window`` key places one in its
     recording): plain tuples of numbers and text, JSON already encoded, for
@@ -266,6 +298,7 @@ def history_rows(
                 w.get("end"),
                 speed,
                 load,
+                operating_hours,
                 c.get("estimate"),
                 c.get("lower"),
                 c.get("upper"),
@@ -277,3 +310,37 @@ def history_rows(
             )
         )
     return rows
+
+
+def prognosis_history(rows: list[tuple]):
+    """The history table a prognosis is made from
+    (:func:`prsm_health.prognostics.prognose`), from :meth:`HistoryStore.operating_history`
+    rows, and notes on the rows left out.
+
+    ``age_hours`` is the stored operating hours; ``clearance``, ``clearance_lower``,
+    ``clearance_upper`` [m] the stored estimate and 90 % interval; ``design`` the diagnosing
+    model's; ``fault_class``. Of several diagnoses at the same operating hours only the latest
+    received is kept (a repeated reading replaces the earlier one); diagnoses without a
+    clearance estimate or interval (a model without a clearance estimator) carry nothing to
+    predict from and are left out, with a note.
+
+    Returns
+    -------
+    (pandas.DataFrame, list of str)
+        The table, oldest first (operating hours strictly increasing), and the notes.
+    """
+    import pandas as pd
+
+    from ..prognostics import HISTORY_COLUMNS
+
+    columns = [*HISTORY_COLUMNS, "fault_class", "design"]
+    usable = [r for r in rows if None not in r[1:4]]
+    notes = []
+    if len(usable) < len(rows):
+        notes.append(
+            f"{len(rows) - len(usable)} stored diagnosis(es) with operating hours but without a "
+            "clearance estimate and interval were left out"
+        )
+    table = pd.DataFrame(usable, columns=columns)
+    table = table.drop_duplicates("age_hours", keep="last").reset_index(drop=True)
+    return table, notes

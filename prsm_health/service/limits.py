@@ -14,6 +14,8 @@ from ..errors import PRSMHealthError, RecordingError
 MAX_ABS_VALUE = 1e12
 #: Largest accepted time [s] of a recording's samples: time runs from the recording start.
 MAX_TIME = 1e7
+#: Largest accepted operating hours [h] of an asset (over a thousand years: a typing error).
+MAX_OPERATING_HOURS = 1e7
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from pydantic_core import PydanticKnownError
 
 from ..channels import CHANNEL_NAMES, CHANNELS, TRUTH_NAMES, TRUTH_PREFIX
 from ..design import PRESETS
-from .limits import ServiceLimits
+from .limits import MAX_OPERATING_HOURS, ServiceLimits
 from .responses import HTTPError
 
 #: Pattern of an asset id (also a URL path segment).
@@ -32,6 +32,11 @@ ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
 _DEFAULT_LIMITS = ServiceLimits()
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
+#: What ``operating_hours`` of a diagnose request means (JSON field and query parameter).
+OPERATING_HOURS_DESCRIPTION = (
+    "operating hours of the asset when the recording was made [h], 0 – 1e7; stored with the "
+    "diagnosis and used by GET /v1/assets/{asset_id}/prognosis"
+)
 
 # One optional array per measured contract channel; any other name is an error
 # (extra="forbid"), simulator truth included: a diagnosis reads measurements only, and a truth
@@ -58,6 +63,12 @@ class DiagnoseRequest(BaseModel):
     )
     speed: Finite | None = Field(None, description="nominal screw speed [rad/s] (stored)")
     load: Finite | None = Field(None, description="nominal axial load [N] (stored)")
+    operating_hours: Finite | None = Field(
+        None,
+        ge=0,
+        le=MAX_OPERATING_HOURS,
+        description=OPERATING_HOURS_DESCRIPTION,
+    )
     asset_id: str | None = Field(
         None,
         pattern=ASSET_ID_PATTERN,
@@ -172,6 +183,9 @@ class HistoryEntry(BaseModel):
     window: WindowRef | None
     speed: float | None = Field(description="[rad/s]")
     load: float | None = Field(description="[N]")
+    operating_hours: float | None = Field(
+        description="operating hours of the asset at the recording, as sent [h]"
+    )
     diagnosis: dict
 
 
@@ -181,6 +195,46 @@ class History(BaseModel):
     total: int = Field(description="diagnoses stored at or after `since`")
     truncated: bool
     diagnoses: list[HistoryEntry]
+
+
+class RulHours(BaseModel):
+    estimate: float = Field(description="median remaining useful life [h]")
+    lower: float = Field(description="5 % quantile [h] (lower bound of the 90 % interval)")
+    upper: float = Field(description="95 % quantile [h] (upper bound of the 90 % interval)")
+
+
+class HealthIndicator(BaseModel):
+    name: str = Field(description="clearance")
+    unit: str = Field(description="m")
+    threshold: float = Field(description="clearance at which the unit fails [m]")
+    ages_hours: list[float] = Field(description="operating hours of the diagnoses used [h]")
+    values: list[float] = Field(description="their clearance estimates [m]")
+    lower: list[float] = Field(description="their 90 % interval lower bounds [m]")
+    upper: list[float] = Field(description="their 90 % interval upper bounds [m]")
+    current: float = Field(description="the latest clearance estimate [m]")
+
+
+class PrognosisModel(BaseModel):
+    """The prognostics model and, by method, its posterior or similarity details."""
+
+    model_config = ConfigDict(extra="allow")
+    name: str = Field(
+        description="degradation-exponential, degradation-linear or similarity (the method used)"
+    )
+    version: str
+    design: str = Field(description="design the prognostics model is for")
+    units_trained: int
+    threshold: float = Field(description="[m]")
+    horizon_hours: float = Field(description="RUL cap [h]")
+
+
+class Prognosis(BaseModel):
+    """Remaining useful life of an asset (``prsm_health.prognostics.Prognosis.as_dict``)."""
+
+    rul_hours: RulHours
+    health_indicator: HealthIndicator
+    model: PrognosisModel
+    warnings: list[str] = Field(description="what limits the answer")
 
 
 class Health(BaseModel):

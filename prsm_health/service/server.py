@@ -57,6 +57,7 @@ def serve(
     limits: ServiceLimits | None = None,
     log_level: str = "info",
     http: str = "auto",
+    prognostics_model_path: str | os.PathLike | None = None,
 ) -> None:
     """Run the service on uvicorn until interrupted.
 
@@ -75,11 +76,15 @@ def serve(
     http : str
         HTTP/1.1 parser: ``"auto"`` (``httptools``, a C parser, when it can be imported, else
         ``h11``, pure Python), ``"httptools"`` or ``"h11"``.
+    prognostics_model_path : path or None
+        Prognostics model of ``GET /v1/assets/{asset_id}/prognosis`` (see :func:`create_app`;
+        None: the shipped one if it exists).
 
     Raises
     ------
     PRSMHealthError
-        Non-loopback host without a token, bad port, unreadable model or database.
+        Non-loopback host without a token, bad port, unreadable model, prognostics model or
+        database.
     """
     import uvicorn
 
@@ -89,7 +94,9 @@ def serve(
         raise PRSMHealthError(f"port = {port!r} must be an integer in [0, 65535]")
     check_bind(host, token)
     http_protocol = http_implementation(http)
-    app = create_app(model_path, db_path, token, limits)
+    app = create_app(
+        model_path, db_path, token, limits, prognostics_model_path=prognostics_model_path
+    )
     sock = bind_socket(host, port)
     config = uvicorn.Config(
         app,
@@ -100,13 +107,14 @@ def serve(
         http=http_protocol,
     )
     logging.getLogger("uvicorn.error").info(
-        "prsm-health serving on http://%s:%d (HTTP parser %s): model %s v%s, history %s, "
-        "bearer token %s",
+        "prsm-health serving on http://%s:%d (HTTP parser %s): model %s v%s, prognostics "
+        "model %s, history %s, bearer token %s",
         f"[{host.strip('[]')}]" if ":" in host else host,
         sock.getsockname()[1],
         http_protocol,
         app.state.bundle.name,
         app.state.bundle.version,
+        _prognostics_text(app.state.prognostics),
         app.state.store.path,
         "required" if token else "not required (loopback only)",
     )
@@ -114,6 +122,12 @@ def serve(
         _server_class()(config).run(sockets=[sock])
     finally:
         sock.close()
+
+
+def _prognostics_text(model) -> str:
+    if model is None:
+        return "none (prognosis answers 503)"
+    return f"for {model.design} ({len(model.units_)} training units)"
 
 
 def http_implementation(http: str = "auto") -> str:

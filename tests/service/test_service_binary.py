@@ -298,5 +298,11 @@ def test_openapi_documents_the_binary_bodies(app):
         MCAP,
         "application/x-mcap",
     }
-    assert {p["name"] for p in operation["parameters"]} == {"asset_id", "speed", "load", "design"}
+    assert {p["name"] for p in operation["parameters"]} == {
+        "asset_id",
+        "speed",
+        "load",
+        "design",
+        "operating_hours",
+    }
     assert {"400", "413", "415", "422", "503"} <= set(operation["responses"])

@@ -5,6 +5,7 @@ from typing import Annotated
 from fastapi import Depends, Request
 
 from ...diagnosis import ModelBundle
+from ...prognostics import PrognosticsModel as _PrognosticsModel
 from ..history import HistoryStore
 from ..limits import ServiceLimits
 from ..workers import WorkerPool
@@ -20,6 +21,10 @@ async def get_store(request: Request) -> HistoryStore:
     return request.app.state.store
 
 
+async def get_prognostics(request: Request) -> _PrognosticsModel | None:
+    return request.app.state.prognostics
+
+
 async def get_limits(request: Request) -> ServiceLimits:
     return request.app.state.limits
 
@@ -32,6 +37,8 @@ async def get_workers(request: Request) -> WorkerPool:
 Bundle = Annotated[ModelBundle, Depends(get_bundle)]
 #: The history database.
 Store = Annotated[HistoryStore, Depends(get_store)]
+#: The prognostics model (None: none loaded).
+PrognosticsModel = Annotated[_PrognosticsModel | None, Depends(get_prognostics)]
 #: The service's limits.
 Limits = Annotated[ServiceLimits, Depends(get_limits)]
 #: The worker pool diagnoses run in (and the admission counter).

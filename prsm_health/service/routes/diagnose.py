@@ -8,8 +8,16 @@ from fastapi import APIRouter, Request
 from ...design import PRESETS
 from ..diagnosing import BodyParams, diagnose_body, diagnose_upload
 from ..history import utc_now
+from ..limits import MAX_OPERATING_HOURS
 from ..responses import HTTPError, json_response
-from ..schemas import ASSET_ID_PATTERN, ERROR_RESPONSES, Diagnosis, Error, FileDiagnosis
+from ..schemas import (
+    ASSET_ID_PATTERN,
+    ERROR_RESPONSES,
+    OPERATING_HOURS_DESCRIPTION,
+    Diagnosis,
+    Error,
+    FileDiagnosis,
+)
 from ..uploads import multipart_boundary, receive_upload, upload_directory
 from .deps import Limits, Store, Workers
 
@@ -61,6 +69,13 @@ _JSON_BODY = {
             "required": False,
             "description": "binary bodies only: design preset (must be the model's)",
             "schema": {"type": "string", "enum": sorted(PRESETS)},
+        },
+        {
+            "name": "operating_hours",
+            "in": "query",
+            "required": False,
+            "description": f"binary bodies only: {OPERATING_HOURS_DESCRIPTION}",
+            "schema": {"type": "number", "minimum": 0, "maximum": MAX_OPERATING_HOURS},
         },
     ],
     "requestBody": {
@@ -130,8 +145,8 @@ def body_params(request: Request, fmt: str) -> BodyParams | None:
     if items:
         raise HTTPError(
             422,
-            f"query parameter {items[0][0]!r}: a JSON body carries asset_id, speed, load and "
-            "design as fields (query parameters are for binary bodies)",
+            f"query parameter {items[0][0]!r}: a JSON body carries asset_id, speed, load, "
+            "design and operating_hours as fields (query parameters are for binary bodies)",
         )
     return None
 
@@ -152,7 +167,8 @@ async def post_diagnose(request: Request, store: Store, limits: Limits, workers:
     """Diagnose uniformly sampled contract channels (at most `max_window_seconds`, 2 s by
     default), sent as JSON or as a recording (Arrow IPC stream, Parquet or MCAP: decoded by
     the library's readers; the asset and nominal operating point then come as query
-    parameters). With `asset_id` the diagnosis is stored in the asset's history."""
+    parameters). With `asset_id` the diagnosis is stored in the asset's history, with
+    `operating_hours` when given (the prognosis uses those)."""
     received_at = utc_now()
     fmt = body_format(request)
     params = body_params(request, fmt)
