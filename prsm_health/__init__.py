@@ -11,6 +11,10 @@ Public API (SI units throughout), imported lazily so ``import prsm_health`` stay
 - data: :class:`Dataset`, :func:`read_mcap`, :func:`write_mcap`, :func:`read_recording`
 - diagnostics: :func:`extract_features`, :func:`load_model` (a diagnosis model bundle),
   :func:`diagnose` → :class:`Diagnosis`
+- ageing and prognostics: :class:`LifeSpec`, :func:`fleet_lives` (wear, lubricant ageing and
+  fatigue over operating hours), :func:`diagnose_runs`, :func:`fleet_histories`,
+  :class:`PrognosticsModel`, :func:`load_prognostics_model`, :func:`read_history`,
+  :func:`prognose` → :class:`Prognosis`
 - static stiffness: :mod:`prsm_health.stiffness`; validation: :func:`prsm_health.validation.collect`
 """
 
@@ -53,6 +57,15 @@ _EXPORTS = {
     "extract_features": ".features",
     "Diagnosis": ".diagnosis",
     "diagnose": ".diagnosis",
+    "diagnose_runs": ".diagnosis",
+    "LifeSpec": ".life",
+    "fleet_lives": ".life",
+    "Prognosis": ".prognostics",
+    "PrognosticsModel": ".prognostics",
+    "fleet_histories": ".prognostics",
+    "load_prognostics_model": ".prognostics",
+    "prognose": ".prognostics",
+    "read_history": ".prognostics",
 }
 #: Public names that differ from the defining module's name for them.
 _ALIASES = {"load_model": (".diagnosis", "load_bundle")}

@@ -264,6 +264,7 @@ class UnitLife:
     initial_clearance: float
     wear_spread: float  # uneven roller load sharing (FleetScatter.wear_spread)
     load_scale: float
+    wear_scale: float  # the unit's wear coefficient ÷ the duty's (lognormal scatter)
     temperature: float  # [K]
     lubricant_life: float  # [h] at the unit's temperature
     ages: np.ndarray  # [h], the grid the wear is accumulated on
@@ -440,6 +441,7 @@ def unit_life(
             initial_clearance=float(b0),
             wear_spread=float(spread),
             load_scale=float(load_scale),
+            wear_scale=float(k_scale),
             temperature=float(temperature),
             lubricant_life=t_lube,
             ages=ages,
