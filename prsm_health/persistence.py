@@ -111,11 +111,13 @@ def _bundle_bytes(model, header: dict) -> bytes:
     return buffer.getvalue()
 
 
-def _write_atomic(path: Path, data: bytes) -> None:
+def write_atomic(path: Path, data: bytes, what: str = "model file") -> None:
+    """Write ``data`` to ``path`` through a temporary file and a rename: a reader sees the old
+    file or the whole new one, never half of it."""
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     except OSError as err:
-        raise PRSMHealthError(f"{path}: cannot write model file ({err.strerror})") from err
+        raise PRSMHealthError(f"{path}: cannot write {what} ({err.strerror})") from None
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
@@ -183,7 +185,7 @@ def save_model(path, model, *, metadata: dict) -> Path:
             f"{path}: cannot save a model holding types load_model would refuse: "
             + ", ".join(refused)
         )
-    _write_atomic(path, data)
+    write_atomic(path, data)
     return path
 
 

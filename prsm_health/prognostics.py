@@ -45,8 +45,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1168,22 +1166,10 @@ def save_prognostics_model(path, model: PrognosticsModel) -> Path:
         type(model).__name__,
         "must be a fitted PrognosticsModel",
     )
+    from .persistence import write_atomic
+
     text = json.dumps(model.to_dict(), indent=1, allow_nan=False)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as err:
-        raise PRSMHealthError(f"{path}: cannot write prognostics model ({err.strerror})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    write_atomic(path, text.encode("utf-8"), "prognostics model")
     return path
 
 
