@@ -318,10 +318,15 @@ def _rate(text: str) -> float | None:
 def _cmd_replay(args) -> int:
     from .diagnosis import load_bundle, replay
 
+    if args.live and (args.out or args.json):
+        raise PRSMHealthError("--live plays the recording to Foxglove: drop --out and --json")
     bundle = None if args.statistics_only else load_bundle(args.model)
     window = args.window or (bundle.window if bundle else 1.0)
+    if args.live:
+        return _live(args.file, args, bundle, window, rate=getattr(args, "rate", 1.0))
     steps = []
-    for step in replay(args.file, bundle, window=window, rate=args.rate, out=args.out):
+    rate = getattr(args, "rate", None)
+    for step in replay(args.file, bundle, window=window, rate=rate, out=args.out):
         steps.append(step.to_json())
         if not args.json:
             print(_replay_line(steps[-1]))
@@ -352,6 +357,78 @@ def _replay_line(entry) -> str:
 
 def _um(value) -> str:
     return "  –" if value is None else f"{1e6 * value:5.1f}"
+
+
+# ----------------------------------------------------------------------------- live view
+def _live(source, args, bundle, window: float, *, rate: float | None) -> int:
+    """``replay --live`` and ``simulate --live``: play ``source`` (a file or a Run) to Foxglove
+    until its end, then keep the server up until Ctrl-C (exit 0)."""
+    import signal
+
+    from .live import LivePlayer
+
+    if args.host not in ("127.0.0.1", "localhost", "::1"):
+        print(
+            f"warning: --host {args.host}: the Foxglove WebSocket protocol has no "
+            "authentication; anyone who reaches this address sees the recording",
+            file=sys.stderr,
+        )
+    live = None
+    try:
+        live = LivePlayer(
+            source,
+            window=window,
+            diagnose=_window_diagnoser(bundle) if bundle is not None else None,
+            host=args.host,
+            port=args.port,
+            rate=rate,
+            decimate=args.live_decimate,
+        )
+        print(
+            f"live: open {live.url} in Foxglove (Open connection → Foxglove WebSocket); "
+            "playing starts when it subscribes; Ctrl-C stops",
+            flush=True,
+        )
+        if bundle is not None and not live.diagnosing:
+            print(
+                f"warning: no complete {window:g} s window in the recording: "
+                "no diagnosis is published",
+                file=sys.stderr,
+            )
+        live.wait_for_client()
+        stats = live.play()
+        pace = "as fast as possible" if rate is None else f"at {rate:g}× real time"
+        print(
+            f"played {stats.samples} samples ({stats.log_span:.3f} s of log time) {pace} "
+            f"in {stats.wall_time:.3f} s, every {live.decimate}. sample published, "
+            f"{stats.diagnoses} diagnoses; the server stays up until Ctrl-C",
+            flush=True,
+        )
+        live.hold()
+    except KeyboardInterrupt:
+        # A second Ctrl-C must not interrupt the shutdown with a traceback.
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            if live is not None:
+                live.close()
+            print("stopped", file=sys.stderr)
+        finally:
+            signal.signal(signal.SIGINT, previous)
+    finally:
+        if live is not None:
+            live.close()
+    return 0
+
+
+def _window_diagnoser(bundle):
+    """Window → its Diagnosis JSON object (what ``replay --out`` writes on /prsm/diagnosis)."""
+    from .diagnosis import diagnose_window
+    from .run import Run
+
+    def diagnose(w) -> dict:
+        return diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
+
+    return diagnose
 
 
 # ----------------------------------------------------------------------------- serve
@@ -619,13 +696,22 @@ def _cmd_simulate(args) -> int:
     from .scenario import Scenario
     from .tomlfile import read_toml
 
-    out = Path(args.out)
-    if out.suffix not in (".parquet", ".mcap"):
+    if args.out is None and not args.live:
+        raise PRSMHealthError("--out is required (or --live)")
+    if args.live and args.json:
+        raise PRSMHealthError("--live plays the run to Foxglove: drop --json")
+    out = Path(args.out) if args.out is not None else None
+    if out is not None and out.suffix not in (".parquet", ".mcap"):
         raise PRSMHealthError(
             f"--out {out}: unsupported extension {out.suffix!r} (use .parquet or .mcap)"
         )
-    if not out.parent.exists():
+    if out is not None and not out.parent.exists():
         raise PRSMHealthError(f"--out {out}: directory {out.parent} does not exist")
+    bundle = None
+    if args.live and not args.no_diagnosis:
+        from .diagnosis import load_bundle
+
+        bundle = load_bundle(args.model)  # before simulating: a bad model fails fast
     # a health file gives the base state; the flags given on the command line override it
     health = read_toml(args.health, "health file") if args.health else {}
     if args.clearance is not None:
@@ -669,11 +755,11 @@ def _cmd_simulate(args) -> int:
     )
     run = scenario.simulate(progress=not args.json)
     design, profile = scenario.design, scenario.profile
-    if out.suffix == ".mcap":
+    if out is not None and out.suffix == ".mcap":
         from .mcap import write_mcap
 
         write_mcap(run, out)
-    else:
+    elif out is not None:
         from .io.parquet import write_run_parquet
 
         write_run_parquet(run, out)
@@ -683,7 +769,7 @@ def _cmd_simulate(args) -> int:
 
         plot_run(run, args.plot, mesh_frequency=mesh)
     summary = {
-        "out": str(out),
+        "out": None if out is None else str(out),
         "instrumentation": scenario.instrumentation.name,
         "channels": list(run.channels),
         "samples": len(run),
@@ -699,8 +785,8 @@ def _cmd_simulate(args) -> int:
         _print_json(summary)
     else:
         _print_table(
-            [
-                ("wrote", str(out), ""),
+            [("wrote", str(out), "")] * (out is not None)
+            + [
                 ("instrumentation", scenario.instrumentation.name, ""),
                 ("channels", ", ".join(run.channels), ""),
                 ("samples", len(run), f"at {run.sample_rate:g} Hz"),
@@ -710,6 +796,9 @@ def _cmd_simulate(args) -> int:
                 ("dissipated energy", run.energy["dissipated"], "J"),
             ]
         )
+    if args.live:
+        window = args.window or (bundle.window if bundle is not None else 1.0)
+        return _live(run, args, bundle, window, rate=args.rate)
     return 0
 
 
@@ -1046,8 +1135,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument(
         "--rate",
         type=_rate,
-        default=None,
-        help="real-time factor, or 'max' (None: as fast as possible)",
+        default=argparse.SUPPRESS,
+        help="real-time factor, or 'max' (default: max; with --live: 1, real time)",
     )
     r.add_argument("--model", default=None, help="model bundle (None: the shipped model)")
     r.add_argument(
@@ -1057,6 +1146,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--statistics-only", action="store_true", help="window statistics only, no model"
     )
     _add_json(r, "every window")
+    _add_live(r, rate=False)
     r.set_defaults(func=_cmd_replay)
 
     v = command("serve", "HTTP diagnostics service with asset health history (docs/service.md)")
@@ -1106,6 +1196,50 @@ def build_parser() -> argparse.ArgumentParser:
     _add_json(f)
     f.set_defaults(func=_cmd_friction)
     return parser
+
+
+def _port(text: str) -> int:
+    value = int(text)
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"{text!r}: use a TCP port 0…65535 (0: any free port)")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: use an integer >= 1")
+    return value
+
+
+def _add_live(p, *, rate: bool) -> None:
+    """The ``--live`` options of ``replay`` and ``simulate`` (docs/live.md)."""
+    from .live import DEFAULT_HOST, DEFAULT_PORT, MESSAGE_BUDGET
+
+    p.add_argument(
+        "--live",
+        action="store_true",
+        help="play the recording to Foxglove over its WebSocket protocol, with the diagnosis "
+        "of each window (docs/live.md)",
+    )
+    p.add_argument(
+        "--host",
+        default=DEFAULT_HOST,
+        help="--live: bind address (the protocol has no authentication: keep it local)",
+    )
+    p.add_argument(
+        "--port", type=_port, default=DEFAULT_PORT, help="--live: TCP port (0: any free port)"
+    )
+    if rate:
+        p.add_argument("--rate", type=_rate, default=1.0, help="--live: real-time factor, or 'max'")
+    p.add_argument(
+        "--live-decimate",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help=f"--live: publish every Nth sample (None: the smallest N that keeps all topics "
+        f"under {MESSAGE_BUDGET} messages/s — 2 for a 20 kHz recording, 3 with truth)",
+    )
 
 
 def _actions(parser):
@@ -1225,9 +1359,20 @@ def _add_simulate_parser(command, default_preset) -> None:
     )
     s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
     s.add_argument("--seed", type=int, default=0, help="seed of variation, wear and noise")
-    s.add_argument("--out", required=True, help="output file (.parquet or .mcap)")
+    s.add_argument(
+        "--out", default=None, help="output file (.parquet or .mcap); required unless --live"
+    )
     s.add_argument("--plot", default=None, help="write a PNG with time traces and spectra")
     _add_json(s, "a summary")
+    _add_live(s, rate=True)
+    s.add_argument("--model", default=None, help="--live: model bundle (None: the shipped model)")
+    s.add_argument(
+        "--window",
+        type=_finite_float,
+        default=None,
+        help="--live: window length [s] (None: the model's)",
+    )
+    s.add_argument("--no-diagnosis", action="store_true", help="--live: publish the signals only")
     s.set_defaults(func=_cmd_simulate)
 
 

@@ -41,6 +41,7 @@ LAYERS = {
     "io": 3,
     "mcap": 3,
     "dataset": 3,
+    "live": 3,
     "features": 4,
     "estimators": 4,
     "trees": 4,

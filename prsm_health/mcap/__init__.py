@@ -22,9 +22,11 @@ channel with no custom code:
 Modules:
 
 - :mod:`.schema` — topic and diagnosis JSON schemas, metadata names and value encoding;
-- :mod:`.writer` — :func:`write_mcap`; :mod:`.reader` — :func:`read_mcap`;
+- :mod:`.writer` — :func:`write_mcap` (and :func:`~.writer.sample_payloads`, the signal
+  message payloads it writes); :mod:`.reader` — :func:`read_mcap`;
 - :mod:`.replay` — :func:`iter_windows`, :class:`Window`, :func:`window_statistics`;
-- :mod:`.diagnosis_topic` — :class:`DiagnosisWriter`, :func:`write_diagnosis_mcap`;
+- :mod:`.diagnosis_topic` — :class:`DiagnosisWriter`, :func:`write_diagnosis_mcap` (and
+  :func:`~.diagnosis_topic.diagnosis_payload`, the diagnosis message payload);
 - private: ``_container`` (the fast hand-framed writer), ``_scan`` (the tolerant record
   scanner), ``_samples`` (log-time clock, topic batches, alignment), ``_framing`` (opcodes).
 

@@ -26,7 +26,23 @@ from ._container import (
 from ._scan import _Source
 from .schema import DIAGNOSIS_SCHEMA_NAME, diagnosis_schema, encode_schema
 
-__all__ = ["DiagnosisWriter", "write_diagnosis_mcap"]
+__all__ = ["DiagnosisWriter", "diagnosis_payload", "write_diagnosis_mcap"]
+
+
+def diagnosis_payload(diagnosis: dict) -> bytes:
+    """Payload of one diagnosis message: compact JSON (numpy values allowed; NaN/inf as null).
+
+    Used by :class:`DiagnosisWriter` and by the live view (:mod:`prsm_health.live`).
+
+    Raises
+    ------
+    PRSMHealthError
+        ``diagnosis`` is not JSON-serialisable.
+    """
+    try:
+        return dumps(diagnosis, compact=True).encode()
+    except TypeError as exc:
+        raise PRSMHealthError(f"diagnosis is not JSON-serialisable: {exc}") from None
 
 
 class DiagnosisWriter:
@@ -166,10 +182,7 @@ class DiagnosisWriter:
             raise PRSMHealthError(f"diagnosis must be a dict, not {type(diagnosis).__name__}")
         if self._channel_id is None:
             self._register(diagnosis)
-        try:
-            payload = dumps(diagnosis, compact=True).encode()
-        except TypeError as exc:
-            raise PRSMHealthError(f"diagnosis is not JSON-serialisable: {exc}") from None
+        payload = diagnosis_payload(diagnosis)
         self._pending.append((int(log_time_ns), payload))
         self._pending_bytes += len(payload) + _HEADER_SIZE
         if self._pending_bytes >= self._chunk_size:

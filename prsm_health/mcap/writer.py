@@ -32,15 +32,17 @@ from .schema import (
     topic_schema,
 )
 
-__all__ = ["write_mcap"]
+__all__ = ["sample_payloads", "write_mcap"]
 
 # Samples formatted at a time by write_mcap (~10 MB of JSON for the measured topics, ~30 MB
 # with the truth topic).
 _WRITE_BLOCK = 1 << 16
 
 
-def _json_object_payloads(fields: list[str], columns: list[np.ndarray]) -> list[bytes]:
-    """One compact JSON object per row, floats as ``repr`` (exact), non-finite as ``null``."""
+def sample_payloads(fields: list[str], columns: list[np.ndarray]) -> list[bytes]:
+    """Message payloads of one signal topic: one compact JSON object per sample (row), with the
+    keys ``fields`` and the values of ``columns``, floats as ``repr`` (exact), non-finite as
+    ``null``. Used by :func:`write_mcap` and by the live view (:mod:`prsm_health.live`)."""
     rows = zip(*[column.tolist() for column in columns])
     if all(np.isfinite(column).all() for column in columns):
         template = ("{" + ",".join(f'"{name}":%r' for name in fields) + "}").encode()
@@ -174,7 +176,7 @@ def write_mcap(
         for a in range(0, n, _WRITE_BLOCK):
             b = min(a + _WRITE_BLOCK, n)
             payloads = [
-                _json_object_payloads([name for name, _ in pairs], [c[a:b] for c in columns[t]])
+                sample_payloads([name for name, _ in pairs], [c[a:b] for c in columns[t]])
                 for t, pairs in topics.items()
             ]
             block = _MessageBlock.from_payloads(
