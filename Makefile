@@ -5,7 +5,7 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: demo test lint validation-doc clean
+.PHONY: demo test lint validation-doc clean chromium vendor
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -30,8 +30,28 @@ demo: $(STAMP)
 	$(BIN)/prsm-health replay $(DEMO)/recording.mcap --model $(DEMO)/model.skops --out $(DEMO)/recording-diagnosed.mcap
 	@echo "demo outputs in $(DEMO)/ (validation.txt, recording.png, diagnosis.png, recording-diagnosed.mcap)"
 
-test: $(STAMP)
+# The dashboard's browser test (tests/service/test_dashboard_browser.py) drives Debian's
+# Chromium: installed here when missing (apt-get, as root). Without it that test fails;
+# PRSM_HEALTH_SKIP_BROWSER=1 skips it (and this step).
+CHROMIUM := /usr/bin/chromium
+chromium:
+	@if [ "$$PRSM_HEALTH_SKIP_BROWSER" = 1 ] || [ -x $(CHROMIUM) ]; then exit 0; fi; \
+	if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+		echo "installing Debian's chromium for the dashboard's browser test (apt-get)"; \
+		{ apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+			chromium chromium-driver; } >/dev/null || \
+		echo "warning: apt-get could not install chromium: the browser test will fail (apt-get install -y chromium, or PRSM_HEALTH_SKIP_BROWSER=1 to skip it)" >&2; \
+	else \
+		echo "warning: $(CHROMIUM) is missing and only root can apt-get it: the browser test will fail (sudo apt-get install -y chromium, or PRSM_HEALTH_SKIP_BROWSER=1 to skip it)" >&2; \
+	fi
+
+test: $(STAMP) chromium
 	$(PY) -m pytest -q
+
+# Re-vendor the dashboard's plotting library from the npm registry (needs npm; the files it
+# writes under prsm_health/service/static/vendor/ are committed).
+vendor:
+	$(PYTHON) tools/vendor_js.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check prsm_health tests tools

@@ -39,7 +39,9 @@ import math
 
 import numpy as np
 
+from .design import PRSMDesign
 from .errors import PRSMHealthError
+from .kinematics import characteristic_frequencies, defect_frequencies
 from .signal_kernels import frame_power_sums, line_floors
 from .spectra import amplitude_spectrum, band_envelope, hann
 
@@ -305,3 +307,129 @@ def defect_lines_batch(
             for k, name in enumerate(names[r])
         }
     return results
+
+
+#: Most points of each spectrum :func:`window_spectra` returns (a plot a screen wide shows
+#: fewer).
+SPECTRUM_POINTS = 1024
+
+
+def window_spectra(
+    x: np.ndarray,
+    rate: float,
+    design: PRSMDesign | None = None,
+    screw_speed: float | None = None,
+    max_points: int = SPECTRUM_POINTS,
+) -> dict:
+    """What a person looks at in one window of nut acceleration: its amplitude spectrum, its
+    envelope spectrum in the band the indicators use, and the defect frequencies to read them
+    at — bounded in size, for a dashboard or a report.
+
+    * **Amplitude spectrum**: :func:`prsm_health.spectra.amplitude_spectrum` (Hann, coherent
+      gain corrected) without the DC bin, reduced to at most ``max_points`` points on
+      log-spaced frequency bins, each bin keeping its largest amplitude at that amplitude's
+      frequency (a peak keeps its height and place; below the FFT resolution a bin holds one
+      FFT bin, so nothing is averaged away).
+    * **Envelope spectrum**: :func:`envelope_amplitude_spectrum` in the band :func:`defect_lines`
+      chooses (the kurtogram above 3× the highest defect frequency: the band of the
+      ``*_sk_band_centre`` indicator), up to the modulation that band carries (half its width:
+      above, lines are meaningless), reduced the same way on linear bins.
+    * **Defect frequencies** at ``screw_speed``: :func:`prsm_health.kinematics.defect_frequencies`
+      and the gear mesh frequency (:func:`~prsm_health.kinematics.characteristic_frequencies`),
+      with :func:`defect_lines`' amplitude and line-to-floor ratio at each.
+
+    Parameters
+    ----------
+    x : ndarray
+        One window of a vibration channel (the nut axial acceleration) [m/s²].
+    rate : float [Hz]
+    design : PRSMDesign or None
+        None (a rig that is not a PRSM): no defect frequencies, the band above 2 % of the rate.
+    screw_speed : float or None [rad/s]
+        The window's mean screw speed; None or 0: no defect frequencies.
+    max_points : int
+        Most points per spectrum (≥ 16).
+
+    Returns
+    -------
+    dict
+        ``sample_rate`` [Hz], ``samples``, ``screw_speed`` [rad/s] or None;
+        ``spectrum``: ``frequency`` [Hz], ``amplitude`` [unit of x]; ``envelope``:
+        ``frequency``, ``amplitude``, ``band`` (low, high) [Hz], ``sk``, ``impulsive``,
+        ``modulation_limit`` [Hz] — or None with ``envelope_note`` saying why (no band fits a
+        short window at a low rate); ``frequencies``: name → [Hz] (the defect locations of
+        :func:`~prsm_health.kinematics.defect_frequencies`, then ``gear_mesh`` for a standard
+        PRSM); ``lines``: defect name → ``amplitude``, ``ratio``, ``ratio_sum``. Plain
+        floats and lists (JSON-ready; a NaN ratio stays NaN).
+    """
+    x = _check(x, rate)
+    if not (isinstance(max_points, int) and max_points >= 16):
+        raise PRSMHealthError(f"max_points = {max_points!r} must be an integer >= 16")
+    speed = None
+    if screw_speed is not None:
+        if not math.isfinite(screw_speed):
+            raise PRSMHealthError(f"screw_speed = {screw_speed!r} must be finite [rad/s]")
+        speed = float(screw_speed)
+    defects: dict[str, float] = {}
+    mesh = None
+    if design is not None and speed:
+        defects = defect_frequencies(design, speed)
+        mesh = characteristic_frequencies(design, speed).gear_mesh
+    freq, amp = amplitude_spectrum(x, rate)
+    spectrum = _peak_bins(freq[1:], amp[1:], max_points, log=True)
+    envelope, note, lines = None, None, {}
+    try:
+        found = defect_lines(x, rate, defects)
+    except PRSMHealthError as exc:  # no kurtogram band fits (short window, low rate)
+        note = str(exc)
+    else:
+        band = found["band"]
+        limit = 0.5 * (band[1] - band[0])
+        f_env, a_env = envelope_amplitude_spectrum(x, rate, band)
+        keep = (f_env > 0) & (f_env <= limit)
+        envelope = {
+            **_peak_bins(f_env[keep], a_env[keep], max_points, log=False),
+            "band": [float(band[0]), float(band[1])],
+            "sk": float(found["sk"]),
+            "impulsive": bool(found["impulsive"]),
+            "modulation_limit": float(limit),
+        }
+        lines = {
+            name: {key: float(value) for key, value in line.items()}
+            for name, line in found["lines"].items()
+        }
+    frequencies = {name: float(f) for name, f in defects.items()}
+    if mesh is not None:
+        frequencies["gear_mesh"] = float(mesh)
+    out = {
+        "sample_rate": float(rate),
+        "samples": int(len(x)),
+        "screw_speed": speed,
+        "spectrum": spectrum,
+        "envelope": envelope,
+        "frequencies": frequencies,
+        "lines": lines,
+    }
+    if note is not None:
+        out["envelope_note"] = note
+    return out
+
+
+def _peak_bins(freq: np.ndarray, amp: np.ndarray, max_points: int, *, log: bool) -> dict:
+    """At most ``max_points`` (frequency, amplitude) pairs: the spectrum cut into that many
+    equal bins of frequency (of log frequency with ``log``), each represented by its largest
+    amplitude at that amplitude's frequency; empty bins dropped."""
+    if len(freq) > max_points:
+        if log:
+            edges = np.geomspace(freq[0], freq[-1], max_points + 1)
+        else:
+            edges = np.linspace(freq[0], freq[-1], max_points + 1)
+        group = np.clip(np.searchsorted(edges, freq, side="right") - 1, 0, max_points - 1)
+        # frequencies ascend, so each bin's points are one run: its maximum by reduceat, and
+        # the first point of the run that reaches it
+        starts = np.flatnonzero(np.r_[True, group[1:] != group[:-1]])
+        peak = np.repeat(np.maximum.reduceat(amp, starts), np.diff(np.r_[starts, len(amp)]))
+        hits = np.flatnonzero(amp == peak)
+        keep = hits[np.r_[True, group[hits[1:]] != group[hits[:-1]]]]
+        freq, amp = freq[keep], amp[keep]
+    return {"frequency": freq.tolist(), "amplitude": amp.tolist()}

@@ -101,6 +101,7 @@ def create_app(
     app.state.prognostics = prognostics_model
     app.state.store = store
     app.state.limits = limits
+    app.state.token = token  # the dashboard's login form compares against it
     app.state.workers = WorkerPool(limits, bundle)
     app.state.model_info = model_info(bundle, model_file)
     app.state.started = time.monotonic()

@@ -23,12 +23,13 @@ import numpy as np
 
 from ..channels import CHANNEL_NAMES
 from ..design import PRESETS
-from ..diagnosis import diagnose
+from ..diagnosis import diagnose, split_windows
+from ..envelope_analysis import window_spectra
 from ..errors import PRSMHealthError, TruncatedRecordingWarning
 from ..io import read_recording, read_recording_bytes
 from ..jsonable import json_ready
 from ..run import MIN_SAMPLES, Run
-from .history import history_rows
+from .history import history_rows, spectra_row, utc_now
 from .limits import MAX_ABS_VALUE, MAX_OPERATING_HOURS, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
 from .schemas import ASSET_ID_PATTERN, DiagnoseRequest, parse_diagnose_request
@@ -75,13 +76,46 @@ def warm_up(bundle) -> None:
     diagnosis_json(Run(time, noise, rate), bundle)
 
 
+#: The channel whose spectra are stored for each asset's latest window.
+SPECTRA_CHANNEL = "nut_axial_accel"
+
+
 @dataclass(frozen=True)
 class Answer:
     """What a diagnose request gives back to the route: the encoded JSON answer and, when the
-    request named an asset, its history rows (:func:`~.history.history_rows`)."""
+    request named an asset, its history rows (:func:`~.history.history_rows`) and the spectra
+    row of the recording's last window (:func:`~.history.spectra_row`; None when the recording
+    has no nut axial acceleration)."""
 
     encoded: bytes
     history: list | None = None
+    spectra: tuple | None = None
+
+
+def last_window_spectra(
+    run: Run, bundle, asset_id: str, windows: list[dict], **row
+) -> tuple | None:
+    """The spectra row of the recording's last window (:func:`split_windows` with the model's
+    window, as the diagnosis cut it): :func:`prsm_health.envelope_analysis.window_spectra` of
+    its nut axial acceleration at its mean screw speed, with the model's design. None when the
+    recording has no nut axial acceleration. ``windows``: the diagnosis' window entries (the
+    last one's index and span are stored); ``row``: :func:`spectra_row`'s keywords."""
+    if SPECTRA_CHANNEL not in run.channels:
+        return None
+    last = split_windows(run, bundle.window)[0][-1]
+    speed = last.channels.get("screw_speed")
+    try:
+        spectra = window_spectra(
+            last.channels[SPECTRA_CHANNEL],
+            float(last.sample_rate),
+            bundle.design,
+            None if speed is None else float(np.mean(speed)),
+        )
+    except PRSMHealthError:  # the diagnosis stands; the asset keeps its previous spectra
+        log.warning("no spectra for asset %r", asset_id, exc_info=True)
+        return None
+    window = windows[-1].get("window") if windows else None
+    return spectra_row(asset_id, spectra, window=window, channel=SPECTRA_CHANNEL, **row)
 
 
 @dataclass(frozen=True)
@@ -250,11 +284,12 @@ def diagnose_body(
         raise _too_long(len(run), run.sample_rate, limits)
     check_run(run, limits, max_samples=max(max_samples, MIN_SAMPLES), what=_what(fmt))
     result = diagnosis_json(run, bundle)
-    if len(result.get("windows", [])) <= 1:
+    windows = result.get("windows", [])
+    if len(windows) <= 1:
         result.pop("windows", None)
     if notes:
         result["warnings"] = [*notes, *result.get("warnings", [])]
-    history = None
+    history = spectra = None
     if params.asset_id is not None:
         history = history_rows(
             params.asset_id,
@@ -265,7 +300,16 @@ def diagnose_body(
             load=params.load,
             operating_hours=params.operating_hours,
         )
-    return Answer(encode(result), history)
+        spectra = last_window_spectra(
+            run,
+            bundle,
+            params.asset_id,
+            windows,
+            received_at=received_at,
+            source=fmt,
+            operating_hours=params.operating_hours,
+        )
+    return Answer(encode(result), history, spectra)
 
 
 def _what(fmt: str) -> str:
@@ -328,8 +372,9 @@ def diagnose_upload(
         "channels": [c for c in CHANNEL_NAMES if c in run.channels],
     }
     answer = {"diagnosis": result, "windows": per_window, "recording": recording, "warnings": notes}
-    history = None
+    history = spectra = None
     if asset_id is not None:
+        received_at = received_at or utc_now()
         history = history_rows(
             asset_id,
             per_window,
@@ -337,4 +382,13 @@ def diagnose_upload(
             source="file",
             filename=upload.filename,
         )
-    return Answer(encode(answer), history)
+        spectra = last_window_spectra(
+            run,
+            bundle,
+            asset_id,
+            per_window,
+            received_at=received_at,
+            source="file",
+            filename=upload.filename,
+        )
+    return Answer(encode(answer), history, spectra)

@@ -1,6 +1,7 @@
 """Diagnoses per asset over time: :class:`HistoryStore` (embedded SQLite, WAL journal), its
 default location (:func:`default_db_path`), its time format (:func:`utc_now`,
-:func:`parse_time`) and the table a prognosis is made from (:func:`prognosis_history`)."""
+:func:`parse_time`), the table a prognosis is made from (:func:`prognosis_history`) and each
+asset's latest window spectra (:func:`spectra_row`)."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from ..errors import PRSMHealthError
-from ..jsonable import dumps
+from ..jsonable import dumps, json_ready
 
 #: Environment variable overriding the default history database path.
 DB_ENV = "PRSM_HEALTH_DB"
@@ -50,10 +51,23 @@ CREATE TABLE IF NOT EXISTS diagnoses (
     diagnosis           TEXT    NOT NULL   -- the full Diagnosis contract JSON
 );
 CREATE INDEX IF NOT EXISTS diagnoses_asset_time ON diagnoses (asset_id, received_at, id);
+CREATE TABLE IF NOT EXISTS spectra (
+    asset_id            TEXT    PRIMARY KEY,  -- one row per asset, replaced by each recording
+    received_at         TEXT    NOT NULL,     -- as the diagnosis it came with
+    source              TEXT    NOT NULL,
+    filename            TEXT,
+    window_index        INTEGER,              -- the recording's last window
+    window_start        REAL,                 -- [s]
+    window_end          REAL,                 -- [s]
+    operating_hours     REAL,                 -- [h]
+    channel             TEXT    NOT NULL,     -- 'nut_axial_accel'
+    spectra             TEXT    NOT NULL      -- JSON: prsm_health.envelope_analysis.window_spectra
+);
 """
-#: Version 1: the table above without ``operating_hours``; version 2 added it (a version 1
-#: database gets the column on open, its existing rows NULL).
-_SCHEMA_VERSION = 2
+#: Version 1: the diagnoses table without ``operating_hours``; version 2 added it (a version 1
+#: database gets the column on open, its existing rows NULL); version 3 added the ``spectra``
+#: table (created on open: ``CREATE TABLE IF NOT EXISTS`` above).
+_SCHEMA_VERSION = 3
 
 
 def utc_now() -> str:
@@ -135,9 +149,11 @@ class HistoryStore:
             raise
 
     def _migrate(self) -> None:
-        """Bring an older table up to the current schema (inside the opening transaction, so
+        """Bring older tables up to the current schema (inside the opening transaction, so
         two processes opening the same file migrate it once): version 1 → 2 adds the nullable
-        ``operating_hours`` column."""
+        ``operating_hours`` column; version 2 → 3 adds the ``spectra`` table, which the schema's
+        ``CREATE TABLE IF NOT EXISTS`` has created just before (empty: spectra come with the
+        next recordings)."""
         columns = {row[1] for row in self._conn.execute("PRAGMA table_info(diagnoses)")}
         if "operating_hours" not in columns:
             self._conn.execute("ALTER TABLE diagnoses ADD COLUMN operating_hours REAL")
@@ -180,11 +196,19 @@ class HistoryStore:
             )
         )
 
-    def add_rows(self, rows: list[tuple]) -> list[int]:
-        """Store rows made by :func:`history_rows` (possibly in another process) in one
-        transaction; returns their ids."""
+    def add_rows(self, rows: list[tuple], spectra: tuple | None = None) -> list[int]:
+        """Store rows made by :func:`history_rows` (possibly in another process) and, when
+        given, the asset's latest spectra (a :func:`spectra_row`, replacing the asset's
+        previous one) in one transaction; returns the rows' ids."""
         ids = []
         with self._lock, self._transaction():
+            if spectra is not None:
+                self._conn.execute(
+                    "INSERT OR REPLACE INTO spectra (asset_id, received_at, source, filename,"
+                    " window_index, window_start, window_end, operating_hours, channel, spectra)"
+                    " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    spectra,
+                )
             for row in rows:
                 cur = self._conn.execute(
                     "INSERT INTO diagnoses (asset_id, received_at, source, filename, window_index,"
@@ -255,6 +279,109 @@ class HistoryStore:
                 (asset_id,),
             ).fetchall()
 
+    def spectra(self, asset_id: str) -> dict | None:
+        """The asset's latest stored spectra (:func:`spectra_row`), or None."""
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT received_at, source, filename, window_index, window_start, window_end,"
+                " operating_hours, channel, spectra FROM spectra WHERE asset_id = ?",
+                (asset_id,),
+            ).fetchone()
+        if row is None:
+            return None
+        received_at, source, filename, w_index, w_start, w_end, hours, channel, blob = row
+        return {
+            "asset_id": asset_id,
+            "received_at": received_at,
+            "source": source,
+            "filename": filename,
+            "window": None
+            if w_index is None
+            else {"index": w_index, "start": w_start, "end": w_end},
+            "operating_hours": hours,
+            "channel": channel,
+            **json.loads(blob),
+        }
+
+    def assets(self, *, limit: int = 100) -> dict:
+        """The ``limit`` most recently seen assets, most recent first, each as
+        :meth:`asset_summary` gives it: ``{"count", "total", "truncated", "assets": [...]}``."""
+        with self._lock:
+            total = self._conn.execute("SELECT COUNT(DISTINCT asset_id) FROM diagnoses").fetchone()[
+                0
+            ]
+            page = self._conn.execute(
+                "SELECT asset_id, COUNT(*), MIN(received_at), MAX(received_at) FROM diagnoses"
+                " GROUP BY asset_id ORDER BY MAX(received_at) DESC, asset_id LIMIT ?",
+                (int(limit),),
+            ).fetchall()
+            summaries = [self._summary(*row) for row in page]
+        return {
+            "count": len(summaries),
+            "total": total,
+            "truncated": total > len(summaries),
+            "assets": summaries,
+        }
+
+    def asset_summary(self, asset_id: str) -> dict | None:
+        """One asset: ``asset_id``, ``diagnoses`` (how many are stored), ``with_operating_hours``
+        (how many of them have operating hours), ``operating_hours`` (the largest sent [h] or
+        None), ``first_received_at``, ``last_received_at``, ``latest`` (the latest stored
+        diagnosis in brief: receive time, source, file name, window, operating hours,
+        clearance, fault class, class probabilities, warnings, model) and
+        ``spectra_received_at`` (when its stored spectra came, or None); None when nothing
+        is stored for it."""
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT asset_id, COUNT(*), MIN(received_at), MAX(received_at) FROM diagnoses"
+                " WHERE asset_id = ? GROUP BY asset_id",
+                (asset_id,),
+            ).fetchone()
+            return None if row is None else self._summary(*row)
+
+    def _summary(self, asset_id: str, count: int, first: str, last: str) -> dict:
+        # under self._lock
+        latest = self._conn.execute(
+            "SELECT received_at, source, filename, window_index, window_start, window_end,"
+            " operating_hours, clearance_estimate, clearance_lower, clearance_upper, fault_class,"
+            " class_probabilities, json_extract(diagnosis, '$.warnings'),"
+            " json_extract(diagnosis, '$.model') FROM diagnoses WHERE asset_id = ?"
+            " ORDER BY received_at DESC, id DESC LIMIT 1",
+            (asset_id,),
+        ).fetchone()
+        with_hours, max_hours = self._conn.execute(
+            "SELECT COUNT(operating_hours), MAX(operating_hours) FROM diagnoses WHERE asset_id = ?",
+            (asset_id,),
+        ).fetchone()
+        spectra = self._conn.execute(
+            "SELECT received_at FROM spectra WHERE asset_id = ?", (asset_id,)
+        ).fetchone()
+        received_at, source, filename, w_index, w_start, w_end, hours = latest[:7]
+        estimate, lower, upper, fault_class, probabilities, warnings, model = latest[7:]
+        return {
+            "asset_id": asset_id,
+            "diagnoses": count,
+            "with_operating_hours": with_hours,
+            "operating_hours": max_hours,
+            "first_received_at": first,
+            "last_received_at": last,
+            "latest": {
+                "received_at": received_at,
+                "source": source,
+                "filename": filename,
+                "window": None
+                if w_index is None
+                else {"index": w_index, "start": w_start, "end": w_end},
+                "operating_hours": hours,
+                "clearance": {"estimate": estimate, "lower": lower, "upper": upper},
+                "fault_class": fault_class,
+                "class_probabilities": json.loads(probabilities),
+                "warnings": json.loads(warnings) if warnings else [],
+                "model": json.loads(model) if model else None,
+            },
+            "spectra_received_at": None if spectra is None else spectra[0],
+        }
+
     def has_asset(self, asset_id: str) -> bool:
         with self._lock:
             row = self._conn.execute(
@@ -310,6 +437,46 @@ def history_rows(
             )
         )
     return rows
+
+
+def spectra_row(
+    asset_id: str,
+    spectra: dict,
+    *,
+    received_at: str,
+    source: str,
+    filename: str | None = None,
+    window: dict | None = None,
+    operating_hours: float | None = None,
+    channel: str = "nut_axial_accel",
+) -> tuple:
+    """The ``spectra`` row of an asset's latest window (``spectra``:
+    :func:`prsm_health.envelope_analysis.window_spectra`, JSON encoded here) for
+    :meth:`HistoryStore.add_rows`."""
+    w = window or {}
+    # The spectra's thousands of plain floats go to json.dumps directly (json_ready would
+    # visit each); the line ratios, NaN where a line lies outside the band, become null.
+    small = {k: v for k, v in spectra.items() if k not in ("spectrum", "envelope")}
+    try:
+        text = json.dumps(
+            {**json_ready(small), "spectrum": spectra["spectrum"], "envelope": spectra["envelope"]},
+            separators=(",", ":"),
+            allow_nan=False,
+        )
+    except (ValueError, TypeError):  # a non-finite or non-plain value among them after all
+        text = dumps(spectra, compact=True)
+    return (
+        asset_id,
+        received_at,
+        source,
+        filename,
+        w.get("index"),
+        w.get("start"),
+        w.get("end"),
+        operating_hours,
+        channel,
+        text,
+    )
 
 
 def prognosis_history(rows: list[tuple]):

@@ -237,6 +237,106 @@ class Prognosis(BaseModel):
     warnings: list[str] = Field(description="what limits the answer")
 
 
+class LatestDiagnosis(BaseModel):
+    """The latest stored diagnosis of an asset, in brief."""
+
+    received_at: str = Field(description="server receive time, UTC ISO-8601")
+    source: str = Field(description="'json', 'arrow', 'parquet', 'mcap' or 'file'")
+    filename: str | None
+    window: WindowRef | None
+    operating_hours: float | None = Field(description="[h], as sent")
+    clearance: Clearance
+    fault_class: str | None
+    class_probabilities: dict[str, float]
+    warnings: list[str]
+    model: dict | None = Field(description="name, version, design of the diagnosing model")
+
+
+class PrognosisBrief(BaseModel):
+    """The asset's prognosis in brief (``rul_hours``, ``method``, ``threshold``,
+    ``current``, ``warnings``), or why there is none (``error`` and the ``status`` that
+    ``GET /v1/assets/{asset_id}/prognosis`` answers)."""
+
+    rul_hours: RulHours | None = None
+    method: str | None = Field(None, description="the prognostics method used")
+    threshold: float | None = Field(None, description="failure threshold of the clearance [m]")
+    current: float | None = Field(None, description="latest clearance estimate used [m]")
+    warnings: list[str] = Field(default_factory=list)
+    error: str | None = Field(None, description="why there is no prognosis")
+    status: int | None = Field(None, description="the prognosis endpoint's status: 422, 503")
+
+
+class AssetSummary(BaseModel):
+    """One asset: what is stored for it and its latest diagnosis."""
+
+    asset_id: str
+    diagnoses: int = Field(description="diagnoses stored")
+    with_operating_hours: int = Field(description="of which sent with operating hours")
+    operating_hours: float | None = Field(description="the largest operating hours sent [h]")
+    first_received_at: str
+    last_received_at: str
+    latest: LatestDiagnosis
+    spectra_received_at: str | None = Field(
+        description="when the stored spectra of the latest window came (None: none stored)"
+    )
+    prognosis: PrognosisBrief | None = Field(
+        None, description="with `prognosis=true`: the RUL in brief, or why there is none"
+    )
+
+
+class AssetList(BaseModel):
+    count: int
+    total: int = Field(description="assets stored")
+    truncated: bool
+    assets: list[AssetSummary] = Field(description="most recently seen first")
+
+
+class SpectrumPoints(BaseModel):
+    frequency: list[float] = Field(description="[Hz]")
+    amplitude: list[float] = Field(description="[m/s²]")
+
+
+class EnvelopeSpectrum(SpectrumPoints):
+    band: list[float] = Field(description="band-pass of the envelope (low, high) [Hz]")
+    sk: float = Field(description="spectral kurtosis of the band")
+    impulsive: bool = Field(description="whether the band's SK is above the noise threshold")
+    modulation_limit: float = Field(description="highest frequency the band carries [Hz]")
+
+
+class DefectLine(BaseModel):
+    amplitude: float | None = Field(description="envelope amplitude at the frequency [m/s²]")
+    ratio: float | None = Field(description="line-to-floor ratio")
+    ratio_sum: float | None = Field(description="sum of the ratios of the first harmonics")
+
+
+class Spectra(BaseModel):
+    """Spectra of the latest window of an asset's latest recording with a nut axial
+    acceleration (``prsm_health.envelope_analysis.window_spectra``)."""
+
+    asset_id: str
+    received_at: str
+    source: str
+    filename: str | None
+    window: WindowRef | None
+    operating_hours: float | None = Field(description="[h]")
+    channel: str = Field(description="nut_axial_accel")
+    sample_rate: float = Field(description="[Hz]")
+    samples: int = Field(description="samples in the window")
+    screw_speed: float | None = Field(description="the window's mean screw speed [rad/s]")
+    spectrum: SpectrumPoints = Field(
+        description="amplitude spectrum (Hann), at most 2048 log-spaced peak-keeping points"
+    )
+    envelope: EnvelopeSpectrum | None = Field(
+        description="envelope amplitude spectrum up to the band's modulation limit; None when "
+        "no band fits (envelope_note says why)"
+    )
+    envelope_note: str | None = None
+    frequencies: dict[str, float] = Field(
+        description="defect frequencies at the window's mean screw speed, and gear_mesh [Hz]"
+    )
+    lines: dict[str, DefectLine] = Field(description="envelope lines at the defect frequencies")
+
+
 class Health(BaseModel):
     status: str
     model: str
@@ -333,7 +433,7 @@ def add_request_schema(schema: dict, limits: ServiceLimits) -> None:
 def document_limits(schema: dict, limits: ServiceLimits) -> None:
     """Write the bounds of ``limits`` that routes check at run time into an OpenAPI document."""
     add_request_schema(schema, limits)
-    history = schema["paths"]["/v1/assets/{asset_id}/history"]["get"]
-    for parameter in history["parameters"]:
-        if parameter["name"] == "limit":
-            parameter["schema"]["maximum"] = limits.max_history
+    for path in ("/v1/assets/{asset_id}/history", "/v1/assets"):
+        for parameter in schema["paths"][path]["get"]["parameters"]:
+            if parameter["name"] == "limit":
+                parameter["schema"]["maximum"] = limits.max_history

@@ -1,5 +1,13 @@
-"""The service's routes, one module per concern, as FastAPI routers (in OpenAPI order)."""
+"""The service's routes, one module per concern, as FastAPI routers (in OpenAPI order); the
+dashboard's pages and static files (not in the OpenAPI document) last."""
 
-from . import diagnose, history, prognosis, status
+from . import assets, dashboard, diagnose, history, prognosis, status
 
-ROUTERS = (diagnose.router, history.router, prognosis.router, status.router)
+ROUTERS = (
+    diagnose.router,
+    assets.router,
+    history.router,
+    prognosis.router,
+    status.router,
+    dashboard.router,
+)

@@ -177,7 +177,7 @@ async def post_diagnose(request: Request, store: Store, limits: Limits, workers:
         answer = await workers.diagnose(diagnose_body, body, fmt, params, limits, received_at)
         del body
     if answer.history:
-        await anyio.to_thread.run_sync(store.add_rows, answer.history)
+        await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
     return json_response(answer.encoded)
 
 
@@ -214,5 +214,5 @@ async def post_diagnose_file(request: Request, store: Store, limits: Limits, wor
                 received_at,
             )
     if answer.history:
-        await anyio.to_thread.run_sync(store.add_rows, answer.history)
+        await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
     return json_response(answer.encoded)

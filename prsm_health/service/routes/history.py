@@ -35,12 +35,20 @@ async def history_query(
         ),
     ] = None,
 ) -> HistoryQuery:
-    """The query, parsed before the store is touched. A ``limit`` given above the service's
-    ``max_history`` gets the answer a ``Query(le=max_history)`` bound would give (the OpenAPI
-    document shows that bound); the default is at most ``max_history``."""
+    """The query, parsed before the store is touched (:func:`bounded_limit`)."""
+    limit = bounded_limit(request, limits, limit)
+    if since is not None:
+        parse_time(since)
+    return HistoryQuery(limit, since)
+
+
+def bounded_limit(request: Request, limits, limit: int) -> int:
+    """A ``limit`` query parameter given above the service's ``max_history`` gets the answer a
+    ``Query(le=max_history)`` bound would give (the OpenAPI document shows that bound); the
+    default is at most ``max_history``."""
     if "limit" not in request.query_params:
-        limit = min(limit, limits.max_history)
-    elif limit > limits.max_history:
+        return min(limit, limits.max_history)
+    if limit > limits.max_history:
         raise RequestValidationError(
             [
                 {
@@ -52,9 +60,7 @@ async def history_query(
                 }
             ]
         )
-    if since is not None:
-        parse_time(since)
-    return HistoryQuery(limit, since)
+    return limit
 
 
 @router.get(

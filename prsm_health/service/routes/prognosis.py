@@ -9,7 +9,7 @@ from fastapi import APIRouter, Query
 from fastapi import Path as PathParam
 
 from ...prognostics import METHODS, HistoryError, prognose
-from ..history import prognosis_history
+from ..history import HistoryStore, prognosis_history
 from ..responses import HTTPError, encode, json_response
 from ..schemas import ASSET_ID_PATTERN, Error, Prognosis
 from .deps import PrognosticsModel, Store
@@ -20,6 +20,30 @@ NO_MODEL = (
     "no prognostics model loaded: start the service with --prognostics-model FILE (a model "
     "saved by prsm_health.prognostics.save_prognostics_model; default models/prognostics.json)"
 )
+
+
+def asset_prognosis(store: HistoryStore, model, asset_id: str, method: str | None = None) -> dict:
+    """The asset's prognosis (``Prognosis.as_dict()``, the history's notes first in its
+    warnings); :class:`HTTPError` 503 without a model, 404 for an unknown asset, 422 when the
+    history does not allow one. Runs in a worker thread (reads the store)."""
+    if model is None:
+        raise HTTPError(503, NO_MODEL)
+    if not store.has_asset(asset_id):
+        raise HTTPError(404, f"no diagnoses stored for asset {asset_id!r}")
+    history, notes = prognosis_history(store.operating_history(asset_id))
+    if len(history) < 2:
+        raise HTTPError(
+            422,
+            f"asset {asset_id!r} has {len(history)} diagnosis(es) at distinct operating "
+            "hours; a prognosis needs at least 2 (send operating_hours with POST "
+            "/v1/diagnose)",
+        )
+    try:
+        prognosis = prognose(history, model, method).as_dict()
+    except HistoryError as exc:
+        raise HTTPError(422, f"asset {asset_id!r}: {exc}") from None
+    prognosis["warnings"] = [*notes, *prognosis["warnings"]]
+    return prognosis
 
 
 @router.get(
@@ -56,21 +80,6 @@ async def get_prognosis(
         raise HTTPError(503, NO_MODEL)
 
     def compute() -> bytes:
-        if not store.has_asset(asset_id):
-            raise HTTPError(404, f"no diagnoses stored for asset {asset_id!r}")
-        history, notes = prognosis_history(store.operating_history(asset_id))
-        if len(history) < 2:
-            raise HTTPError(
-                422,
-                f"asset {asset_id!r} has {len(history)} diagnosis(es) at distinct operating "
-                "hours; a prognosis needs at least 2 (send operating_hours with POST "
-                "/v1/diagnose)",
-            )
-        try:
-            prognosis = prognose(history, model, method).as_dict()
-        except HistoryError as exc:
-            raise HTTPError(422, f"asset {asset_id!r}: {exc}") from None
-        prognosis["warnings"] = [*notes, *prognosis["warnings"]]
-        return encode(prognosis)
+        return encode(asset_prognosis(store, model, asset_id, method))
 
     return json_response(await anyio.to_thread.run_sync(compute))

@@ -1,0 +1,46 @@
+// The fleet overview (/): one row per asset from GET /v1/assets?prognosis=true.
+"use strict";
+
+PH.ready(async () => {
+  const status = document.getElementById("status");
+  const tbody = document.querySelector("#fleet tbody");
+  try {
+    const page = await PH.getJSON("/v1/assets?prognosis=true&limit=200");
+    for (const asset of page.assets) {
+      const name = PH.el("th", null, {scope: "row"});
+      name.append(PH.el("a", asset.asset_id, {href: PH.assetHref(asset.asset_id)}));
+      const row = PH.el("tr");
+      row.append(
+        name,
+        PH.el("td", PH.classText(asset.latest)),
+        PH.el("td", PH.clearanceText(asset.latest.clearance), {class: "num"}),
+        rulCell(asset.prognosis),
+        PH.el("td", asset.diagnoses, {class: "num"}),
+        PH.el("td", PH.time(asset.last_received_at)),
+      );
+      tbody.append(row);
+    }
+    if (page.total === 0) {
+      status.textContent = "No diagnosis is stored yet: send recordings with an asset id " +
+        "(Diagnose a recording, or POST /v1/diagnose).";
+    } else {
+      status.textContent = page.truncated
+        ? `${page.count} most recently seen of ${page.total} assets.`
+        : `${page.count} asset(s).`;
+    }
+  } catch (error) {
+    status.textContent = "Could not load the assets: " + error.message;
+    status.classList.add("error");
+  }
+});
+
+function rulCell(prognosis) {
+  const cell = PH.el("td", null, {class: "num"});
+  if (prognosis && prognosis.rul_hours) {
+    cell.textContent = PH.rulText(prognosis.rul_hours);
+  } else {
+    cell.textContent = "–";
+    if (prognosis && prognosis.error) cell.append(PH.el("span", prognosis.error, {class: "why"}));
+  }
+  return cell;
+}
