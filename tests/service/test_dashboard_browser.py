@@ -325,4 +325,13 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
     _loaded(page)
     assert page.locator("#status").text_content() == "No diagnosis is stored for asset nobody."
     assert any("404" in e for e in watch.errors), watch.errors
+
+    # ---- an asset id carrying markup never becomes a page: the id pattern refuses it with a
+    # JSON error (the browser shows it as text), and nothing in it runs
+    watch.reset()
+    refused = page.goto(service.url + "/assets/%3Cscript%3Ealert(1)%3C%2Fscript%3E")
+    assert refused.status in (404, 422)
+    assert refused.headers["content-type"].startswith("application/json")
+    assert watch.dialogs == []
+    assert page.evaluate("() => document.querySelectorAll('body script').length") == 0
     context.close()
