@@ -245,12 +245,7 @@ class HistoryStore:
             entries.append(
                 {
                     "id": id_,
-                    "received_at": received_at,
-                    "source": source,
-                    "filename": filename,
-                    "window": None
-                    if w_index is None
-                    else {"index": w_index, "start": w_start, "end": w_end},
+                    **_provenance(received_at, source, filename, w_index, w_start, w_end),
                     "speed": speed,
                     "load": load,
                     "operating_hours": hours,
@@ -292,12 +287,7 @@ class HistoryStore:
         received_at, source, filename, w_index, w_start, w_end, hours, channel, blob = row
         return {
             "asset_id": asset_id,
-            "received_at": received_at,
-            "source": source,
-            "filename": filename,
-            "window": None
-            if w_index is None
-            else {"index": w_index, "start": w_start, "end": w_end},
+            **_provenance(received_at, source, filename, w_index, w_start, w_end),
             "operating_hours": hours,
             "channel": channel,
             **json.loads(blob),
@@ -392,6 +382,16 @@ class HistoryStore:
     def close(self) -> None:
         with self._lock:
             self._conn.close()
+
+
+def _provenance(received_at, source, filename, w_index, w_start, w_end) -> dict:
+    """Where a stored row came from: when, which body kind and file, which window."""
+    return {
+        "received_at": received_at,
+        "source": source,
+        "filename": filename,
+        "window": None if w_index is None else {"index": w_index, "start": w_start, "end": w_end},
+    }
 
 
 def history_rows(
