@@ -222,7 +222,7 @@ def _write_card(
         f"{model.threshold * 1e6:.2f} µm, the diagnosed clearance at failure learnt from the "
         f"training units (the true limit is {spec.failure_clearance * 1e6:g} µm; the diagnosis "
         "reads worn units between the mean and the screw-side clearance, screw wear being "
-        "≈ 20× the nut's).",
+        "≈ 25× the nut's).",
         "",
         "## Metrics on the held-out units (Saxena et al. 2010)",
         "",
