@@ -9,6 +9,7 @@ protocol under its current subprotocol name ``foxglove.sdk.v1`` only (the same p
 """
 
 import asyncio
+import contextlib
 import json
 import math
 import re
@@ -398,7 +399,8 @@ def test_foxglove_layout_file_matches_the_contract(recording, bundle):
     assert len(panels) == len(set(panels)) and set(panels) == set(layout["configById"])
 
     # message paths: topic + field (nested for the diagnosis), resolved in the contract schemas
-    example = _diagnoser(bundle)(next(iter(iter_windows(recording, WINDOW))))
+    with contextlib.closing(iter_windows(recording, WINDOW)) as stream:  # no file left open
+        example = _diagnoser(bundle)(next(stream))
     schemas = {t: topic_schema(t, list(pairs)) for t, pairs in TOPIC_FIELDS.items()}
     schemas[TOPIC_DIAGNOSIS] = diagnosis_schema(example)
     paths, kinds = [], set()

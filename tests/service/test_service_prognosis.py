@@ -500,6 +500,7 @@ def test_command_line_service_prognosis_survives_a_restart(model_file, tmp_path)
             proc.send_signal(signal.SIGINT)
             proc.wait(timeout=60)
         stderr = proc.stderr.read()
+        proc.stderr.close()  # the pipe, not left to the garbage collector
         if r is None and b"address already in use" in stderr.lower():
             continue  # another process took the free port between probe and bind: retry
         assert r is not None, stderr.decode(errors="replace")
