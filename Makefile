@@ -49,16 +49,16 @@ test: $(STAMP) chromium
 	$(PY) -m pytest -q
 
 # Re-vendor the dashboard's plotting library from the npm registry (needs npm; the files it
-# writes under prsm_health/service/static/vendor/ are committed).
+# writes under prsm_health/apps/service/static/vendor/ are committed).
 vendor:
-	$(PYTHON) tools/vendor_js.py
+	$(PYTHON) tools/release/vendor_js.py
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check prsm_health tests tools
 	$(VENV)/bin/ruff format --check prsm_health tests tools
 
 validation-doc: $(STAMP)
-	$(PY) tools/make_validation_doc.py
+	$(PY) tools/release/make_validation_doc.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache

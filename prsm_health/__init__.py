@@ -15,7 +15,7 @@ Public API (SI units throughout), imported lazily so ``import prsm_health`` stay
   fatigue over operating hours), :func:`diagnose_runs`, :func:`fleet_histories`,
   :class:`PrognosticsModel`, :func:`load_prognostics_model`, :func:`read_history`,
   :func:`prognose` → :class:`Prognosis`
-- static stiffness: :mod:`prsm_health.stiffness`; validation: :func:`prsm_health.validation.collect`
+- static stiffness: :mod:`prsm_health.physics.stiffness`; validation: :func:`prsm_health.validation.collect`
 """
 
 from __future__ import annotations
@@ -24,42 +24,58 @@ from importlib import import_module
 
 __version__ = "0.1.0"
 
+#: The layers, lowest first: each is a folder of this package, and a module imports only from
+#: its own layer and those below it (docs/architecture.md; tests/test_architecture.py checks it).
+LAYERS = (
+    "core",
+    "actuator",
+    "physics",
+    "simulation",
+    "signals",
+    "io",
+    "datasets",
+    "diagnostics",
+    "prognostics",
+    "validation",
+    "apps",
+)
+
 #: Public name → module that defines it (relative to the package).
 _EXPORTS = {
-    "PRESETS": ".design",
-    "GearGeometry": ".design",
-    "MassProperties": ".design",
-    "Material": ".design",
-    "PRSMDesign": ".design",
-    "preset": ".design",
-    "HealthState": ".states",
-    "ManufacturingVariation": ".states",
-    "Spall": ".faults",
-    "PreloadLoss": ".faults",
-    "OperatingProfile": ".states",
-    "Instrumentation": ".instrumentation",
-    "list_profiles": ".instrumentation",
-    "load_instrumentation": ".instrumentation",
-    "SimulationOptions": ".dynamics.model",
-    "Scenario": ".scenario",
-    "simulate": ".dynamics.simulate",
-    "Run": ".run",
-    "characteristic_frequencies": ".kinematics",
-    "defect_frequencies": ".kinematics",
-    "speed_ratios": ".kinematics",
-    "ParameterError": ".errors",
-    "PRSMHealthError": ".errors",
-    "SimulationError": ".errors",
-    "Dataset": ".dataset",
-    "read_mcap": ".mcap",
-    "write_mcap": ".mcap",
+    "PRESETS": ".actuator.design",
+    "GearGeometry": ".actuator.design",
+    "MassProperties": ".actuator.design",
+    "Material": ".actuator.design",
+    "PRSMDesign": ".actuator.design",
+    "preset": ".actuator.design",
+    "HealthState": ".actuator.states",
+    "ManufacturingVariation": ".actuator.states",
+    "Spall": ".actuator.faults",
+    "PreloadLoss": ".actuator.faults",
+    "OperatingProfile": ".actuator.states",
+    "Instrumentation": ".simulation.instrumentation",
+    "list_profiles": ".simulation.instrumentation",
+    "load_instrumentation": ".simulation.instrumentation",
+    "SimulationOptions": ".simulation.dynamics.model",
+    "Scenario": ".simulation.scenario",
+    "simulate": ".simulation.scenario",
+    "Run": ".core.run",
+    "characteristic_frequencies": ".physics.kinematics",
+    "defect_frequencies": ".physics.kinematics",
+    "speed_ratios": ".physics.kinematics",
+    "ParameterError": ".core.errors",
+    "PRSMHealthError": ".core.errors",
+    "SimulationError": ".core.errors",
+    "Dataset": ".datasets",
+    "read_mcap": ".io.mcap",
+    "write_mcap": ".io.mcap",
     "read_recording": ".io",
-    "extract_features": ".features",
-    "Diagnosis": ".diagnosis",
-    "diagnose": ".diagnosis",
-    "diagnose_runs": ".diagnosis",
-    "LifeSpec": ".life",
-    "fleet_lives": ".life",
+    "extract_features": ".signals.features",
+    "Diagnosis": ".diagnostics.diagnosis",
+    "diagnose": ".diagnostics.diagnosis",
+    "diagnose_runs": ".diagnostics.diagnosis",
+    "LifeSpec": ".physics.life",
+    "fleet_lives": ".physics.life",
     "Prognosis": ".prognostics",
     "PrognosticsModel": ".prognostics",
     "fleet_histories": ".prognostics",
@@ -68,7 +84,7 @@ _EXPORTS = {
     "read_history": ".prognostics",
 }
 #: Public names that differ from the defining module's name for them.
-_ALIASES = {"load_model": (".diagnosis", "load_bundle")}
+_ALIASES = {"load_model": (".diagnostics.diagnosis", "load_bundle")}
 
 __all__ = sorted([*_EXPORTS, *_ALIASES, "__version__"])
 

@@ -14,12 +14,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import pytest  # noqa: E402
 
-from prsm_health import (  # noqa: E402
-    HealthState,
-    OperatingProfile,
-    SimulationOptions,
-    simulate,
-)
+from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
 
 #: The regime in which the clearance is observable (docs/validation.md): a ±300 N load
 #: reversing at 10 Hz with 2 ms edges around a zero mean, Hertzian thread flanks.

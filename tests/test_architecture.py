@@ -1,7 +1,11 @@
-"""The layers of docs/architecture.md: no module imports from a layer above its own.
+"""The house in layers (docs/architecture.md), read from the package's own folders and imports.
 
-Checked on the source (every import statement, including those inside functions), so a lazy
-import cannot hide an upward dependency.
+- The layers are the top folders of ``prsm_health``, in the order ``prsm_health.LAYERS``
+  declares once; no module sits outside a layer.
+- A module imports only from its own layer and the layers below (every import statement,
+  including those inside functions, so a lazy import cannot hide an upward dependency).
+- No import cycle between modules, lazy imports included.
+- No module over ~800 lines unless it does one job (named below).
 """
 
 import ast
@@ -9,96 +13,125 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "prsm_health"
+import prsm_health
 
-#: Layer of each top-level module or subpackage (docs/architecture.md), lowest first.
-LAYERS = {
-    "errors": 0,
-    "jsonable": 0,
-    "channels": 0,
-    "run": 0,
-    "tomlfile": 0,
-    "design": 1,
-    "design_files": 1,
-    "states": 1,
-    "faults": 1,
-    "drive_train": 1,
-    "kinematics": 1,
-    "stiffness": 1,
-    "friction": 1,
-    "lubrication": 1,
-    "recirculating": 1,
-    "sensors": 1,
-    "instrumentation": 1,
-    "spectra": 1,
-    "gear_indicators": 1,
-    "envelope_analysis": 1,
-    "signal_kernels": 1,
-    "wear": 1,
-    "dynamics": 2,
-    "scenario": 2,
-    "life": 2,
-    "io": 3,
-    "mcap": 3,
-    "dataset": 3,
-    "live": 3,
-    "features": 4,
-    "estimators": 4,
-    "trees": 4,
-    "evaluation": 4,
-    "persistence": 4,
-    "training": 4,
-    "diagnosis": 4,
-    "prognostics": 4,
-    "prognostic_metrics": 4,
-    "plots": 4,
-    "validation": 4,
-    "cli": 5,
-    "service": 5,
+PACKAGE = Path(prsm_health.__file__).resolve().parent
+ROOT = PACKAGE.parent
+LAYERS = prsm_health.LAYERS
+MAX_LINES = 800
+
+#: Modules over MAX_LINES that each do one job, and which.
+ONE_JOB = {
+    "physics/stiffness/gear_mesh.py": "potential-energy mesh stiffness of one gear pair "
+    "(tooth geometry, compliances, the mesh cycle), one model from one family of papers",
+    "physics/stiffness/cylinder.py": "paper 05's electric-cylinder deformation model",
+    "simulation/instrumentation.py": "the sensor models of an instrumentation profile",
+    "actuator/design.py": "the PRSM design dataclasses, their validation and the presets",
+    "diagnostics/estimators.py": "the scikit-learn estimators of a diagnosis model",
 }
 
-
-def _top(module: Path) -> str:
-    return module.relative_to(PACKAGE).parts[0].removesuffix(".py")
+MODULES = sorted(p for p in PACKAGE.rglob("*.py") if p != PACKAGE / "__init__.py")
 
 
-def _imported_tops(module: Path) -> set[str]:
-    """Top-level prsm_health modules imported anywhere in ``module``."""
+def _dotted(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+DOTTED = {_dotted(p): p for p in [*MODULES, PACKAGE / "__init__.py"]}
+
+
+def _imports(module: Path) -> set[str]:
+    """Dotted names of the prsm_health modules ``module`` imports anywhere (submodules named
+    in ``from package import submodule`` count as the submodule)."""
     tree = ast.parse(module.read_text())
-    depth = len(module.relative_to(PACKAGE).parts) - 1  # 0 for prsm_health/x.py
-    tops = set()
+    own = _dotted(module).split(".")
+    base = own if module.name == "__init__.py" else own[:-1]
+    found = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
-            if node.level == 0:
-                parts = (node.module or "").split(".")
-                if parts[0] == "prsm_health" and len(parts) > 1:
-                    tops.add(parts[1])
-                elif parts[0] == "prsm_health":
-                    tops.update(a.name for a in node.names)
-            elif node.level - 1 == depth:  # relative import resolving to the package root
-                tops.add(node.module.split(".")[0] if node.module else None)
-                if not node.module:
-                    tops.update(a.name for a in node.names)
-            elif node.level - 1 < depth:  # inside its own subpackage
-                tops.add(_top(module))
+            if node.level:
+                target = ".".join(base[: len(base) - node.level + 1] + [node.module or ""])
+            else:
+                target = node.module or ""
+            target = target.rstrip(".")
+            if not target.startswith("prsm_health"):
+                continue
+            subs = [f"{target}.{a.name}" for a in node.names if f"{target}.{a.name}" in DOTTED]
+            found.update(subs or [target])
         elif isinstance(node, ast.Import):
-            for alias in node.names:
-                parts = alias.name.split(".")
-                if parts[0] == "prsm_health" and len(parts) > 1:
-                    tops.add(parts[1])
-    tops.discard(None)
-    return tops
+            found.update(a.name for a in node.names if a.name.startswith("prsm_health"))
+    return {name for name in found if name in DOTTED}
 
 
-MODULES = sorted(p for p in PACKAGE.rglob("*.py") if p.name != "__init__.py" or p.parent != PACKAGE)
+def _layer(dotted: str) -> str | None:
+    parts = dotted.split(".")
+    return parts[1] if len(parts) > 1 else None
 
 
-def test_every_module_has_a_layer():
-    assert {_top(m) for m in MODULES} <= set(LAYERS), {_top(m) for m in MODULES} - set(LAYERS)
+def test_layers_are_the_folders():
+    folders = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
+    loose = sorted(p.name for p in PACKAGE.glob("*.py") if p.name != "__init__.py")
+    assert folders == set(LAYERS), (folders ^ set(LAYERS), "a folder that is no layer, or back")
+    assert not loose, f"modules outside every layer: {loose}"
 
 
 @pytest.mark.parametrize("module", MODULES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_no_import_from_a_layer_above(module):
-    own = LAYERS[_top(module)]
-    above = {t: LAYERS.get(t) for t in _imported_tops(module) if LAYERS.get(t, -1) > own}
-    assert not above, f"{module.relative_to(PACKAGE)} (layer {own}) imports {above}"
+    own = LAYERS.index(_layer(_dotted(module)))
+    above = {
+        name
+        for name in _imports(module)
+        if _layer(name) is not None and LAYERS.index(_layer(name)) > own
+    }
+    assert not above, f"{module.relative_to(PACKAGE)} ({LAYERS[own]}) imports {sorted(above)}"
+
+
+def test_no_import_cycle():
+    graph = {name: _imports(path) - {name} for name, path in DOTTED.items()}
+    # A package's __init__ importing its own submodules is how it re-exports them, not a cycle.
+    graph = {
+        name: {t for t in targets if not t.startswith(name + ".")}
+        for name, targets in graph.items()
+    }
+    index, low, stack, on_stack, cycles = {}, {}, [], set(), []
+
+    def visit(node):  # Tarjan's strongly connected components
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for nxt in graph[node]:
+            if nxt not in index:
+                visit(nxt)
+                low[node] = min(low[node], low[nxt])
+            elif nxt in on_stack:
+                low[node] = min(low[node], index[nxt])
+        if low[node] == index[node]:
+            component = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                component.append(member)
+                if member == node:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    for name in graph:
+        if name not in index:
+            visit(name)
+    assert not cycles, cycles
+
+
+@pytest.mark.parametrize("module", MODULES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_module_does_one_job_or_is_short(module):
+    rel = str(module.relative_to(PACKAGE))
+    lines = len(module.read_text().splitlines())
+    assert lines <= MAX_LINES or rel in ONE_JOB, f"{rel}: {lines} lines (split it, or name its job)"
+
+
+def test_the_docs_list_the_layers_in_order():
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    positions = [text.find(f"`{layer}/`") for layer in LAYERS]
+    assert all(p >= 0 for p in positions), dict(zip(LAYERS, positions))
+    assert positions == sorted(positions), "docs/architecture.md lists the layers out of order"

@@ -3,8 +3,8 @@
 - :mod:`prsm_health.io.parquet` — one run as a single Parquet file (``simulate --out x.parquet``);
 - :mod:`prsm_health.io.arrow` — one run as an Arrow IPC stream (the Parquet file's columns);
 - :mod:`prsm_health.io.csv` — a CSV table with contract channel names (a rig's export);
-- :mod:`prsm_health.mcap` — MCAP recordings (writer, tolerant reader, replay);
-- :mod:`prsm_health.dataset` — generated datasets (a directory of Parquet files).
+- :mod:`prsm_health.io.mcap` — MCAP recordings (writer, tolerant reader, replay);
+- :mod:`prsm_health.datasets.dataset` — generated datasets (a directory of Parquet files).
 
 :func:`read_recording` picks the reader from the file suffix; :func:`read_recording_bytes`
 reads a recording held in memory (a request body).
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import PRSMHealthError
+from prsm_health.core.errors import PRSMHealthError
 
 SUFFIXES = (".mcap", ".parquet", ".csv")
 #: Formats :func:`read_recording_bytes` reads.
@@ -22,13 +22,13 @@ BYTE_FORMATS = ("arrow", "parquet", "mcap")
 
 
 def read_recording(path: str | Path):
-    """A recording as a :class:`~prsm_health.run.Run`: ``.mcap``, ``.parquet`` or ``.csv``."""
+    """A recording as a :class:`~prsm_health.core.run.Run`: ``.mcap``, ``.parquet`` or ``.csv``."""
     path = Path(path)
     if not path.exists():
         raise PRSMHealthError(f"{path}: no such file")
     suffix = path.suffix.lower()
     if suffix == ".mcap":
-        from ..mcap import read_mcap
+        from .mcap import read_mcap
 
         return read_mcap(path)
     if suffix == ".parquet":
@@ -43,7 +43,7 @@ def read_recording(path: str | Path):
 
 
 def read_recording_bytes(data: bytes, fmt: str, name: str = "recording"):
-    """A recording held in memory as a :class:`~prsm_health.run.Run`: ``fmt`` is ``"arrow"``
+    """A recording held in memory as a :class:`~prsm_health.core.run.Run`: ``fmt`` is ``"arrow"``
     (Arrow IPC stream), ``"parquet"`` or ``"mcap"``; ``name`` names it in messages and
     warnings.
 
@@ -69,8 +69,9 @@ def _read_mcap_bytes(data: bytes, name: str):
     import tempfile
     import warnings
 
-    from ..errors import TruncatedRecordingWarning
-    from ..mcap import read_mcap
+    from prsm_health.core.errors import TruncatedRecordingWarning
+
+    from .mcap import read_mcap
 
     with tempfile.TemporaryDirectory(prefix="prsm-health-mcap-") as tmp:
         path = Path(tmp) / "recording.mcap"

@@ -17,10 +17,11 @@ import struct
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..channels import UNITS
-from ..errors import PRSMHealthError
-from ..run import Run
-from ._columns import contract_channels, rate_from_time, run_table, truth_columns
+from prsm_health.core.channels import UNITS
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.run import Run
+
+from .columns import contract_channels, rate_from_time, run_table, truth_columns
 
 #: Media type of an Arrow IPC stream (IANA registration).
 ARROW_STREAM_MEDIA_TYPE = "application/vnd.apache.arrow.stream"

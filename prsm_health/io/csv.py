@@ -1,8 +1,8 @@
 """CSV recordings: a header row of contract channel names, ``time`` in seconds (docs/formats.md).
 
-Every column named like a measured contract channel (:mod:`prsm_health.channels`) is read as
+Every column named like a measured contract channel (:mod:`prsm_health.core.channels`) is read as
 that channel in its SI unit, a ``truth_<name>`` column of a truth signal into
-:attr:`Run.truth <prsm_health.run.Run.truth>` (never a channel); other columns are ignored. Sampling must be uniform; the sample rate is
+:attr:`Run.truth <prsm_health.core.run.Run.truth>` (never a channel); other columns are ignored. Sampling must be uniform; the sample rate is
 1/median(Δt). A time column in milliseconds is the usual mistake: name it ``time_ms`` and it is
 converted, and a time axis that implies a sample rate below 100 Hz gets a hint.
 """
@@ -12,13 +12,14 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-from ..errors import PRSMHealthError
-from ..run import Run, ms_hint
-from ._columns import contract_channels, rate_from_time, truth_columns
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.run import Run, ms_hint
+
+from .columns import contract_channels, rate_from_time, truth_columns
 
 
 def read_csv(path: str | Path) -> Run:
-    """Read a CSV recording as a :class:`~prsm_health.run.Run` (SI units)."""
+    """Read a CSV recording as a :class:`~prsm_health.core.run.Run` (SI units)."""
     import pandas as pd
 
     path = Path(path)

@@ -1,6 +1,6 @@
 """One run as a single Parquet file: ``time``, the measured channels, then ``truth_<name>`` for
 each truth signal as columns, with the units, sample rate, labels and scenario in the schema
-metadata (docs/formats.md), so pandas, pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.dataset`.
+metadata (docs/formats.md), so pandas, pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.datasets.dataset`.
 """
 
 from __future__ import annotations
@@ -8,9 +8,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..errors import PRSMHealthError
-from ..run import Run
-from ._columns import contract_channels, rate_from_time, run_table, truth_columns
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.run import Run
+
+from .columns import contract_channels, rate_from_time, run_table, truth_columns
 
 
 def write_run_parquet(run: Run, path: str | Path) -> Path:

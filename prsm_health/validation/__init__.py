@@ -4,7 +4,7 @@ One module per paper (``paper01.py`` …) exposes ``rows() -> list[Row]``. A row
 *expects to reproduce* the paper value within a stated tolerance — and then fails loudly if it
 does not — or records why the paper number cannot be matched: the paper contradicts itself
 ("paper inconsistent") or lacks the inputs ("not computable"). ``prsm-health validate`` prints
-the report; ``tools/make_validation_doc.py`` writes docs/validation.md from it.
+the report; ``tools/release/make_validation_doc.py`` writes docs/validation.md from it.
 """
 
 from __future__ import annotations

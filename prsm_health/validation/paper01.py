@@ -9,14 +9,15 @@ import math
 
 import numpy as np
 
-from ..design import preset
-from ..drive_train import DriveTrain
-from ..dynamics.model import SimulationOptions
-from ..dynamics.simulate import simulate
-from ..kinematics import characteristic_frequencies, speed_ratios
-from ..spectra import amplitude_spectrum, dominant_frequency
-from ..states import HealthState, ManufacturingVariation, OperatingProfile
-from ..stiffness.thread import roller_side_stiffness
+from prsm_health.actuator.design import preset
+from prsm_health.actuator.drive_train import DriveTrain
+from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
+from prsm_health.physics.kinematics import characteristic_frequencies, speed_ratios
+from prsm_health.physics.stiffness.thread import roller_side_stiffness
+from prsm_health.signals.spectra import amplitude_spectrum, dominant_frequency
+from prsm_health.simulation.dynamics.model import SimulationOptions
+from prsm_health.simulation.scenario import simulate
+
 from . import Row, inconsistent, not_computable, reproduced
 
 #: Paper 01's model: identical rollers and its constant friction coefficients.

@@ -3,12 +3,13 @@
 Reference: paper 02 (docs/references.md), results table and text. Reading:
 Coulomb friction and M_fs3 summed over all n_R·n_t contacts, zero contact offset angles, the
 screw ramped linearly to 1 rad/s over t_acc, efficiencies over [0, t_acc + 0.1 s]
-(prsm_health/friction.py).
+(prsm_health/physics/friction.py).
 """
 
 from __future__ import annotations
 
-from ..friction import FrictionParameters, simulate_friction
+from prsm_health.physics.friction import FrictionParameters, simulate_friction
+
 from . import Row, inconsistent, reproduced
 
 #: (F_out [N], t_acc [s]) → (peak torque, steady torque [N·m], η_min, η_overall [%]) as printed.

@@ -1,7 +1,7 @@
 """Paper 03 (recirculating PRSM): every number of the design and results sections.
 
 Table 1 (structural parameters) and Table 2 (simulated vs theoretical values) are not printed;
-the model is :mod:`prsm_health.recirculating` for the ``paper03`` preset, the geometry that
+the model is :mod:`prsm_health.physics.recirculating` for the ``paper03`` preset, the geometry that
 fits most of the paper's numbers (orbit radius 19.75 mm, d_s = 32, d_r = 7.5, d_n = 47 mm,
 12 rollers, 1 mm single-start pitch, α = 90°; docs/validation.md). Because
 that geometry was reconstructed from the speeds, the orbital angle and L_r3, the rows that
@@ -23,8 +23,9 @@ from __future__ import annotations
 
 import math
 
-from .. import recirculating as rc
-from ..design import preset, printed_eq14_limit
+from prsm_health.actuator.design import preset, printed_eq14_limit
+from prsm_health.physics import recirculating as rc
+
 from . import Row, inconsistent, not_computable, reproduced
 
 PAPER = "03"

@@ -2,7 +2,7 @@
 
 The paper does not give the specimen's thread geometry, roller count, engaged threads or
 clearances, so its absolute stiffnesses cannot be recomputed; each such row still shows what
-:mod:`prsm_health.stiffness.thread` gives for the ``paper04`` preset (21/7/35 mm pitch
+:mod:`prsm_health.physics.stiffness.thread` gives for the ``paper04`` preset (21/7/35 mm pitch
 diameters, 5 starts, lead angle 1.74° → 0.4 mm pitch; assumed 7 rollers, 10 engaged threads,
 100 mm free screw). The model stiffness is the secant F/δ including the shaft (the paper's
 rig reports both secant and incremental stiffness without saying which its tables hold).
@@ -24,8 +24,9 @@ import math
 
 from scipy.optimize import brentq
 
-from ..design import preset
-from ..stiffness import thread
+from prsm_health.actuator.design import preset
+from prsm_health.physics.stiffness import thread
+
 from . import Row, inconsistent, not_computable, reproduced
 
 PAPER = "04"

@@ -2,7 +2,7 @@
 
 The paper's Δl(F, x) is printed in metres with F in N and x in mm; its stiffness table in
 mm and N/mm. Rows keep the paper's units so the two columns compare directly. The model is
-:mod:`prsm_health.stiffness.cylinder` for the paper's parameter table
+:mod:`prsm_health.physics.stiffness.cylinder` for the paper's parameter table
 (:meth:`ElectricCylinder.paper05`), whose module docstring gives the unit readings.
 
 Tolerances of the reproduced rows: the paper evaluates with π ≈ 3.14 (π·d1²/4 and
@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import math
 
-from ..stiffness import cylinder as cyl_mod
+from prsm_health.physics.stiffness import cylinder as cyl_mod
+
 from . import Row, inconsistent, not_computable, reproduced
 
 PAPER = "05"

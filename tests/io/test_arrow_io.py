@@ -7,12 +7,12 @@ import numpy as np
 import pyarrow as pa
 import pytest
 
-from prsm_health.errors import PRSMHealthError, TruncatedRecordingWarning
+from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
+from prsm_health.core.run import Run
 from prsm_health.io import read_recording_bytes
 from prsm_health.io.arrow import arrow_stream_sizes, read_run_arrow, write_run_arrow
+from prsm_health.io.mcap import write_mcap
 from prsm_health.io.parquet import write_run_parquet
-from prsm_health.mcap import write_mcap
-from prsm_health.run import Run
 
 
 @pytest.fixture(scope="module")

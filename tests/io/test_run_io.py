@@ -9,8 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from prsm_health import HealthState, OperatingProfile, simulate
-from prsm_health.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
-from prsm_health.errors import PRSMHealthError
+from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
+from prsm_health.core.errors import PRSMHealthError
 from prsm_health.io.csv import read_csv
 from prsm_health.io.parquet import read_run_parquet, write_run_parquet
 

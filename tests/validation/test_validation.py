@@ -12,7 +12,7 @@ import unicodedata
 
 import pytest
 
-from prsm_health.cli import main
+from prsm_health.apps.cli import main
 from prsm_health.validation import (
     NOT_COMPUTABLE,
     NOT_REPRODUCED,

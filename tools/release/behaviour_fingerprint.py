@@ -75,7 +75,7 @@ def _mcap_chunks(path: Path):
 
     with open(path, "rb") as f:
         reader = make_reader(f)
-        for schema, channel, message in reader.iter_messages(log_time_order=True):
+        for _schema, channel, message in reader.iter_messages(log_time_order=True):
             yield channel.topic
             yield message.log_time
             yield message.data

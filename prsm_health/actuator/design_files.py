@@ -1,0 +1,173 @@
+"""Design files: a :class:`~prsm_health.actuator.design.PRSMDesign` as TOML, and designs by name or path.
+
+A design file holds the fields of :class:`~prsm_health.actuator.design.PRSMDesign` under their own names,
+in SI units (m, kg, kg·m², Pa, rad); the nested dataclasses are tables: ``[masses]``,
+``[gear]`` (standard variant only), ``[screw_material]``, ``[roller_material]``,
+``[nut_material]``. Optional fields (``None`` in Python) are left out. ``name`` defaults to the
+file's stem. See docs/formats.md → Design files.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from prsm_health.core.errors import ParameterError
+from prsm_health.core.tomlfile import read_toml, toml_value
+
+from .design import PRESETS, GearGeometry, MassProperties, Material, PRSMDesign, preset
+
+#: Unit and meaning of every design field, by dotted name below the design (``gear.module``);
+#: the material fields apply to each of the three ``*_material`` tables.
+FIELDS = {
+    "name": ("", "design name"),
+    "variant": ("", '"standard" (threaded rollers, ring gears) or "recirculating" (paper 03)'),
+    "screw_diameter": ("m", "screw thread pitch diameter d_s"),
+    "roller_diameter": ("m", "roller thread pitch diameter d_r"),
+    "nut_diameter": ("m", "nut thread pitch diameter d_n = d_s + 2·d_r (within 0.5 %)"),
+    "pitch": ("m", "axial thread pitch, common to screw, rollers and nut"),
+    "screw_starts": ("", "screw thread starts n_s"),
+    "nut_starts": ("", "nut thread starts n_n = n_s (standard: n_n·d_r = n_r·d_n)"),
+    "roller_starts": ("", "roller thread starts n_r (0 for recirculating grooved rollers)"),
+    "n_rollers": ("", "number of rollers"),
+    "contact_angle": ("rad", "thread contact angle β from the radial plane (15°–75°)"),
+    "engaged_threads": ("", "thread turns of one roller engaged with the screw"),
+    "nut_outer_diameter": ("m", "nut outer diameter"),
+    "screw_free_length": ("m", "screw length between its axial bearing and the nut"),
+    "screw_bore_diameter": ("m", "screw bore diameter (0: solid screw)"),
+    "thread_addendum": ("m", "thread crest height (absent: 0.25·p·tan β)"),
+    "roller_profile_radius": ("m", "roller thread profile radius (absent: r_r / cos β)"),
+    "nut_length": ("m", "threaded nut length (absent: engaged_threads·pitch)"),
+    "reference": ("", "where the numbers come from"),
+    "material.youngs_modulus": ("Pa", "Young's modulus E"),
+    "material.poisson_ratio": ("", "Poisson's ratio ν"),
+    "material.density": ("kg/m³", "density"),
+    "material.shear_modulus": ("Pa", "shear modulus G (absent: E / (2(1 + ν)))"),
+    "gear.ring_teeth": ("", "teeth of the nut's internal ring gear z_ring"),
+    "gear.roller_teeth": ("", "teeth of the roller-end gear z_roller (z_ring/z_roller = d_n/d_r)"),
+    "gear.module": ("m", "gear module"),
+    "gear.pressure_angle": ("rad", "standard pressure angle α0 (10°–35°)"),
+    "gear.face_width": ("m", "roller gear face width"),
+    "gear.addendum_coefficient": ("", "tooth addendum in modules"),
+    "gear.dedendum_coefficient": ("", "tooth dedendum in modules"),
+    "masses.screw_mass": ("kg", "screw mass"),
+    "masses.screw_inertia": ("kg·m²", "screw polar moment of inertia"),
+    "masses.nut_mass": ("kg", "nut mass"),
+    "masses.nut_inertia": ("kg·m²", "nut polar moment of inertia"),
+    "masses.roller_mass": ("kg", "mass of one roller"),
+    "masses.roller_inertia": ("kg·m²", "polar moment of inertia of one roller"),
+    "masses.carrier_mass": ("kg", "carrier mass"),
+    "masses.carrier_inertia": ("kg·m²", "carrier polar moment of inertia"),
+}
+
+_TABLES = {
+    "masses": MassProperties,
+    "gear": GearGeometry,
+    "screw_material": Material,
+    "roller_material": Material,
+    "nut_material": Material,
+}
+
+
+def field_info(dotted: str) -> tuple[str, str]:
+    """(unit, meaning) of a dotted design field (``gear.module``, ``nut_material.density``)."""
+    head, _, tail = dotted.partition(".")
+    if head.endswith("_material"):
+        dotted = f"material.{tail}"
+    return FIELDS.get(dotted, ("", ""))
+
+
+def load_design(design: str | Path | dict | PRSMDesign, *, base: Path | None = None) -> PRSMDesign:
+    """A design from a preset name, a design TOML file, a dict or a design.
+
+    Parameters
+    ----------
+    design : str, Path, dict or PRSMDesign
+        A preset name (``paper01`` … ``paper05``), a path to a ``.toml`` design file, the dict
+        form of :meth:`PRSMDesign.to_dict` or a design (returned as is).
+    base : Path, optional
+        Folder a relative path is resolved against (default: the working directory).
+    """
+    if isinstance(design, PRSMDesign):
+        return design
+    if isinstance(design, dict):
+        return PRSMDesign.from_dict(design)
+    if isinstance(design, str) and design in PRESETS:
+        return preset(design)
+    if not isinstance(design, (str, Path)):
+        raise ParameterError(
+            "design", design, "must be a preset name, a design TOML file or a table"
+        )
+    path = Path(design)
+    if not path.is_absolute() and base is not None:
+        path = Path(base) / path
+    if path.suffix != ".toml" and not path.exists():
+        raise ParameterError(
+            "design",
+            str(design),
+            f"must be one of {', '.join(sorted(PRESETS))} or a design TOML file (*.toml)",
+        )
+    data = read_toml(path, "design file")
+    data.setdefault("name", path.stem)
+    return PRSMDesign.from_dict(data)
+
+
+def design_to_toml(design: PRSMDesign, *, comments: bool = True) -> str:
+    """TOML text that :func:`load_design` reads back to an equal design.
+
+    Parameters
+    ----------
+    design : PRSMDesign
+    comments : bool
+        Follow every value with a comment giving its unit and meaning.
+    """
+    data = design.to_dict()
+    tables = {key: data.pop(key) for key in _TABLES if data.get(key) is not None}
+    data = {k: v for k, v in data.items() if k not in _TABLES}
+    lines = _toml_lines(data, "", comments)
+    for table, values in tables.items():
+        lines += ["", f"[{table}]"] + _toml_lines(values, table, comments)
+    return "\n".join(lines) + "\n"
+
+
+def design_toml_tables(design: PRSMDesign, prefix: str) -> list[str]:
+    """The design as TOML tables under ``[prefix]`` (a scenario's ``[design]``), no comments."""
+    data = design.to_dict()
+    tables = {key: data.pop(key) for key in _TABLES if data.get(key) is not None}
+    data = {k: v for k, v in data.items() if k not in _TABLES}
+    lines = [f"[{prefix}]"] + _toml_lines(data, "", False)
+    for table, values in tables.items():
+        lines += ["", f"[{prefix}.{table}]"] + _toml_lines(values, table, False)
+    return lines
+
+
+def _toml_lines(values: dict, table: str, comments: bool) -> list[str]:
+    rows = [(k, toml_value(v)) for k, v in values.items() if v is not None]
+    width = max((len(f"{k} = {v}") for k, v in rows), default=0)
+    out = []
+    for key, text in rows:
+        line = f"{key} = {text}"
+        if comments:
+            unit, meaning = field_info(f"{table}.{key}" if table else key)
+            note = f"[{unit}] {meaning}" if unit else meaning
+            line = f"{line:<{width}}  # {note}".rstrip(" #")
+        out.append(line)
+    return out
+
+
+def design_rows(design: PRSMDesign) -> list[tuple[str, object, str]]:
+    """(dotted field, value, unit) of every field, ``None`` shown as "–" (for tables)."""
+    rows = []
+
+    def walk(values: dict, prefix: str) -> None:
+        for key, value in values.items():
+            dotted = f"{prefix}{key}"
+            if isinstance(value, dict):
+                walk(value, f"{dotted}.")
+            else:
+                rows.append((dotted, "–" if value is None else value, field_info(dotted)[0]))
+
+    walk(design.to_dict(), "")
+    return rows
+
+
+__all__ = ["FIELDS", "design_rows", "design_to_toml", "field_info", "load_design"]

@@ -1,0 +1,415 @@
+"""Health states, operating profiles and manufacturing variation of a simulated PRSM.
+
+Frozen dataclasses grouped by lifetime: a :class:`HealthState` is what wears (clearances,
+lubricant), an :class:`OperatingProfile` what the actuator is asked to do (screw motion, axial
+load), :class:`ManufacturingVariation` the as-built scatter between rollers. All SI.
+
+Sign convention for the axial load: ``load`` is the *resisting* force on the nut, positive when
+it opposes the nut motion produced by a positive screw speed (a compressive load on an
+extending actuator). Reversing load profiles swing it through zero.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from prsm_health.core.errors import require, require_known_keys, require_positive, require_range
+from prsm_health.core.tomlfile import read_toml
+
+from .faults import fault_as_dict, fault_from_dict
+
+MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
+LOADS = ("constant", "sinusoidal", "reversing")
+DRIVES = ("prescribed", "speed_loop", "position_loop")
+RAMP_SHAPES = ("linear", "cosine")
+
+
+@dataclass(frozen=True)
+class HealthState:
+    """Wear and lubrication state.
+
+    Parameters
+    ----------
+    clearance_screw, clearance_nut, clearance_gear : float [m]
+        Half-clearance b on each flank of the screw–roller thread, roller–nut thread and roller
+        gear mesh (paper 01's backlash function f(δ, b), total play 2b). Paper 01 §3.3 uses
+        b_s = b_N = 10, 20, 30 µm.
+    wear_spread : float [-]
+        Uneven wear between rollers: roller i's thread clearances are scaled by
+        (1 + wear_spread·u_i), u_i uniform in [−1, 1] drawn from the run seed. 0 = even wear.
+    friction_scale : float [-]
+        Multiplies the thread friction coefficients (1: as the lubrication model gives them).
+    lubricant_degradation : float [-]
+        0 (new) … 1: additive depletion raises boundary friction towards unprotected steel's,
+        and the viscosity falls (:mod:`prsm_health.physics.lubrication`).
+    lubricant_starvation : float [-]
+        0 (fully flooded) … 1: the inlet is no longer replenished and the film thins to
+        (1 − s) of the flooded one.
+    preload : float [m]
+        Installed axial interference on each flank of every roller's screw and nut threads
+        (oversize rollers or a double nut): the realised half-clearance is b − preload, so with
+        b = 0 and a preload both flanks touch at rest and there is no play while the preload
+        holds. A :class:`~prsm_health.actuator.faults.PreloadLoss` fault takes a share of it away
+        (:attr:`effective_preload`). Range 0–50 µm.
+    faults : tuple
+        Faults of :mod:`prsm_health.actuator.faults` (spalls, preload loss, …), default none; dicts
+        with a ``kind`` key are converted.
+    """
+
+    clearance_screw: float = 10e-6
+    clearance_nut: float = 10e-6
+    clearance_gear: float = 10e-6
+    wear_spread: float = 0.0
+    friction_scale: float = 1.0
+    lubricant_degradation: float = 0.0
+    lubricant_starvation: float = 0.0
+    preload: float = 0.0
+    faults: tuple = ()
+
+    def __post_init__(self):
+        require(
+            isinstance(self.faults, (list, tuple)),
+            "health.faults",
+            self.faults,
+            "must be a list of fault tables",
+        )
+        object.__setattr__(self, "faults", tuple(fault_from_dict(f) for f in self.faults))
+        for name in ("clearance_screw", "clearance_nut", "clearance_gear"):
+            require_range(f"health.{name}", getattr(self, name), 0.0, 500e-6, unit="m")
+        require_range("health.wear_spread", self.wear_spread, 0.0, 1.0)
+        require_range("health.friction_scale", self.friction_scale, 0.0, 20.0)
+        require_range("health.lubricant_degradation", self.lubricant_degradation, 0.0, 1.0)
+        require_range("health.lubricant_starvation", self.lubricant_starvation, 0.0, 1.0)
+        require_range("health.preload", self.preload, 0.0, 50e-6, unit="m")
+        require(
+            self.preload > 0 or not self.of_kind("preload_loss"),
+            "faults.kind",
+            "preload_loss",
+            "needs a preload: set health.preload (the installed interference) > 0",
+        )
+
+    @classmethod
+    def from_dict(cls, values: dict, table: str = "health") -> HealthState:
+        """From a health table: the fields, ``clearance`` as shorthand for screw, nut and gear,
+        and ``faults`` as a list of tables (``[[faults]]``); unknown keys name the table."""
+        if isinstance(values, cls):
+            return values
+        require(isinstance(values, dict), table, values, "must be a table of parameters")
+        values = dict(values)
+        if "clearance" in values:
+            clearance = values.pop("clearance")
+            for key in ("clearance_screw", "clearance_nut", "clearance_gear"):
+                values.setdefault(key, clearance)
+        require_known_keys(table, values, ["clearance", *(f.name for f in fields(cls))])
+        return cls(**values)
+
+    @classmethod
+    def from_toml(cls, path) -> HealthState:
+        """Read a health file: the :meth:`from_dict` table at the top level (docs/faults.md)."""
+        return cls.from_dict(read_toml(path, "health file"))
+
+    def of_kind(self, kind: str) -> tuple:
+        """The faults of one kind (``"spall"``, ``"preload_loss"``, …)."""
+        return tuple(f for f in self.faults if f.kind == kind)
+
+    @property
+    def spalls(self) -> tuple:
+        return self.of_kind("spall")
+
+    @property
+    def effective_preload(self) -> float:
+        """Interference left after preload loss [m]."""
+        kept = 1.0
+        for fault in self.of_kind("preload_loss"):
+            kept *= 1.0 - fault.fraction
+        return self.preload * kept
+
+    @classmethod
+    def uniform(cls, clearance: float, **kw) -> HealthState:
+        """The same clearance on screw, nut and gear engagements [m]."""
+        return cls(
+            clearance_screw=clearance, clearance_nut=clearance, clearance_gear=clearance, **kw
+        )
+
+    def as_dict(self) -> dict:
+        return {**asdict(self), "faults": [fault_as_dict(f) for f in self.faults]}
+
+
+@dataclass(frozen=True)
+class OperatingProfile:
+    """Screw motion and axial load over a run.
+
+    Parameters
+    ----------
+    duration : float [s]
+    motion : {"constant", "ramp", "trapezoid", "reversing"}
+        constant: ω from t = 0; ramp: 0 → ω over ``accel_time`` then constant; trapezoid:
+        ramp up, hold, ramp down to rest at ``duration``; reversing: ±ω alternating every
+        half ``motion_period`` with ``accel_time`` ramps through zero.
+    speed : float [rad/s]
+        Screw speed magnitude ω.
+    accel_time : float [s]
+    motion_period : float [s]
+        Period of the reversing motion.
+    load_profile : {"constant", "sinusoidal", "reversing"}
+    load : float [N]
+        Mean resisting axial load on the nut (see module docstring for the sign).
+    load_amplitude : float [N]
+        Sinusoidal: amplitude around ``load``; reversing: the load swings ±``load_amplitude``
+        around ``load`` as a trapezoidal wave with ``accel_time`` transitions.
+    load_frequency : float [Hz]
+        Frequency of the sinusoidal or reversing load.
+    load_ramp_time : float or None [s]
+        Duration of each reversal of the reversing load; None: ``accel_time``.
+    load_ramp_shape : {"linear", "cosine"}
+        Shape of those reversals: a straight ramp, or a raised cosine (smooth, no jerk step).
+    drive : {"prescribed", "speed_loop", "position_loop"}
+        Prescribed motor angle (ideal servo); a PI speed loop on the motor speed; or a
+        position loop (P, ``position_loop_gain``) cascaded on that speed loop, following the
+        motion's angle — motion reversals as a position-controlled actuator makes them.
+    speed_loop_bandwidth : float [Hz]
+        Closed-loop bandwidth of the speed loop (sets the PI gains from motor + screw inertia).
+    position_loop_gain : float [1/s]
+        Proportional gain of the position loop (speed command per angle error).
+    torque_limit : float [N·m]
+        Motor torque limit of the speed loop.
+    temperature : float [K]
+        Lubricant temperature at the thread contacts (sets its viscosity; 223–473 K).
+    """
+
+    duration: float = 0.2
+    motion: str = "constant"
+    speed: float = 100.0
+    accel_time: float = 0.02
+    motion_period: float = 0.1
+    load_profile: str = "constant"
+    load: float = 100.0
+    load_amplitude: float = 0.0
+    load_frequency: float = 20.0
+    load_ramp_time: float | None = None
+    load_ramp_shape: str = "linear"
+    drive: str = "prescribed"
+    speed_loop_bandwidth: float = 50.0
+    position_loop_gain: float = 60.0
+    torque_limit: float = 50.0
+    temperature: float = 313.15
+
+    def __post_init__(self):
+        require_range("profile.duration", self.duration, 1e-4, 3600.0, unit="s")
+        require(
+            self.motion in MOTIONS,
+            "profile.motion",
+            self.motion,
+            f"must be one of {', '.join(MOTIONS)}",
+        )
+        require(
+            self.load_profile in LOADS,
+            "profile.load_profile",
+            self.load_profile,
+            f"must be one of {', '.join(LOADS)}",
+        )
+        require(
+            self.drive in DRIVES, "profile.drive", self.drive, f"must be one of {', '.join(DRIVES)}"
+        )
+        require_range("profile.speed", self.speed, 0.0, 2000.0, unit="rad/s")
+        require_range("profile.accel_time", self.accel_time, 0.0, 10.0, unit="s")
+        require_positive("profile.motion_period", self.motion_period)
+        if self.motion == "reversing":
+            require(
+                0 < self.accel_time < self.motion_period / 2,
+                "profile.accel_time",
+                self.accel_time,
+                f"must lie in (0, motion_period/2 = {self.motion_period / 2:g}) s for a "
+                "reversing motion (the screw ramps through zero speed)",
+            )
+        if self.motion == "trapezoid":
+            require(
+                2 * self.accel_time < self.duration,
+                "profile.accel_time",
+                self.accel_time,
+                f"must be < duration/2 = {self.duration / 2:g} s for a trapezoid",
+            )
+        require_range("profile.load", self.load, -1e6, 1e6, unit="N")
+        require_range("profile.load_amplitude", self.load_amplitude, 0.0, 1e6, unit="N")
+        require_range("profile.load_frequency", self.load_frequency, 0.0, 1e4, unit="Hz")
+        require_positive("profile.speed_loop_bandwidth", self.speed_loop_bandwidth)
+        require_range("profile.position_loop_gain", self.position_loop_gain, 0.0, 1e4, unit="1/s")
+        if self.load_ramp_time is not None:
+            require_range("profile.load_ramp_time", self.load_ramp_time, 0.0, 10.0, unit="s")
+        require(
+            self.load_ramp_shape in RAMP_SHAPES,
+            "profile.load_ramp_shape",
+            self.load_ramp_shape,
+            f"must be one of {', '.join(RAMP_SHAPES)}",
+        )
+        require_positive("profile.torque_limit", self.torque_limit)
+        require_range("profile.temperature", self.temperature, 223.15, 473.15, unit="K")
+
+    # ------------------------------------------------------------------ knots for the kernel
+    def motion_knots(self) -> np.ndarray:
+        """Piecewise-linear screw speed as a (3, K) array: times [s], speeds [rad/s], angles [rad]."""
+        w, ta, T = self.speed, self.accel_time, self.duration
+        if self.motion == "constant" or (self.motion == "ramp" and ta == 0):
+            times, speeds = [0.0, T], [w, w]
+        elif self.motion == "ramp":
+            times, speeds = [0.0, ta, max(T, ta * 1.000001)], [0.0, w, w]
+        elif self.motion == "trapezoid":
+            times, speeds = [0.0, ta, T - ta, T], [0.0, w, w, 0.0]
+        else:  # reversing: +ω, ramp through zero to −ω every half period
+            half = self.motion_period / 2
+            times, speeds = [0.0], [w]
+            k = 1
+            while k * half - ta / 2 < T:
+                sign = 1.0 if k % 2 == 0 else -1.0
+                times += [k * half - ta / 2, k * half + ta / 2]
+                speeds += [-sign * w, sign * w]
+                k += 1
+            times.append(max(T, times[-1] + 1e-6))
+            speeds.append(speeds[-1])
+        times = np.asarray(times, dtype=float)
+        speeds = np.asarray(speeds, dtype=float)
+        angles = np.concatenate(
+            ([0.0], np.cumsum(0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times)))
+        )
+        return np.vstack([times, speeds, angles])
+
+    def load_knots(self) -> tuple[np.ndarray, float, float]:
+        """Axial load as (2, K) knots [s, N] plus sinusoid amplitude [N] and frequency [Hz]."""
+        T, F = self.duration, self.load
+        if self.load_profile == "constant":
+            return np.array([[0.0, T], [F, F]]), 0.0, 0.0
+        if self.load_profile == "sinusoidal":
+            return np.array([[0.0, T], [F, F]]), self.load_amplitude, self.load_frequency
+        # reversing: trapezoidal wave F ± A with linear or raised-cosine reversals
+        A = self.load_amplitude
+        half = 0.5 / self.load_frequency if self.load_frequency > 0 else T
+        ramp_time = self.accel_time if self.load_ramp_time is None else self.load_ramp_time
+        ramp = min(ramp_time, 0.5 * half) or 1e-6
+        # a raised cosine as 16 linear pieces: within 0.5 % of the amplitude
+        shape = np.linspace(0.0, 1.0, 2 if self.load_ramp_shape == "linear" else 17)
+        if self.load_ramp_shape == "cosine":
+            shape = 0.5 - 0.5 * np.cos(np.pi * shape)
+        pieces = np.linspace(-0.5, 0.5, len(shape)) * ramp
+        times, values = [0.0], [F + A]
+        k = 1
+        while k * half - ramp / 2 < T:
+            start = F + A if k % 2 else F - A
+            end = F - A if k % 2 else F + A
+            times += list(k * half + pieces)
+            values += list(start + (end - start) * shape)
+            k += 1
+        times.append(max(T, times[-1] + 1e-6))
+        values.append(values[-1])
+        return np.vstack([np.asarray(times), np.asarray(values)]), 0.0, 0.0
+
+    @property
+    def has_reversals(self) -> bool:
+        """True when the motion or the load changes sign during the run."""
+        return self.motion == "reversing" or (
+            self.load_profile in ("sinusoidal", "reversing")
+            and self.load_amplitude > abs(self.load)
+        )
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+#: ISO 3408-3 lead-deviation tolerances by grade: (v_300p, v_2πp) [m] — travel variation within
+#: 300 mm and within one revolution (grade 7 has no v_2πp in the standard: engineering value).
+LEAD_GRADES = {1: (6e-6, 4e-6), 3: (12e-6, 6e-6), 5: (23e-6, 8e-6), 7: (52e-6, 10e-6)}
+
+
+@dataclass(frozen=True)
+class ManufacturingVariation:
+    """As-built geometry errors, drawn per run from its seed (standard deviations or amplitudes).
+
+    The papers give no tolerances. Defaults: a precision PRSM at ISO 3408-3 grade 5 (lead) with
+    ground threads and ISO 1328-1 grade-6-class gears; :meth:`grade` gives the lead figures of
+    other grades. They make the rollers share load unequally, break the perfect mesh-phase
+    cancellation, and excite the threads along the screw, so steady running vibrates as on real
+    hardware (docs/validation.md, excitation along the screw).
+
+    Parameters
+    ----------
+    pitch_error : float [m]
+        Axial position error of each roller's thread against screw and nut (σ).
+    position_error : float [rad]
+        Angular position error of each carrier pocket (σ).
+    eccentricity : float [m]
+        Radial position error of each pocket (σ).
+    mesh_stiffness_spread : float [-]
+        Relative scatter of each roller's gear mesh stiffness (σ).
+    transmission_error : float [m]
+        Static transmission-error offset of each roller gear along the line of action (σ).
+    lead_error_cumulative : float [m]
+        ISO 3408-3 v_300p: screw travel deviation accumulated over 300 mm; the run's lead
+        deviation is drawn as N(0, (v_300p/2)²) per 300 mm (grade 5: 23 µm).
+    lead_error_periodic : float [m]
+        ISO 3408-3 v_2πp: peak-to-peak travel variation within one screw revolution (grade 5:
+        8 µm), split over the 1st–3rd harmonics of the screw angle, random phases.
+    screw_runout : float [m]
+        Radial runout of the screw thread about the bearing axis (1st harmonic).
+    roller_runout : float [m]
+        Radial runout of each roller's thread about its spin axis (amplitude scale per roller).
+    gear_pitch_error : float [m]
+        Cumulative pitch deviation F_p of the ring gear (once per turn of a roller around it).
+    gear_profile_error : float [m]
+        Profile form deviation f_fα: transmission-error harmonics 1 and 2 of the mesh.
+    flank_waviness : float [m]
+        RMS waviness of the screw and nut flanks along the contact path, wavelengths 0.3–3 mm
+        (shorter waves are averaged out by the contact ellipse), 6 components per flank.
+    """
+
+    pitch_error: float = 2e-6
+    position_error: float = math.radians(0.02)
+    eccentricity: float = 2e-6
+    mesh_stiffness_spread: float = 0.03
+    transmission_error: float = 1e-6
+    lead_error_cumulative: float = LEAD_GRADES[5][0]
+    lead_error_periodic: float = LEAD_GRADES[5][1]
+    screw_runout: float = 5e-6
+    roller_runout: float = 2e-6
+    gear_pitch_error: float = 11e-6
+    gear_profile_error: float = 5e-6
+    flank_waviness: float = 0.25e-6
+
+    def __post_init__(self):
+        for name, high in (
+            ("pitch_error", 1e-4),
+            ("position_error", 0.05),
+            ("eccentricity", 1e-4),
+            ("mesh_stiffness_spread", 0.5),
+            ("transmission_error", 1e-4),
+            ("lead_error_cumulative", 1e-3),
+            ("lead_error_periodic", 1e-4),
+            ("screw_runout", 1e-4),
+            ("roller_runout", 1e-4),
+            ("gear_pitch_error", 1e-4),
+            ("gear_profile_error", 1e-4),
+            ("flank_waviness", 1e-5),
+        ):
+            require_range(f"variation.{name}", getattr(self, name), 0.0, high)
+
+    @classmethod
+    def ideal(cls) -> ManufacturingVariation:
+        """No scatter and no geometric error: every roller identical and exactly placed."""
+        return cls(**{f.name: 0.0 for f in fields(cls)})
+
+    @classmethod
+    def grade(cls, grade: int, **overrides) -> ManufacturingVariation:
+        """Lead errors of ISO 3408-3 tolerance grade 1, 3, 5 or 7; other fields as given."""
+        require(
+            grade in LEAD_GRADES, "variation.grade", grade, f"must be one of {sorted(LEAD_GRADES)}"
+        )
+        v_300p, v_2pi = LEAD_GRADES[grade]
+        return cls(**{"lead_error_cumulative": v_300p, "lead_error_periodic": v_2pi, **overrides})
+
+    @property
+    def is_ideal(self) -> bool:
+        return not any(asdict(self).values())
+
+    def as_dict(self) -> dict:
+        return asdict(self)

@@ -1,0 +1,397 @@
+"""matplotlib figures: run time traces and spectra with the characteristic frequencies marked."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from prsm_health.core.channels import UNITS
+from prsm_health.core.run import Run
+from prsm_health.signals.spectra import amplitude_spectrum
+
+
+def plot_run(
+    run: Run, path: str | Path, mesh_frequency: float | None = None, harmonics: int = 5
+) -> Path:
+    """Time traces and spectra of a run's nut accelerations and torques, saved as PNG.
+
+    Parameters
+    ----------
+    run : Run
+    path : str or Path
+    mesh_frequency : float or None [Hz]
+        Marked with its harmonics on the spectra.
+    harmonics : int
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    channels = ["nut_axial_accel", "nut_tangential_accel", "nut_radial_x_accel", "drive_torque"]
+    channels = [c for c in channels if c in run.channels]
+    fig, axes = plt.subplots(len(channels), 2, figsize=(12, 2.4 * len(channels)), squeeze=False)
+    for row, name in enumerate(channels):
+        x = run.channels[name]
+        ax_t, ax_f = axes[row]
+        ax_t.plot(run.time, x, lw=0.6)
+        ax_t.set_ylabel(f"{name}\n[{UNITS[name]}]", fontsize=8)
+        ax_f.set_ylabel(f"amplitude\n[{UNITS[name]}]", fontsize=8)
+        f, a = amplitude_spectrum(x, run.sample_rate)
+        ax_f.semilogy(f[1:], np.maximum(a[1:], 1e-12), lw=0.6)
+        top = min(run.sample_rate / 2, 8 * (mesh_frequency or 500.0))
+        ax_f.set_xlim(0, top)
+        if mesh_frequency:
+            for k in range(1, harmonics + 1):
+                if k * mesh_frequency < top:
+                    ax_f.axvline(k * mesh_frequency, color="tab:red", lw=0.8, ls="--", alpha=0.7)
+            ax_f.text(
+                mesh_frequency,
+                ax_f.get_ylim()[1],
+                f" f_mesh {mesh_frequency:.1f} Hz",
+                color="tab:red",
+                fontsize=7,
+                va="top",
+            )
+    axes[-1][0].set_xlabel("time [s]")
+    axes[-1][1].set_xlabel("frequency [Hz] (dashed: gear mesh harmonics)")
+    fig.suptitle(_run_title(run.labels), fontsize=10)
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def _run_title(labels: dict) -> str:
+    """Design, clearance, speed, load with its profile, seed — what a reader needs to place it."""
+    load = f"load {labels.get('axial_load', 0):g} N"
+    profile = labels.get("load_profile", "constant")
+    if profile != "constant":
+        load += f" {profile} ±{labels.get('load_amplitude', 0):g} N"
+    motion = labels.get("motion", "constant")
+    return (
+        f"{labels.get('design', '')}  clearance {1e6 * labels.get('clearance_screw', 0):.0f} µm  "
+        f"speed {labels.get('screw_speed', 0):g} rad/s"
+        + (f" ({motion})" if motion != "constant" else "")
+        + f"  {load}  seed {labels.get('seed', '')}"
+    )
+
+
+def plot_diagnosis(result, path: str | Path) -> Path:
+    """Per-window clearance estimates with their 90 % intervals and class probabilities, as PNG.
+
+    Each window is drawn over its own span (start to end), the last one included; the
+    recording's overall estimate and interval are the dashed line and the band behind them.
+
+    Parameters
+    ----------
+    result : Diagnosis
+        A recording diagnosis (:func:`prsm_health.diagnostics.diagnosis.diagnose`).
+    path : str or Path
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    def um(value):
+        return np.nan if value is None else 1e6 * value
+
+    wins = result.windows or [result]
+    spans = [(w.window["start"], w.window["end"]) if w.window else (0.0, 1.0) for w in wins]
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    overall = result.clearance
+    t0, t1 = spans[0][0], spans[-1][1]
+    a1.axhspan(
+        um(overall["lower"]),
+        um(overall["upper"]),
+        color="tab:gray",
+        alpha=0.15,
+        label="recording: 90 % interval",
+    )
+    a1.hlines(
+        um(overall["estimate"]),
+        t0,
+        t1,
+        colors="tab:gray",
+        linestyles="--",
+        label="recording: estimate",
+    )
+    for k, ((a, b), w) in enumerate(zip(spans, wins)):
+        c = w.clearance
+        a1.fill_between(
+            [a, b],
+            um(c["lower"]),
+            um(c["upper"]),
+            color="tab:blue",
+            alpha=0.3,
+            label="window: 90 % interval" if k == 0 else None,
+        )
+        a1.hlines(
+            um(c["estimate"]),
+            a,
+            b,
+            colors="tab:blue",
+            lw=2,
+            label="window: estimate" if k == 0 else None,
+        )
+    a1.set_ylabel("clearance [µm]")
+    a1.legend(fontsize=8, loc="best")
+    for i, cls in enumerate(result.class_probabilities):
+        for k, ((a, b), w) in enumerate(zip(spans, wins)):
+            probability = w.class_probabilities.get(cls, 0.0)
+            a2.hlines(probability, a, b, lw=2, colors=f"C{i}", label=cls if k == 0 else None)
+    a2.set_ylabel("class probability [-]")
+    a2.set_xlabel("recording time [s] (one segment per window)")
+    a2.set_ylim(-0.02, 1.02)
+    a2.legend(fontsize=8, loc="best")
+    a2.set_xlim(t0, t1 if t1 > t0 else t0 + 1.0)
+    fig.suptitle(
+        f"{result.fault_class}  clearance {um(overall['estimate']):.1f} µm "
+        f"[{um(overall['lower']):.1f}, {um(overall['upper']):.1f}]  "
+        f"{len(wins)} window(s)  model {result.model['name']}",
+        fontsize=10,
+    )
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_evaluation(report: dict, records, directory: str | Path) -> list[Path]:
+    """Figures of :func:`prsm_health.diagnostics.evaluation.evaluate_model` as PNGs in ``directory``:
+
+    - ``clearance.png``: predicted vs true clearance with the 90 % intervals (grey where the
+      diagnosis called the clearance not observable);
+    - ``calibration.png``: reliability of the class probabilities (top probability in bins vs
+      the share of those runs whose class was right), runs given a class only;
+    - ``confusion.png``: the confusion matrix, ``cannot_tell`` as its own column.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    if "clearance" in report:
+        fig, ax = plt.subplots(figsize=(6, 6))
+        y = 1e6 * records["clearance"].to_numpy(float)
+        est = 1e6 * records["estimate"].to_numpy(float)
+        lo, hi = 1e6 * records["lower"].to_numpy(float), 1e6 * records["upper"].to_numpy(float)
+        seen = records["clearance_observable"].to_numpy(bool)
+        for mask, colour, label in ((seen, "tab:blue", "observable"), (~seen, "0.6", "not")):
+            if mask.any():
+                ax.errorbar(
+                    y[mask],
+                    est[mask],
+                    yerr=[est[mask] - lo[mask], hi[mask] - est[mask]],
+                    fmt="o",
+                    ms=3,
+                    color=colour,
+                    ecolor=colour,
+                    alpha=0.5,
+                    label=f"{label} (90 % interval)",
+                )
+        top = float(np.nanmax(np.concatenate([y, hi]))) if len(y) else 1.0
+        ax.plot([0, top], [0, top], "k--", lw=1, label="ideal")
+        c = report["clearance"]
+        ax.set_title(
+            f"MAE {_um_text(c['mae'])} µm, coverage {_fraction_text(c['coverage'])} (n = {c['n']})"
+        )
+        ax.set_xlabel("true clearance [µm]")
+        ax.set_ylabel("estimated clearance [µm]")
+        ax.legend(loc="upper left")
+        written.append(_save(fig, out / "clearance.png"))
+    if "fault" in report:
+        told = records[records["predicted_class"] != "cannot_tell"]
+        fig, ax = plt.subplots(figsize=(6, 5))
+        edges = np.linspace(0.0, 1.0, 11)
+        right = (told["predicted_class"] == told["fault_class"]).to_numpy(float)
+        conf = told["top_probability"].to_numpy(float)
+        which = np.clip(np.digitize(conf, edges[1:-1]), 0, 9)
+        centres = [conf[which == b].mean() for b in range(10) if np.any(which == b)]
+        shares = [right[which == b].mean() for b in range(10) if np.any(which == b)]
+        ax.plot([0, 1], [0, 1], "k--", lw=1, label="perfectly calibrated")
+        ax.plot(centres, shares, "o-", label="model")
+        ax.set_xlabel("top class probability")
+        ax.set_ylabel("share correct")
+        ax.set_title(f"class calibration ({len(told)} runs given a class)")
+        ax.legend(loc="upper left")
+        written.append(_save(fig, out / "calibration.png"))
+        cm = report["fault"]["confusion"]
+        matrix = np.asarray(cm["matrix"], float)
+        fig, ax = plt.subplots(
+            figsize=(1.0 + 0.8 * len(cm["predicted"]), 1.0 + 0.7 * len(cm["true"]))
+        )
+        ax.imshow(matrix, cmap="Blues")
+        for i in range(matrix.shape[0]):
+            for j in range(matrix.shape[1]):
+                ax.text(j, i, int(matrix[i, j]), ha="center", va="center", fontsize=8)
+        ax.set_xticks(range(len(cm["predicted"])), cm["predicted"], rotation=45, ha="right")
+        ax.set_yticks(range(len(cm["true"])), cm["true"])
+        ax.set_xlabel("predicted")
+        ax.set_ylabel("true")
+        f = report["fault"]
+        ax.set_title(
+            f"macro-F1 {f['macro_f1']:.2f} (given a class: {_fraction_text(f['macro_f1_told'])})"
+        )
+        written.append(_save(fig, out / "confusion.png"))
+    return written
+
+
+def _um_text(value) -> str:
+    return "–" if value is None else f"{1e6 * value:.2f}"
+
+
+def _fraction_text(value) -> str:
+    return "–" if value is None else f"{value:.2f}"
+
+
+def _save(fig, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def plot_fleet_lives(lives, path: str | Path, *, test_units=(), snapshots: int = 0) -> Path:
+    """Wear trajectories of a fleet (:func:`prsm_health.physics.life.fleet_lives`): mean thread
+    half-clearance, screw and nut sides, and lubricant degradation over operating hours, with
+    the failure threshold and the snapshot ages; saved as PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax_b, ax_s, ax_d) = plt.subplots(1, 3, figsize=(15, 4.2))
+    test_units = set(test_units)
+    for unit in lives:
+        ages = np.linspace(0.0, unit.failure_age, 200)
+        screw, nut = unit.clearances(ages)
+        color = "tab:red" if unit.unit_id in test_units else "tab:blue"
+        ax_b.plot(ages, 0.5 * (screw + nut) * 1e6, color=color, lw=0.9, alpha=0.8)
+        if snapshots:
+            at = unit.snapshot_ages(snapshots)
+            ax_b.plot(at, unit.clearance(at) * 1e6, ".", color=color, ms=2.5)
+        ax_s.plot(ages, screw * 1e6, color="tab:purple", lw=0.7, alpha=0.6)
+        ax_s.plot(ages, nut * 1e6, color="tab:green", lw=0.7, alpha=0.6)
+        ax_d.plot(ages, unit.degradation(ages), color=color, lw=0.8, alpha=0.7)
+        if unit.failure_mode == "spall":  # failed by its spall before the wear limit
+            ax_b.plot(unit.failure_age, float(unit.clearance(unit.failure_age)) * 1e6, "kx")
+    threshold = lives[0].failure_clearance * 1e6
+    ax_b.axhline(threshold, color="k", ls="--", lw=0.8)
+    ax_b.set_title(
+        f"mean thread half-clearance (blue: train, red: test units; failure at {threshold:g} µm)",
+        fontsize=9,
+    )
+    ax_s.set_title("screw side (purple) and nut side (green)", fontsize=9)
+    ax_d.set_title("lubricant degradation (additives used up at 1)", fontsize=9)
+    for ax, label in ((ax_b, "µm"), (ax_s, "µm"), (ax_d, "-")):
+        ax.set_xlabel("age [operating hours]")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return _save(fig, Path(path))
+
+
+def plot_prognostics(histories, predictions, model, directory, *, alpha: float = 0.2) -> list[Path]:
+    """Figures of a prognostics evaluation (tools/release/train_prognostics_model.py): each held-out
+    unit's predicted RUL against its true RUL with the α cone, and its diagnosed health
+    indicator against the true clearance; saved as PNG in ``directory``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(directory)
+    units = sorted(int(u) for u in predictions["unit_id"].unique())
+    cols = min(3, len(units))
+    rows = -(-len(units) // cols)
+    written = []
+
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.4 * rows), squeeze=False)
+    for ax, unit in zip(axes.flat, units):
+        mine = predictions[predictions["unit_id"] == unit]
+        deg = mine[mine["method"] == "degradation"]
+        sim = mine[mine["method"] == "similarity"]
+        ax.plot(deg["age_hours"], deg["true_rul"], "k-", lw=1, label="true RUL")
+        ax.fill_between(
+            deg["age_hours"],
+            (1 - alpha) * deg["true_rul"],
+            (1 + alpha) * deg["true_rul"],
+            color="0.85",
+            label=f"±{alpha:g}·true (α cone)",
+        )
+        ax.fill_between(
+            deg["age_hours"], deg["lower"], deg["upper"], color="tab:blue", alpha=0.25, lw=0
+        )
+        ax.plot(
+            deg["age_hours"],
+            deg["estimate"],
+            "o-",
+            color="tab:blue",
+            ms=2.5,
+            lw=1,
+            label="degradation (90 % interval)",
+        )
+        ax.plot(
+            sim["age_hours"],
+            sim["estimate"],
+            "s--",
+            color="tab:orange",
+            ms=2,
+            lw=0.8,
+            label="similarity",
+        )
+        life = float(deg["age_hours"].max() + deg["true_rul"].min())
+        ax.axvline(0.5 * life, color="0.5", ls=":", lw=0.8)
+        ax.set_title(f"unit {unit} (life {life:.0f} h)", fontsize=9)
+        ax.set_xlabel("age [h]")
+        ax.set_ylabel("RUL [h]")
+        ax.set_ylim(0, 1.6 * float(deg["true_rul"].max()))
+        ax.grid(alpha=0.3)
+    axes.flat[0].legend(fontsize=6.5, loc="upper right")
+    for ax in list(axes.flat)[len(units) :]:
+        ax.axis("off")
+    written.append(_save(fig, out / "prognostics_rul.png"))
+
+    fig, axes = plt.subplots(rows, cols, figsize=(4.6 * cols, 3.2 * rows), squeeze=False)
+    for ax, unit in zip(axes.flat, units):
+        h = histories[histories["unit_id"] == unit]
+        ax.errorbar(
+            h["age_hours"],
+            h["clearance"] * 1e6,
+            yerr=[
+                (h["clearance"] - h["clearance_lower"]) * 1e6,
+                (h["clearance_upper"] - h["clearance"]) * 1e6,
+            ],
+            fmt=".",
+            ms=3,
+            lw=0.6,
+            color="tab:blue",
+            label="diagnosed (90 % interval)",
+        )
+        ax.plot(h["age_hours"], h["clearance_mean_true"] * 1e6, "k-", lw=1, label="true (mean)")
+        ax.axhline(
+            model.threshold * 1e6,
+            color="tab:red",
+            ls="--",
+            lw=0.8,
+            label="model threshold (diagnosed)",
+        )
+        ax.set_title(f"unit {unit}", fontsize=9)
+        ax.set_xlabel("age [h]")
+        ax.set_ylabel("clearance [µm]")
+        ax.grid(alpha=0.3)
+    axes.flat[0].legend(fontsize=6.5, loc="upper left")
+    for ax in list(axes.flat)[len(units) :]:
+        ax.axis("off")
+    written.append(_save(fig, out / "prognostics_indicator.png"))
+    return written

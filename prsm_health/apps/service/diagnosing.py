@@ -1,0 +1,395 @@
+"""The work done in worker threads or diagnosis processes: a request body (JSON, or a binary
+recording decoded by :mod:`prsm_health.io`) or an upload → a :class:`~prsm_health.core.run.Run` →
+the library's diagnosis → the encoded answer and its history rows (:class:`Answer`). The
+service's calls into :mod:`prsm_health.diagnostics.diagnosis` and :mod:`prsm_health.io` are here; recording
+checks are :meth:`Run.validate <prsm_health.core.run.Run.validate>`'s.
+
+Everything that crosses to and from a diagnosis process is plain data: the request body as
+bytes (decoded in the process: cheaper to send than decoded arrays), and back the answer's
+JSON bytes and the history rows (built there too, so the server process never encodes a
+diagnosis).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import re
+import threading
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from prsm_health.actuator.design import PRESETS
+from prsm_health.core.channels import CHANNEL_NAMES
+from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
+from prsm_health.core.jsonable import json_ready
+from prsm_health.core.run import MIN_SAMPLES, Run
+from prsm_health.diagnostics.diagnosis import diagnose, split_windows
+from prsm_health.io import read_recording, read_recording_bytes
+from prsm_health.signals.envelope_analysis import window_spectra
+
+from .history import history_rows, spectra_row, utc_now
+from .limits import MAX_ABS_VALUE, MAX_OPERATING_HOURS, MAX_TIME, ServiceLimits
+from .responses import HTTPError, encode
+from .schemas import ASSET_ID_PATTERN, DiagnoseRequest, parse_diagnose_request
+from .uploads import ReceivedUpload, precheck_recording, precheck_upload
+
+log = logging.getLogger("prsm_health.apps.service")
+
+# warnings.catch_warnings changes process-wide state: one upload is read under it at a time.
+_warnings_lock = threading.Lock()
+
+
+def diagnosis_json(run: Run, bundle) -> dict:
+    """The library's diagnosis of ``run`` as a JSON-ready dict (with ``windows``)."""
+    return json_ready(diagnose(run, bundle).to_json())
+
+
+def check_run(run: Run, limits: ServiceLimits, *, max_samples: int, what: str = "") -> None:
+    """The service's sample-rate range, then the library's recording checks (``RecordingError``:
+    422, ``RecordingTooLongError``: 413)."""
+    limits.check_sample_rate(run.sample_rate, what)
+    run.validate(
+        min_samples=MIN_SAMPLES,
+        max_samples=max_samples,
+        max_abs=MAX_ABS_VALUE,
+        max_time=MAX_TIME,
+        what=what or "recording",
+    )
+
+
+def warm_up(bundle) -> None:
+    """Diagnose recordings of noise: walks the whole diagnosis path (JIT compilation, caches),
+    so the first request does not pay for it. Not blank ones: constant channels skip compiled
+    kernels that a measured recording runs (8 s at the first request). Twice, two windows
+    each: with writable channels (JSON bodies, uploads) and with read-only ones (as an Arrow or
+    Parquet body decodes to: numba compiles its kernels again for read-only arrays)."""
+    rate = float(bundle.metadata.get("sample_rate") or 20000.0)
+    n = 2 * max(MIN_SAMPLES, int(round(bundle.window * rate)))
+    rng = np.random.default_rng(0)
+    noise = {name: rng.standard_normal(n) for name in CHANNEL_NAMES}
+    time = np.arange(n) / rate
+    diagnosis_json(Run(time, noise, rate), bundle)
+    for values in noise.values():
+        values.flags.writeable = False
+    diagnosis_json(Run(time, noise, rate), bundle)
+
+
+#: The channel whose spectra are stored for each asset's latest window.
+SPECTRA_CHANNEL = "nut_axial_accel"
+
+
+@dataclass(frozen=True)
+class Answer:
+    """What a diagnose request gives back to the route: the encoded JSON answer and, when the
+    request named an asset, its history rows (:func:`~.history.history_rows`) and the spectra
+    row of the recording's last window (:func:`~.history.spectra_row`; None when the recording
+    has no nut axial acceleration)."""
+
+    encoded: bytes
+    history: list | None = None
+    spectra: tuple | None = None
+
+
+def last_window_spectra(
+    run: Run, bundle, asset_id: str, windows: list[dict], **row
+) -> tuple | None:
+    """The spectra row of the recording's last window (:func:`split_windows` with the model's
+    window, as the diagnosis cut it): :func:`prsm_health.signals.envelope_analysis.window_spectra` of
+    its nut axial acceleration at its mean screw speed, with the model's design. None when the
+    recording has no nut axial acceleration. ``windows``: the diagnosis' window entries (the
+    last one's index and span are stored); ``row``: :func:`spectra_row`'s keywords."""
+    if SPECTRA_CHANNEL not in run.channels:
+        return None
+    last = split_windows(run, bundle.window)[0][-1]
+    speed = last.channels.get("screw_speed")
+    try:
+        spectra = window_spectra(
+            last.channels[SPECTRA_CHANNEL],
+            float(last.sample_rate),
+            bundle.design,
+            None if speed is None else float(np.mean(speed)),
+        )
+    except PRSMHealthError:  # the diagnosis stands; the asset keeps its previous spectra
+        log.warning("no spectra for asset %r", asset_id, exc_info=True)
+        return None
+    window = windows[-1].get("window") if windows else None
+    return spectra_row(asset_id, spectra, window=window, channel=SPECTRA_CHANNEL, **row)
+
+
+@dataclass(frozen=True)
+class BodyParams:
+    """The query parameters of a binary body (a JSON body carries them as fields)."""
+
+    asset_id: str | None = None
+    speed: float | None = None
+    load: float | None = None
+    design: str | None = None
+    operating_hours: float | None = None
+
+    FIELDS = ("asset_id", "speed", "load", "design", "operating_hours")
+
+    @classmethod
+    def from_query(cls, items: list[tuple[str, str]]) -> BodyParams:
+        """Parsed and checked query parameters; 422 naming the parameter otherwise."""
+        values: dict = {}
+        for name, text in items:
+            if name not in cls.FIELDS:
+                raise HTTPError(
+                    422,
+                    f"unknown query parameter {name!r}; a binary body takes "
+                    f"{', '.join(cls.FIELDS)}",
+                )
+            if name in values:
+                raise HTTPError(422, f"query parameter {name!r} given twice")
+            if name in ("speed", "load", "operating_hours"):
+                try:
+                    number = float(text)
+                except ValueError:
+                    number = math.nan
+                if not math.isfinite(number):
+                    raise HTTPError(422, f"{name} = {text[:40]!r}: a finite number expected")
+                if name == "operating_hours" and not 0 <= number <= MAX_OPERATING_HOURS:
+                    raise HTTPError(
+                        422,
+                        f"operating_hours = {text[:40]!r}: hours in [0, {MAX_OPERATING_HOURS:g}] "
+                        "expected",
+                    )
+                values[name] = number
+            elif name == "asset_id":
+                if not re.fullmatch(ASSET_ID_PATTERN, text):
+                    raise HTTPError(422, f"asset_id {text[:140]!r} must match {ASSET_ID_PATTERN}")
+                values[name] = text
+            else:
+                if text not in PRESETS:
+                    raise HTTPError(
+                        422, f"design = {text[:40]!r}: one of {', '.join(sorted(PRESETS))}"
+                    )
+                values[name] = text
+        return cls(**values)
+
+
+def check_design(design: str | None, bundle) -> None:
+    if design is not None and design != bundle.design_name:
+        raise HTTPError(
+            422,
+            f"design = {design!r}: model {bundle.name!r} was trained on design "
+            f"{bundle.design_name!r}; load a model for {design!r} (prsm-health serve --model)",
+        )
+
+
+def run_from_request(req: DiagnoseRequest, bundle) -> Run:
+    """The recording a validated request describes (channels of equal length, the model's
+    design); the nominal speed and load become labels."""
+    given = {name: getattr(req.channels, name) for name in CHANNEL_NAMES}
+    channels = {
+        name: np.asarray(values, dtype=float)
+        for name, values in given.items()
+        if values is not None
+    }
+    if not channels:
+        raise HTTPError(
+            422, f"channels: give at least one contract channel ({', '.join(CHANNEL_NAMES)})"
+        )
+    lengths = {name: len(v) for name, v in channels.items()}
+    if len(set(lengths.values())) > 1:
+        described = ", ".join(f"{k} {v}" for k, v in lengths.items())
+        raise HTTPError(422, f"channels must have equal lengths; got {described}")
+    check_design(req.design, bundle)
+    n = next(iter(lengths.values()))
+    rate = float(req.sample_rate)  # range checked by the request's validation
+    labels = {"design": bundle.design_name}
+    if req.speed is not None:
+        labels["screw_speed"] = float(req.speed)
+    if req.load is not None:
+        labels["axial_load"] = float(req.load)
+    return Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
+
+
+def _too_long(n: int, rate: float, limits: ServiceLimits) -> HTTPError:
+    return HTTPError(
+        413,
+        f"recording too long: {n} samples = {n / rate:.6g} s at {rate:g} Hz; /v1/diagnose "
+        f"accepts at most {limits.max_window_seconds:g} s per request (upload longer "
+        "recordings to /v1/diagnose/file)",
+    )
+
+
+def read_body(body: bytes, fmt: str, limits: ServiceLimits) -> tuple[Run, list[str]]:
+    """A binary body of ``POST /v1/diagnose`` (``fmt``: ``arrow``, ``parquet``, ``mcap``) as
+    a measured recording, and the reader's notes. What the body declares (rows, decompressed
+    size) is checked against the limits before it is decoded."""
+    name = f"{fmt} body"
+    if not body:
+        raise HTTPError(400, f"empty request body: send the recording ({fmt})")
+    precheck_recording(
+        body,
+        fmt,
+        max_samples=limits.max_body_samples,
+        max_decoded_bytes=limits.max_body_decoded_bytes,
+        samples_hint=(
+            f" by /v1/diagnose ({limits.max_window_seconds:g} s at "
+            f"{limits.max_sample_rate:g} Hz; upload longer recordings to /v1/diagnose/file)"
+        ),
+        decoded_hint=" (max_body_decoded_bytes)",
+        name=name,
+    )
+    with _warnings_lock, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TruncatedRecordingWarning)
+        try:
+            run = read_recording_bytes(body, fmt, name)
+        except PRSMHealthError as exc:
+            raise HTTPError(422, str(exc)) from None
+        except (ValueError, TypeError, OverflowError, KeyError, IndexError) as exc:
+            log.warning("unreadable %s", name, exc_info=True)
+            raise HTTPError(
+                422, f"{name}: not a readable recording ({type(exc).__name__}: {exc})"
+            ) from None
+    notes = [str(w.message) for w in caught if issubclass(w.category, TruncatedRecordingWarning)]
+    return run.without_truth(), notes
+
+
+def diagnose_body(
+    bundle,
+    body: bytes,
+    fmt: str,
+    params: BodyParams | None,
+    limits: ServiceLimits,
+    received_at: str,
+) -> Answer:
+    """``POST /v1/diagnose``: a JSON body (``fmt`` ``"json"``, fields in the body) or a binary
+    recording (``params`` from the query) → the Diagnosis contract (``windows`` only when the
+    recording spans more than one model window) and, with an ``asset_id``, its history row."""
+    notes: list[str] = []
+    if fmt == "json":
+        req = parse_diagnose_request(body, limits)
+        run = run_from_request(req, bundle)
+        params = BodyParams(req.asset_id, req.speed, req.load, req.design, req.operating_hours)
+    else:
+        params = params or BodyParams()
+        check_design(params.design, bundle)
+        run, notes = read_body(body, fmt, limits)
+        labels = dict(run.labels)
+        if params.design is not None:
+            labels["design"] = params.design
+        if params.speed is not None:
+            labels["screw_speed"] = params.speed
+        if params.load is not None:
+            labels["axial_load"] = params.load
+        run = Run(run.time, run.channels, run.sample_rate, labels, run.scenario)
+        limits.check_sample_rate(run.sample_rate, _what(fmt))  # a JSON body's is validated
+    max_samples = limits.max_json_samples(run.sample_rate)
+    if len(run) > max_samples:
+        raise _too_long(len(run), run.sample_rate, limits)
+    check_run(run, limits, max_samples=max(max_samples, MIN_SAMPLES), what=_what(fmt))
+    result = diagnosis_json(run, bundle)
+    windows = result.get("windows", [])
+    if len(windows) <= 1:
+        result.pop("windows", None)
+    if notes:
+        result["warnings"] = [*notes, *result.get("warnings", [])]
+    history = spectra = None
+    if params.asset_id is not None:
+        history = history_rows(
+            params.asset_id,
+            [result],
+            received_at=received_at,
+            source=fmt,
+            speed=params.speed,
+            load=params.load,
+            operating_hours=params.operating_hours,
+        )
+        spectra = last_window_spectra(
+            run,
+            bundle,
+            params.asset_id,
+            windows,
+            received_at=received_at,
+            source=fmt,
+            operating_hours=params.operating_hours,
+        )
+    return Answer(encode(result), history, spectra)
+
+
+def _what(fmt: str) -> str:
+    return "" if fmt == "json" else f"{fmt} body"
+
+
+# ----------------------------------------------------------------------------- upload
+def read_upload(upload: ReceivedUpload, limits: ServiceLimits) -> tuple[Run, list[str]]:
+    """The uploaded recording and the reader's notes (truncated recording); messages name the
+    client's file name, never the server path."""
+
+    def hide_path(text: str) -> str:
+        return text.replace(str(upload.path), upload.filename or "upload")
+
+    if upload.path is None or upload.file_bytes == 0:
+        raise HTTPError(422, "no recording: send the file in the multipart field 'file'")
+    precheck_upload(upload.path, upload.suffix, limits)
+    with _warnings_lock, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", TruncatedRecordingWarning)
+        try:
+            run = read_recording(upload.path)
+        except PRSMHealthError as exc:
+            raise HTTPError(422, hide_path(str(exc))) from None
+        except (ValueError, TypeError, OverflowError, KeyError, IndexError) as exc:
+            # Decoding client bytes: the readers let a few of these through for files
+            # with non-numeric channel columns; the file is at fault, not the server.
+            log.warning("unreadable upload %r", upload.filename, exc_info=True)
+            raise HTTPError(
+                422,
+                f"{upload.filename}: not a readable recording "
+                f"({type(exc).__name__}: {hide_path(str(exc))})",
+            ) from None
+    notes = [
+        hide_path(str(w.message))
+        for w in caught
+        if issubclass(w.category, TruncatedRecordingWarning)
+    ]
+    # The service diagnoses measurements: a simulated file's truth is neither checked nor used.
+    return run.without_truth(), notes
+
+
+def diagnose_upload(
+    bundle,
+    upload: ReceivedUpload,
+    limits: ServiceLimits,
+    asset_id: str | None = None,
+    received_at: str | None = None,
+) -> Answer:
+    """``POST /v1/diagnose/file``: the whole-recording diagnosis, the per-window ones, what
+    was read and the reader's notes; with an ``asset_id``, the windows' history rows."""
+    run, notes = read_upload(upload, limits)
+    check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
+    result = diagnosis_json(run, bundle)
+    per_window = result.pop("windows")
+    recording = {
+        "filename": upload.filename,
+        "samples": len(run),
+        "sample_rate": float(run.sample_rate),
+        "duration": float(len(run) / run.sample_rate),
+        "channels": [c for c in CHANNEL_NAMES if c in run.channels],
+    }
+    answer = {"diagnosis": result, "windows": per_window, "recording": recording, "warnings": notes}
+    history = spectra = None
+    if asset_id is not None:
+        received_at = received_at or utc_now()
+        history = history_rows(
+            asset_id,
+            per_window,
+            received_at=received_at,
+            source="file",
+            filename=upload.filename,
+        )
+        spectra = last_window_spectra(
+            run,
+            bundle,
+            asset_id,
+            per_window,
+            received_at=received_at,
+            source="file",
+            filename=upload.filename,
+        )
+    return Answer(encode(answer), history, spectra)

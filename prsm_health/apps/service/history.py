@@ -1,0 +1,513 @@
+"""Diagnoses per asset over time: :class:`HistoryStore` (embedded SQLite, WAL journal), its
+default location (:func:`default_db_path`), its time format (:func:`utc_now`,
+:func:`parse_time`), the table a prognosis is made from (:func:`prognosis_history`) and each
+asset's latest window spectra (:func:`spectra_row`)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import sqlite3
+import threading
+from datetime import datetime, timezone
+from pathlib import Path
+
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.jsonable import dumps, json_ready
+
+#: Environment variable overriding the default history database path.
+DB_ENV = "PRSM_HEALTH_DB"
+
+
+def default_db_path() -> Path:
+    """``$PRSM_HEALTH_DB``, else ``$XDG_DATA_HOME/prsm-health/history.sqlite``."""
+    if os.environ.get(DB_ENV):
+        return Path(os.environ[DB_ENV])
+    base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+    return Path(base) / "prsm-health" / "history.sqlite"
+
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS diagnoses (
+    id                  INTEGER PRIMARY KEY AUTOINCREMENT,
+    asset_id            TEXT    NOT NULL,
+    received_at         TEXT    NOT NULL,  -- server receive time, UTC ISO-8601 (microseconds)
+    source              TEXT    NOT NULL,  -- 'json', 'arrow', 'parquet', 'mcap' or 'file'
+    filename            TEXT,              -- uploaded file name (source 'file')
+    window_index        INTEGER,           -- per-window rows of an upload
+    window_start        REAL,              -- [s]
+    window_end          REAL,              -- [s]
+    speed               REAL,              -- nominal screw speed given by the client [rad/s]
+    load                REAL,              -- nominal axial load given by the client [N]
+    operating_hours     REAL,              -- asset's operating hours at the recording [h]
+    clearance_estimate  REAL,              -- [m]
+    clearance_lower     REAL,              -- [m]
+    clearance_upper     REAL,              -- [m]
+    fault_class         TEXT,
+    class_probabilities TEXT    NOT NULL,  -- JSON object
+    model_name          TEXT    NOT NULL,
+    model_version       TEXT    NOT NULL,
+    diagnosis           TEXT    NOT NULL   -- the full Diagnosis contract JSON
+);
+CREATE INDEX IF NOT EXISTS diagnoses_asset_time ON diagnoses (asset_id, received_at, id);
+CREATE TABLE IF NOT EXISTS spectra (
+    asset_id            TEXT    PRIMARY KEY,  -- one row per asset, replaced by each recording
+    received_at         TEXT    NOT NULL,     -- as the diagnosis it came with
+    source              TEXT    NOT NULL,
+    filename            TEXT,
+    window_index        INTEGER,              -- the recording's last window
+    window_start        REAL,                 -- [s]
+    window_end          REAL,                 -- [s]
+    operating_hours     REAL,                 -- [h]
+    channel             TEXT    NOT NULL,     -- 'nut_axial_accel'
+    spectra             TEXT    NOT NULL      -- JSON: prsm_health.signals.envelope_analysis.window_spectra
+);
+"""
+#: Version 1: the diagnoses table without ``operating_hours``; version 2 added it (a version 1
+#: database gets the column on open, its existing rows NULL); version 3 added the ``spectra``
+#: table (created on open: ``CREATE TABLE IF NOT EXISTS`` above).
+_SCHEMA_VERSION = 3
+
+
+def utc_now() -> str:
+    """Current UTC time as ISO-8601 with microseconds (fixed width, so it sorts as text)."""
+    return datetime.now(timezone.utc).isoformat(timespec="microseconds")
+
+
+def parse_time(text: str, field: str = "since") -> str:
+    """An ISO-8601 time as the store's UTC text form (a time without zone is UTC)."""
+    try:
+        value = datetime.fromisoformat(text.strip())
+    except (ValueError, AttributeError):
+        raise PRSMHealthError(
+            f"{field} = {text!r} is not an ISO-8601 time (e.g. 2024-05-01T12:00:00Z)"
+        ) from None
+    if value.tzinfo is None:
+        value = value.replace(tzinfo=timezone.utc)
+    try:
+        return value.astimezone(timezone.utc).isoformat(timespec="microseconds")
+    except (OverflowError, ValueError):
+        raise PRSMHealthError(f"{field} = {text!r} is out of range") from None
+
+
+class HistoryStore:
+    """Diagnoses per asset over time, in an embedded SQLite database.
+
+    The database uses the WAL journal (readers never block the writer, a crash never leaves a
+    half-written row) with ``synchronous=FULL`` (a committed diagnosis survives power loss);
+    every :meth:`add` is one transaction. One connection is shared by the server's threads
+    behind a lock; several processes may open the same file (SQLite locks it, writers wait up
+    to ``timeout`` seconds).
+
+    Parameters
+    ----------
+    path : str or Path
+        Database file; its directory must exist (``":memory:"`` for a throw-away store).
+    timeout : float [s]
+        How long a write waits for another process's lock.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, timeout: float = 30.0):
+        self.path = str(path)
+        if self.path != ":memory:":
+            parent = Path(self.path).expanduser().resolve().parent
+            if not parent.is_dir():
+                raise PRSMHealthError(f"{self.path}: directory {parent} does not exist")
+            if Path(self.path).is_dir():
+                raise PRSMHealthError(f"{self.path}: is a directory, not a database file")
+        self._lock = threading.Lock()
+        try:
+            self._conn = sqlite3.connect(
+                self.path, timeout=timeout, isolation_level=None, check_same_thread=False
+            )
+        except sqlite3.Error as exc:
+            raise PRSMHealthError(
+                f"{self.path}: cannot open the history database ({exc})"
+            ) from None
+        try:
+            self._conn.execute("PRAGMA journal_mode=WAL")
+            self._conn.execute("PRAGMA synchronous=FULL")
+            with self._transaction():
+                version = self._conn.execute("PRAGMA user_version").fetchone()[0]
+                if version > _SCHEMA_VERSION:
+                    raise PRSMHealthError(
+                        f"{self.path}: history schema version {version} is newer than this "
+                        f"prsm_health ({_SCHEMA_VERSION}); upgrade prsm_health"
+                    )
+                for statement in _SCHEMA.split(";"):
+                    if statement.strip():
+                        self._conn.execute(statement)
+                self._migrate()
+                self._conn.execute(f"PRAGMA user_version = {_SCHEMA_VERSION}")
+        except BaseException as exc:
+            self._conn.close()
+            if isinstance(exc, sqlite3.DatabaseError):
+                raise PRSMHealthError(
+                    f"{self.path}: not a usable history database ({exc})"
+                ) from None
+            raise
+
+    def _migrate(self) -> None:
+        """Bring older tables up to the current schema (inside the opening transaction, so
+        two processes opening the same file migrate it once): version 1 → 2 adds the nullable
+        ``operating_hours`` column; version 2 → 3 adds the ``spectra`` table, which the schema's
+        ``CREATE TABLE IF NOT EXISTS`` has created just before (empty: spectra come with the
+        next recordings)."""
+        columns = {row[1] for row in self._conn.execute("PRAGMA table_info(diagnoses)")}
+        if "operating_hours" not in columns:
+            self._conn.execute("ALTER TABLE diagnoses ADD COLUMN operating_hours REAL")
+
+    @contextlib.contextmanager
+    def _transaction(self):
+        self._conn.execute("BEGIN IMMEDIATE")
+        try:
+            yield
+        except BaseException:
+            self._conn.execute("ROLLBACK")
+            raise
+        else:
+            self._conn.execute("COMMIT")
+
+    def add(
+        self,
+        asset_id: str,
+        diagnoses: list[dict],
+        *,
+        received_at: str | None = None,
+        source: str = "json",
+        filename: str | None = None,
+        speed: float | None = None,
+        load: float | None = None,
+        operating_hours: float | None = None,
+    ) -> list[int]:
+        """Store diagnoses (contract dicts; a ``window`` key places one in its recording) in
+        one transaction; returns their ids."""
+        return self.add_rows(
+            history_rows(
+                asset_id,
+                diagnoses,
+                received_at=received_at,
+                source=source,
+                filename=filename,
+                speed=speed,
+                load=load,
+                operating_hours=operating_hours,
+            )
+        )
+
+    def add_rows(self, rows: list[tuple], spectra: tuple | None = None) -> list[int]:
+        """Store rows made by :func:`history_rows` (possibly in another process) and, when
+        given, the asset's latest spectra (a :func:`spectra_row`, replacing the asset's
+        previous one) in one transaction; returns the rows' ids."""
+        ids = []
+        with self._lock, self._transaction():
+            if spectra is not None:
+                self._conn.execute(
+                    "INSERT OR REPLACE INTO spectra (asset_id, received_at, source, filename,"
+                    " window_index, window_start, window_end, operating_hours, channel, spectra)"
+                    " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    spectra,
+                )
+            for row in rows:
+                cur = self._conn.execute(
+                    "INSERT INTO diagnoses (asset_id, received_at, source, filename, window_index,"
+                    " window_start, window_end, speed, load, operating_hours, clearance_estimate,"
+                    " clearance_lower, clearance_upper, fault_class, class_probabilities,"
+                    " model_name, model_version, diagnosis)"
+                    " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                    row,
+                )
+                ids.append(cur.lastrowid)
+        return ids
+
+    def history(self, asset_id: str, *, since: str | None = None, limit: int = 100) -> dict:
+        """The most recent ``limit`` diagnoses of an asset at or after ``since`` (ISO-8601),
+        oldest first: ``{"asset_id", "count", "total", "truncated", "diagnoses": [...]}``."""
+        where, args = "asset_id = ?", [asset_id]
+        if since is not None:
+            where += " AND received_at >= ?"
+            args.append(parse_time(since))
+        with self._lock:
+            total = self._conn.execute(
+                f"SELECT COUNT(*) FROM diagnoses WHERE {where}", args
+            ).fetchone()[0]
+            rows = self._conn.execute(
+                "SELECT id, received_at, source, filename, window_index, window_start, window_end,"
+                f" speed, load, operating_hours, diagnosis FROM diagnoses WHERE {where}"
+                " ORDER BY received_at DESC, id DESC LIMIT ?",
+                [*args, int(limit)],
+            ).fetchall()
+        entries = []
+        for row in reversed(rows):
+            id_, received_at, source, filename, w_index, w_start, w_end, speed, load = row[:9]
+            hours, blob = row[9:]
+            entries.append(
+                {
+                    "id": id_,
+                    **_provenance(received_at, source, filename, w_index, w_start, w_end),
+                    "speed": speed,
+                    "load": load,
+                    "operating_hours": hours,
+                    "diagnosis": json.loads(blob),
+                }
+            )
+        return {
+            "asset_id": asset_id,
+            "count": len(entries),
+            "total": total,
+            "truncated": total > len(entries),
+            "diagnoses": entries,
+        }
+
+    def operating_history(self, asset_id: str) -> list[tuple]:
+        """The asset's diagnoses stored with operating hours, by operating hours, then by
+        receive time and id (the latest received last): rows ``(operating_hours,
+        clearance_estimate, clearance_lower, clearance_upper, fault_class, design)``, the
+        design being the diagnosing model's (``model.design`` of the stored diagnosis)."""
+        with self._lock:
+            return self._conn.execute(
+                "SELECT operating_hours, clearance_estimate, clearance_lower, clearance_upper,"
+                " fault_class, json_extract(diagnosis, '$.model.design') FROM diagnoses"
+                " WHERE asset_id = ? AND operating_hours IS NOT NULL"
+                " ORDER BY operating_hours, received_at, id",
+                (asset_id,),
+            ).fetchall()
+
+    def spectra(self, asset_id: str) -> dict | None:
+        """The asset's latest stored spectra (:func:`spectra_row`), or None."""
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT received_at, source, filename, window_index, window_start, window_end,"
+                " operating_hours, channel, spectra FROM spectra WHERE asset_id = ?",
+                (asset_id,),
+            ).fetchone()
+        if row is None:
+            return None
+        received_at, source, filename, w_index, w_start, w_end, hours, channel, blob = row
+        return {
+            "asset_id": asset_id,
+            **_provenance(received_at, source, filename, w_index, w_start, w_end),
+            "operating_hours": hours,
+            "channel": channel,
+            **json.loads(blob),
+        }
+
+    def assets(self, *, limit: int = 100) -> dict:
+        """The ``limit`` most recently seen assets, most recent first, each as
+        :meth:`asset_summary` gives it: ``{"count", "total", "truncated", "assets": [...]}``."""
+        with self._lock:
+            total = self._conn.execute("SELECT COUNT(DISTINCT asset_id) FROM diagnoses").fetchone()[
+                0
+            ]
+            page = self._conn.execute(
+                "SELECT asset_id, COUNT(*), MIN(received_at), MAX(received_at) FROM diagnoses"
+                " GROUP BY asset_id ORDER BY MAX(received_at) DESC, asset_id LIMIT ?",
+                (int(limit),),
+            ).fetchall()
+            summaries = [self._summary(*row) for row in page]
+        return {
+            "count": len(summaries),
+            "total": total,
+            "truncated": total > len(summaries),
+            "assets": summaries,
+        }
+
+    def asset_summary(self, asset_id: str) -> dict | None:
+        """One asset: ``asset_id``, ``diagnoses`` (how many are stored), ``with_operating_hours``
+        (how many of them have operating hours), ``operating_hours`` (the largest sent [h] or
+        None), ``first_received_at``, ``last_received_at``, ``latest`` (the latest stored
+        diagnosis in brief: receive time, source, file name, window, operating hours,
+        clearance, fault class, class probabilities, warnings, model) and
+        ``spectra_received_at`` (when its stored spectra came, or None); None when nothing
+        is stored for it."""
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT asset_id, COUNT(*), MIN(received_at), MAX(received_at) FROM diagnoses"
+                " WHERE asset_id = ? GROUP BY asset_id",
+                (asset_id,),
+            ).fetchone()
+            return None if row is None else self._summary(*row)
+
+    def _summary(self, asset_id: str, count: int, first: str, last: str) -> dict:
+        # under self._lock
+        latest = self._conn.execute(
+            "SELECT received_at, source, filename, window_index, window_start, window_end,"
+            " operating_hours, clearance_estimate, clearance_lower, clearance_upper, fault_class,"
+            " class_probabilities, json_extract(diagnosis, '$.warnings'),"
+            " json_extract(diagnosis, '$.model') FROM diagnoses WHERE asset_id = ?"
+            " ORDER BY received_at DESC, id DESC LIMIT 1",
+            (asset_id,),
+        ).fetchone()
+        with_hours, max_hours = self._conn.execute(
+            "SELECT COUNT(operating_hours), MAX(operating_hours) FROM diagnoses WHERE asset_id = ?",
+            (asset_id,),
+        ).fetchone()
+        spectra = self._conn.execute(
+            "SELECT received_at FROM spectra WHERE asset_id = ?", (asset_id,)
+        ).fetchone()
+        received_at, source, filename, w_index, w_start, w_end, hours = latest[:7]
+        estimate, lower, upper, fault_class, probabilities, warnings, model = latest[7:]
+        return {
+            "asset_id": asset_id,
+            "diagnoses": count,
+            "with_operating_hours": with_hours,
+            "operating_hours": max_hours,
+            "first_received_at": first,
+            "last_received_at": last,
+            "latest": {
+                "received_at": received_at,
+                "source": source,
+                "filename": filename,
+                "window": None
+                if w_index is None
+                else {"index": w_index, "start": w_start, "end": w_end},
+                "operating_hours": hours,
+                "clearance": {"estimate": estimate, "lower": lower, "upper": upper},
+                "fault_class": fault_class,
+                "class_probabilities": json.loads(probabilities),
+                "warnings": json.loads(warnings) if warnings else [],
+                "model": json.loads(model) if model else None,
+            },
+            "spectra_received_at": None if spectra is None else spectra[0],
+        }
+
+    def has_asset(self, asset_id: str) -> bool:
+        with self._lock:
+            row = self._conn.execute(
+                "SELECT 1 FROM diagnoses WHERE asset_id = ? LIMIT 1", (asset_id,)
+            ).fetchone()
+        return row is not None
+
+    def close(self) -> None:
+        with self._lock:
+            self._conn.close()
+
+
+def _provenance(received_at, source, filename, w_index, w_start, w_end) -> dict:
+    """Where a stored row came from: when, which body kind and file, which window."""
+    return {
+        "received_at": received_at,
+        "source": source,
+        "filename": filename,
+        "window": None if w_index is None else {"index": w_index, "start": w_start, "end": w_end},
+    }
+
+
+def history_rows(
+    asset_id: str,
+    diagnoses: list[dict],
+    *,
+    received_at: str | None = None,
+    source: str = "json",
+    filename: str | None = None,
+    speed: float | None = None,
+    load: float | None = None,
+    operating_hours: float | None = None,
+) -> list[tuple]:
+    """The database rows of diagnoses (contract dicts; a ``window`` key places one in its
+    recording): plain tuples of numbers and text, JSON already encoded, for
+    :meth:`HistoryStore.add_rows`. The service builds them where the diagnosis ran."""
+    received_at = received_at or utc_now()
+    rows = []
+    for d in diagnoses:
+        c = d.get("clearance") or {}
+        w = d.get("window") or {}
+        model = d.get("model") or {}
+        rows.append(
+            (
+                asset_id,
+                received_at,
+                source,
+                filename,
+                w.get("index"),
+                w.get("start"),
+                w.get("end"),
+                speed,
+                load,
+                operating_hours,
+                c.get("estimate"),
+                c.get("lower"),
+                c.get("upper"),
+                d.get("fault_class"),
+                dumps(d.get("class_probabilities", {})),
+                str(model.get("name", "")),
+                str(model.get("version", "")),
+                dumps(d),
+            )
+        )
+    return rows
+
+
+def spectra_row(
+    asset_id: str,
+    spectra: dict,
+    *,
+    received_at: str,
+    source: str,
+    filename: str | None = None,
+    window: dict | None = None,
+    operating_hours: float | None = None,
+    channel: str = "nut_axial_accel",
+) -> tuple:
+    """The ``spectra`` row of an asset's latest window (``spectra``:
+    :func:`prsm_health.signals.envelope_analysis.window_spectra`, JSON encoded here) for
+    :meth:`HistoryStore.add_rows`."""
+    w = window or {}
+    # The spectra's thousands of plain floats go to json.dumps directly (json_ready would
+    # visit each); the line ratios, NaN where a line lies outside the band, become null.
+    small = {k: v for k, v in spectra.items() if k not in ("spectrum", "envelope")}
+    try:
+        text = json.dumps(
+            {**json_ready(small), "spectrum": spectra["spectrum"], "envelope": spectra["envelope"]},
+            separators=(",", ":"),
+            allow_nan=False,
+        )
+    except (ValueError, TypeError):  # a non-finite or non-plain value among them after all
+        text = dumps(spectra, compact=True)
+    return (
+        asset_id,
+        received_at,
+        source,
+        filename,
+        w.get("index"),
+        w.get("start"),
+        w.get("end"),
+        operating_hours,
+        channel,
+        text,
+    )
+
+
+def prognosis_history(rows: list[tuple]):
+    """The history table a prognosis is made from
+    (:func:`prsm_health.prognostics.rul.prognose`), from :meth:`HistoryStore.operating_history`
+    rows, and notes on the rows left out.
+
+    ``age_hours`` is the stored operating hours; ``clearance``, ``clearance_lower``,
+    ``clearance_upper`` [m] the stored estimate and 90 % interval; ``design`` the diagnosing
+    model's; ``fault_class``. Of several diagnoses at the same operating hours only the latest
+    received is kept (a repeated reading replaces the earlier one); diagnoses without a
+    clearance estimate or interval (a model without a clearance estimator) carry nothing to
+    predict from and are left out, with a note.
+
+    Returns
+    -------
+    (pandas.DataFrame, list of str)
+        The table, oldest first (operating hours strictly increasing), and the notes.
+    """
+    import pandas as pd
+
+    from prsm_health.prognostics import HISTORY_COLUMNS
+
+    columns = [*HISTORY_COLUMNS, "fault_class", "design"]
+    usable = [r for r in rows if None not in r[1:4]]
+    notes = []
+    if len(usable) < len(rows):
+        notes.append(
+            f"{len(rows) - len(usable)} stored diagnosis(es) with operating hours but without a "
+            "clearance estimate and interval were left out"
+        )
+    table = pd.DataFrame(usable, columns=columns)
+    table = table.drop_duplicates("age_hours", keep="last").reset_index(drop=True)
+    return table, notes

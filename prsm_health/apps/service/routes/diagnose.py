@@ -1,0 +1,219 @@
+"""``POST /v1/diagnose`` (a JSON body, or a recording as an Arrow IPC, Parquet or MCAP body)
+and ``POST /v1/diagnose/file`` (multipart upload): admit the request, run the diagnosis in the
+worker pool, store it in the asset's history. Bodies are decoded where the diagnosis runs."""
+
+import anyio
+from fastapi import APIRouter, Request
+
+from prsm_health.actuator.design import PRESETS
+
+from ..diagnosing import BodyParams, diagnose_body, diagnose_upload
+from ..history import utc_now
+from ..limits import MAX_OPERATING_HOURS
+from ..responses import HTTPError, json_response
+from ..schemas import (
+    ASSET_ID_PATTERN,
+    ERROR_RESPONSES,
+    OPERATING_HOURS_DESCRIPTION,
+    Diagnosis,
+    Error,
+    FileDiagnosis,
+)
+from ..uploads import multipart_boundary, receive_upload, upload_directory
+from .deps import Limits, Store, Workers
+
+router = APIRouter()
+
+#: Content types of ``POST /v1/diagnose`` → body format.
+BODY_TYPES = {
+    "application/json": "json",
+    "application/vnd.apache.arrow.stream": "arrow",
+    "application/vnd.apache.parquet": "parquet",
+    "application/x-parquet": "parquet",
+    "application/vnd.mcap": "mcap",
+    "application/x-mcap": "mcap",
+}
+_BINARY_DESCRIPTIONS = {
+    "arrow": "Arrow IPC stream: a `time` column [s] and contract channel columns (numbers), "
+    "as the single-run Parquet file; sample rate from the `prsm_health.sample_rate` schema "
+    "metadata, else 1/(median time step)",
+    "parquet": "single-run Parquet file (docs/formats.md)",
+    "mcap": "MCAP recording (docs/formats.md)",
+}
+_JSON_BODY = {
+    "parameters": [
+        {
+            "name": "asset_id",
+            "in": "query",
+            "required": False,
+            "description": "binary bodies only (a JSON body has the field): store the diagnosis "
+            "in this asset's history",
+            "schema": {"type": "string", "pattern": ASSET_ID_PATTERN},
+        },
+        {
+            "name": "speed",
+            "in": "query",
+            "required": False,
+            "description": "binary bodies only: nominal screw speed [rad/s] (stored)",
+            "schema": {"type": "number"},
+        },
+        {
+            "name": "load",
+            "in": "query",
+            "required": False,
+            "description": "binary bodies only: nominal axial load [N] (stored)",
+            "schema": {"type": "number"},
+        },
+        {
+            "name": "design",
+            "in": "query",
+            "required": False,
+            "description": "binary bodies only: design preset (must be the model's)",
+            "schema": {"type": "string", "enum": sorted(PRESETS)},
+        },
+        {
+            "name": "operating_hours",
+            "in": "query",
+            "required": False,
+            "description": f"binary bodies only: {OPERATING_HOURS_DESCRIPTION}",
+            "schema": {"type": "number", "minimum": 0, "maximum": MAX_OPERATING_HOURS},
+        },
+    ],
+    "requestBody": {
+        "required": True,
+        "content": {
+            "application/json": {"schema": {"$ref": "#/components/schemas/DiagnoseRequest"}},
+            **{
+                ctype: {
+                    "schema": {
+                        "type": "string",
+                        "format": "binary",
+                        "description": _BINARY_DESCRIPTIONS[fmt],
+                    }
+                }
+                for ctype, fmt in BODY_TYPES.items()
+                if fmt != "json"
+            },
+        },
+    },
+}
+_MULTIPART_BODY = {
+    "requestBody": {
+        "required": True,
+        "content": {
+            "multipart/form-data": {
+                "schema": {
+                    "type": "object",
+                    "required": ["file"],
+                    "properties": {
+                        "file": {
+                            "type": "string",
+                            "format": "binary",
+                            "description": "recording (.mcap or .parquet, by file name)",
+                        },
+                        "asset_id": {
+                            "type": "string",
+                            "pattern": ASSET_ID_PATTERN,
+                            "description": "store every window in this asset's history",
+                        },
+                    },
+                }
+            }
+        },
+    }
+}
+
+
+def body_format(request: Request) -> str:
+    """The format of a ``POST /v1/diagnose`` body from its Content-Type; 415 otherwise."""
+    ctype = request.headers.get("content-type", "")
+    fmt = BODY_TYPES.get(ctype.split(";")[0].strip().lower())
+    if fmt is None:
+        raise HTTPError(
+            415,
+            f"Content-Type {ctype or 'missing'!r} is not accepted: send application/json, "
+            "application/vnd.apache.arrow.stream, application/vnd.apache.parquet or "
+            "application/vnd.mcap (multipart uploads go to /v1/diagnose/file)",
+        )
+    return fmt
+
+
+def body_params(request: Request, fmt: str) -> BodyParams | None:
+    """A binary body's query parameters; a JSON body takes none (its fields say it all)."""
+    items = request.query_params.multi_items()
+    if fmt != "json":
+        return BodyParams.from_query(items)
+    if items:
+        raise HTTPError(
+            422,
+            f"query parameter {items[0][0]!r}: a JSON body carries asset_id, speed, load, "
+            "design and operating_hours as fields (query parameters are for binary bodies)",
+        )
+    return None
+
+
+@router.post(
+    "/v1/diagnose",
+    summary="Diagnose a recording sent as JSON, Arrow IPC, Parquet or MCAP",
+    response_model=None,
+    responses={
+        200: {"model": Diagnosis, "description": "the Diagnosis contract"},
+        **ERROR_RESPONSES,
+        400: {"model": Error, "description": "empty body"},
+        415: {"model": Error, "description": "Content-Type not accepted"},
+    },
+    openapi_extra=_JSON_BODY,
+)
+async def post_diagnose(request: Request, store: Store, limits: Limits, workers: Workers):
+    """Diagnose uniformly sampled contract channels (at most `max_window_seconds`, 2 s by
+    default), sent as JSON or as a recording (Arrow IPC stream, Parquet or MCAP: decoded by
+    the library's readers; the asset and nominal operating point then come as query
+    parameters). With `asset_id` the diagnosis is stored in the asset's history, with
+    `operating_hours` when given (the prognosis uses those)."""
+    received_at = utc_now()
+    fmt = body_format(request)
+    params = body_params(request, fmt)
+    with workers.admitted():
+        body = await request.body()
+        answer = await workers.diagnose(diagnose_body, body, fmt, params, limits, received_at)
+        del body
+    if answer.history:
+        await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
+    return json_response(answer.encoded)
+
+
+@router.post(
+    "/v1/diagnose/file",
+    summary="Diagnose an uploaded MCAP or Parquet recording",
+    response_model=None,
+    responses={
+        200: {
+            "model": FileDiagnosis,
+            "description": "whole-recording and per-window diagnoses",
+        },
+        **ERROR_RESPONSES,
+        415: {
+            "model": Error,
+            "description": "not multipart, or not a .mcap/.parquet file",
+        },
+    },
+    openapi_extra=_MULTIPART_BODY,
+)
+async def post_diagnose_file(request: Request, store: Store, limits: Limits, workers: Workers):
+    """Stream the upload into a private temporary directory (removed afterwards), read it
+    with the library and diagnose every window."""
+    received_at = utc_now()
+    boundary = multipart_boundary(request)
+    with workers.admitted():
+        async with upload_directory() as directory:
+            upload = await receive_upload(request, boundary, directory)
+            answer = await workers.diagnose(
+                diagnose_upload,
+                upload.received(),
+                limits,
+                upload.fields.get("asset_id"),
+                received_at,
+            )
+    if answer.history:
+        await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
+    return json_response(answer.encoded)

@@ -1,0 +1,86 @@
+"""``GET /v1/assets/{asset_id}/prognosis``: the asset's stored diagnoses with operating hours
+as a history (:func:`~..history.prognosis_history`) → the library's prognosis
+(:func:`prsm_health.prognostics.rul.prognose`) with the service's prognostics model."""
+
+from typing import Annotated, Literal
+
+import anyio
+from fastapi import APIRouter, Query
+from fastapi import Path as PathParam
+
+from prsm_health.prognostics import METHODS, HistoryError, prognose
+
+from ..history import HistoryStore, prognosis_history
+from ..responses import HTTPError, encode, json_response
+from ..schemas import ASSET_ID_PATTERN, Error, Prognosis
+from .deps import PrognosticsModel, Store
+
+router = APIRouter()
+
+NO_MODEL = (
+    "no prognostics model loaded: start the service with --prognostics-model FILE (a model "
+    "saved by prsm_health.prognostics.rul.save_prognostics_model; default models/prognostics.json)"
+)
+
+
+def asset_prognosis(store: HistoryStore, model, asset_id: str, method: str | None = None) -> dict:
+    """The asset's prognosis (``Prognosis.as_dict()``, the history's notes first in its
+    warnings); :class:`HTTPError` 503 without a model, 404 for an unknown asset, 422 when the
+    history does not allow one. Runs in a worker thread (reads the store)."""
+    if model is None:
+        raise HTTPError(503, NO_MODEL)
+    if not store.has_asset(asset_id):
+        raise HTTPError(404, f"no diagnoses stored for asset {asset_id!r}")
+    history, notes = prognosis_history(store.operating_history(asset_id))
+    if len(history) < 2:
+        raise HTTPError(
+            422,
+            f"asset {asset_id!r} has {len(history)} diagnosis(es) at distinct operating "
+            "hours; a prognosis needs at least 2 (send operating_hours with POST "
+            "/v1/diagnose)",
+        )
+    try:
+        prognosis = prognose(history, model, method).as_dict()
+    except HistoryError as exc:
+        raise HTTPError(422, f"asset {asset_id!r}: {exc}") from None
+    prognosis["warnings"] = [*notes, *prognosis["warnings"]]
+    return prognosis
+
+
+@router.get(
+    "/v1/assets/{asset_id}/prognosis",
+    summary="Remaining useful life of an asset from its stored diagnoses",
+    response_model=None,
+    responses={
+        200: {"model": Prognosis},
+        404: {"model": Error, "description": "no diagnosis stored for this asset"},
+        422: {
+            "model": Error,
+            "description": "fewer than 2 diagnoses with operating hours, a design other than "
+            "the prognostics model's, bad query parameters",
+        },
+        503: {"model": Error, "description": "no prognostics model loaded"},
+    },
+)
+async def get_prognosis(
+    asset_id: Annotated[str, PathParam(pattern=ASSET_ID_PATTERN)],
+    store: Store,
+    model: PrognosticsModel,
+    method: Annotated[
+        Literal[METHODS] | None,  # type: ignore[valid-type]
+        Query(
+            description="degradation (default: the form chosen when the model was fitted), "
+            "similarity, or a forced degradation form"
+        ),
+    ] = None,
+):
+    """The RUL [h] with its 90 % interval, from the asset's diagnoses that were sent with
+    `operating_hours`, ordered by operating hours (of several at the same hours, the latest
+    received)."""
+    if model is None:
+        raise HTTPError(503, NO_MODEL)
+
+    def compute() -> bytes:
+        return encode(asset_prognosis(store, model, asset_id, method))
+
+    return json_response(await anyio.to_thread.run_sync(compute))

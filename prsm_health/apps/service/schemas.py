@@ -1,0 +1,440 @@
+"""Request and response models of the API (pydantic), and the one formatting of their errors.
+
+The models are fixed; the bounds that depend on :class:`ServiceLimits` are applied where the
+limits are known: a request body is validated with ``context={"limits": limits}``
+(:func:`parse_diagnose_request`), which checks ``sample_rate`` against the limits with
+pydantic's own error types and messages, and :func:`document_limits` writes the same bounds
+into the app's OpenAPI document.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    create_model,
+    field_validator,
+)
+from pydantic_core import PydanticKnownError
+
+from prsm_health.actuator.design import PRESETS
+from prsm_health.core.channels import CHANNEL_NAMES, CHANNELS, TRUTH_NAMES, TRUTH_PREFIX
+
+from .limits import MAX_OPERATING_HOURS, ServiceLimits
+from .responses import HTTPError
+
+#: Pattern of an asset id (also a URL path segment).
+ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
+_DEFAULT_LIMITS = ServiceLimits()
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+#: What ``operating_hours`` of a diagnose request means (JSON field and query parameter).
+OPERATING_HOURS_DESCRIPTION = (
+    "operating hours of the asset when the recording was made [h], 0 – 1e7; stored with the "
+    "diagnosis and used by GET /v1/assets/{asset_id}/prognosis"
+)
+
+# One optional array per measured contract channel; any other name is an error
+# (extra="forbid"), simulator truth included: a diagnosis reads measurements only, and a truth
+# signal silently dropped would hide a client's mistake.
+Channels = create_model(
+    "Channels",
+    __config__=ConfigDict(strict=True, extra="forbid"),
+    __doc__="Measured contract channels (docs/formats.md): equal-length arrays, SI units. "
+    "Simulator truth (truth_* columns, carrier_speed, friction_torque) is not accepted.",
+    **{
+        c.name: (list[Finite], Field(None, description=f"{c.meaning} [{c.unit}]")) for c in CHANNELS
+    },
+)
+
+
+class DiagnoseRequest(BaseModel):
+    """A recording to diagnose: uniformly sampled contract channels."""
+
+    model_config = ConfigDict(strict=True, extra="forbid")
+    sample_rate: Finite = Field(description="sample rate [Hz]")
+    channels: Channels  # type: ignore[valid-type]
+    design: Literal[tuple(sorted(PRESETS))] | None = Field(  # type: ignore[valid-type]
+        None, description="design preset of the actuator (must match the model's)"
+    )
+    speed: Finite | None = Field(None, description="nominal screw speed [rad/s] (stored)")
+    load: Finite | None = Field(None, description="nominal axial load [N] (stored)")
+    operating_hours: Finite | None = Field(
+        None,
+        ge=0,
+        le=MAX_OPERATING_HOURS,
+        description=OPERATING_HOURS_DESCRIPTION,
+    )
+    asset_id: str | None = Field(
+        None,
+        pattern=ASSET_ID_PATTERN,
+        description="store the diagnosis in this asset's history",
+    )
+    time_start: Finite = Field(0.0, ge=-1e7, le=1e7, description="time of the first sample [s]")
+
+    @field_validator("sample_rate")
+    @classmethod
+    def _within_limits(cls, rate: float, info: ValidationInfo) -> float:
+        # The limits of the validating service (context), else the defaults; same error types
+        # and messages as Field(ge=..., le=...).
+        limits = (info.context or {}).get("limits") or _DEFAULT_LIMITS
+        if rate < limits.min_sample_rate:
+            raise PydanticKnownError("greater_than_equal", {"ge": limits.min_sample_rate})
+        if rate > limits.max_sample_rate:
+            raise PydanticKnownError("less_than_equal", {"le": limits.max_sample_rate})
+        return rate
+
+
+class Clearance(BaseModel):
+    estimate: float | None = Field(description="clearance estimate [m]")
+    lower: float | None = Field(description="lower bound of the 90 % interval [m]")
+    upper: float | None = Field(description="upper bound of the 90 % interval [m]")
+
+
+class ModelRef(BaseModel):
+    name: str
+    version: str
+    design: str = Field(description="design the model was trained for")
+
+
+class WindowRef(BaseModel):
+    index: int
+    start: float = Field(description="[s]")
+    end: float = Field(description="[s]")
+
+
+class WindowDiagnosis(BaseModel):
+    clearance: Clearance
+    fault_class: str | None = Field(
+        description="the class, or cannot_tell (fault not observable, or several classes in "
+        "the class set)"
+    )
+    class_probabilities: dict[str, float]
+    class_set: list[str] = Field(
+        default_factory=list,
+        description="classes the evidence cannot rule out (the model's conformal class set)",
+    )
+    observability: dict[str, bool] = Field(
+        description="clearance, fault: whether the window lets the model see them"
+    )
+    ood_score: float | None = Field(
+        description="out-of-distribution score (1 = training 99th percentile; > 1.5 unlike it)"
+    )
+    indicators: dict[str, float | None]
+    indicator_groups: dict[str, str] = Field(description="group → computed, or why not")
+    model: ModelRef
+    window: WindowRef
+    warnings: list[str] = Field(description="sentences a person can act on")
+
+
+class Diagnosis(BaseModel):
+    """The Diagnosis contract (docs/service.md)."""
+
+    clearance: Clearance
+    fault_class: str | None = Field(
+        description="the class, or cannot_tell (fault not observable, or several classes in "
+        "the class set)"
+    )
+    class_probabilities: dict[str, float]
+    class_set: list[str] = Field(
+        default_factory=list,
+        description="classes the evidence cannot rule out (the model's conformal class set)",
+    )
+    observability: dict[str, float] = Field(
+        description="clearance, fault: fraction of the windows that let the model see them"
+    )
+    ood_score: float | None = Field(description="median out-of-distribution score of the windows")
+    indicators: dict[str, float | None]
+    indicator_groups: dict[str, str] = Field(description="group → computed, or why not")
+    model: ModelRef
+    warnings: list[str] = Field(
+        description="sentences a person can act on: why a target is not observable, a missing "
+        "channel, a recording outside the trained range, a tail left undiagnosed"
+    )
+    windows: list[WindowDiagnosis] | None = Field(
+        None, description="per-window diagnoses, present when there is more than one window"
+    )
+
+
+class RecordingInfo(BaseModel):
+    filename: str
+    samples: int
+    sample_rate: float = Field(description="[Hz]")
+    duration: float = Field(description="[s]")
+    channels: list[str]
+
+
+class FileDiagnosis(BaseModel):
+    diagnosis: Diagnosis
+    windows: list[WindowDiagnosis]
+    recording: RecordingInfo
+    warnings: list[str]
+
+
+class HistoryEntry(BaseModel):
+    id: int
+    received_at: str = Field(description="server receive time, UTC ISO-8601")
+    source: str = Field(description="'json' or 'file'")
+    filename: str | None
+    window: WindowRef | None
+    speed: float | None = Field(description="[rad/s]")
+    load: float | None = Field(description="[N]")
+    operating_hours: float | None = Field(
+        description="operating hours of the asset at the recording, as sent [h]"
+    )
+    diagnosis: dict
+
+
+class History(BaseModel):
+    asset_id: str
+    count: int
+    total: int = Field(description="diagnoses stored at or after `since`")
+    truncated: bool
+    diagnoses: list[HistoryEntry]
+
+
+class RulHours(BaseModel):
+    estimate: float = Field(description="median remaining useful life [h]")
+    lower: float = Field(description="5 % quantile [h] (lower bound of the 90 % interval)")
+    upper: float = Field(description="95 % quantile [h] (upper bound of the 90 % interval)")
+
+
+class HealthIndicator(BaseModel):
+    name: str = Field(description="clearance")
+    unit: str = Field(description="m")
+    threshold: float = Field(description="clearance at which the unit fails [m]")
+    ages_hours: list[float] = Field(description="operating hours of the diagnoses used [h]")
+    values: list[float] = Field(description="their clearance estimates [m]")
+    lower: list[float] = Field(description="their 90 % interval lower bounds [m]")
+    upper: list[float] = Field(description="their 90 % interval upper bounds [m]")
+    current: float = Field(description="the latest clearance estimate [m]")
+
+
+class PrognosisModel(BaseModel):
+    """The prognostics model and, by method, its posterior or similarity details."""
+
+    model_config = ConfigDict(extra="allow")
+    name: str = Field(
+        description="degradation-exponential, degradation-linear or similarity (the method used)"
+    )
+    version: str
+    design: str = Field(description="design the prognostics model is for")
+    units_trained: int
+    threshold: float = Field(description="[m]")
+    horizon_hours: float = Field(description="RUL cap [h]")
+
+
+class Prognosis(BaseModel):
+    """Remaining useful life of an asset (``prsm_health.prognostics.rul.Prognosis.as_dict``)."""
+
+    rul_hours: RulHours
+    health_indicator: HealthIndicator
+    model: PrognosisModel
+    warnings: list[str] = Field(description="what limits the answer")
+
+
+class LatestDiagnosis(BaseModel):
+    """The latest stored diagnosis of an asset, in brief."""
+
+    received_at: str = Field(description="server receive time, UTC ISO-8601")
+    source: str = Field(description="'json', 'arrow', 'parquet', 'mcap' or 'file'")
+    filename: str | None
+    window: WindowRef | None
+    operating_hours: float | None = Field(description="[h], as sent")
+    clearance: Clearance
+    fault_class: str | None
+    class_probabilities: dict[str, float]
+    warnings: list[str]
+    model: dict | None = Field(description="name, version, design of the diagnosing model")
+
+
+class PrognosisBrief(BaseModel):
+    """The asset's prognosis in brief (``rul_hours``, ``method``, ``threshold``,
+    ``current``, ``warnings``), or why there is none (``error`` and the ``status`` that
+    ``GET /v1/assets/{asset_id}/prognosis`` answers)."""
+
+    rul_hours: RulHours | None = None
+    method: str | None = Field(None, description="the prognostics method used")
+    threshold: float | None = Field(None, description="failure threshold of the clearance [m]")
+    current: float | None = Field(None, description="latest clearance estimate used [m]")
+    warnings: list[str] = Field(default_factory=list)
+    error: str | None = Field(None, description="why there is no prognosis")
+    status: int | None = Field(None, description="the prognosis endpoint's status: 422, 503")
+
+
+class AssetSummary(BaseModel):
+    """One asset: what is stored for it and its latest diagnosis."""
+
+    asset_id: str
+    diagnoses: int = Field(description="diagnoses stored")
+    with_operating_hours: int = Field(description="of which sent with operating hours")
+    operating_hours: float | None = Field(description="the largest operating hours sent [h]")
+    first_received_at: str
+    last_received_at: str
+    latest: LatestDiagnosis
+    spectra_received_at: str | None = Field(
+        description="when the stored spectra of the latest window came (None: none stored)"
+    )
+    prognosis: PrognosisBrief | None = Field(
+        None, description="with `prognosis=true`: the RUL in brief, or why there is none"
+    )
+
+
+class AssetList(BaseModel):
+    count: int
+    total: int = Field(description="assets stored")
+    truncated: bool
+    assets: list[AssetSummary] = Field(description="most recently seen first")
+
+
+class SpectrumPoints(BaseModel):
+    frequency: list[float] = Field(description="[Hz]")
+    amplitude: list[float] = Field(description="[m/s²]")
+
+
+class EnvelopeSpectrum(SpectrumPoints):
+    band: list[float] = Field(description="band-pass of the envelope (low, high) [Hz]")
+    sk: float = Field(description="spectral kurtosis of the band")
+    impulsive: bool = Field(description="whether the band's SK is above the noise threshold")
+    modulation_limit: float = Field(description="highest frequency the band carries [Hz]")
+
+
+class DefectLine(BaseModel):
+    amplitude: float | None = Field(description="envelope amplitude at the frequency [m/s²]")
+    ratio: float | None = Field(description="line-to-floor ratio")
+    ratio_sum: float | None = Field(description="sum of the ratios of the first harmonics")
+
+
+class Spectra(BaseModel):
+    """Spectra of the latest window of an asset's latest recording with a nut axial
+    acceleration (``prsm_health.signals.envelope_analysis.window_spectra``)."""
+
+    asset_id: str
+    received_at: str
+    source: str
+    filename: str | None
+    window: WindowRef | None
+    operating_hours: float | None = Field(description="[h]")
+    channel: str = Field(description="nut_axial_accel")
+    sample_rate: float = Field(description="[Hz]")
+    samples: int = Field(description="samples in the window")
+    screw_speed: float | None = Field(description="the window's mean screw speed [rad/s]")
+    spectrum: SpectrumPoints = Field(
+        description="amplitude spectrum (Hann), at most 2048 log-spaced peak-keeping points"
+    )
+    envelope: EnvelopeSpectrum | None = Field(
+        description="envelope amplitude spectrum up to the band's modulation limit; None when "
+        "no band fits (envelope_note says why)"
+    )
+    envelope_note: str | None = None
+    frequencies: dict[str, float] = Field(
+        description="defect frequencies at the window's mean screw speed, and gear_mesh [Hz]"
+    )
+    lines: dict[str, DefectLine] = Field(description="envelope lines at the defect frequencies")
+
+
+class Health(BaseModel):
+    status: str
+    model: str
+    version: str
+    uptime_s: float
+    warm: bool
+    active_diagnoses: int
+
+
+class ModelInfo(BaseModel):
+    name: str
+    version: str
+    window: float = Field(description="window length [s]")
+    design: str
+    sample_rate: float | None = Field(description="training sample rate [Hz]")
+    feature_names: list[str]
+    classes: list[str]
+    clearance_range: list[float] | None = Field(description="[m]")
+    saved_at: str | None
+    versions: dict
+    metrics: dict | None
+
+
+class Error(BaseModel):
+    error: str
+
+
+#: Error answers shared by the routes' OpenAPI documentation.
+ERROR_RESPONSES = {
+    401: {"model": Error, "description": "missing or invalid bearer token"},
+    413: {"model": Error, "description": "request or recording too large"},
+    422: {"model": Error, "description": "invalid request"},
+    503: {"model": Error, "description": "too many diagnoses in progress"},
+}
+
+
+def parse_diagnose_request(body: bytes, limits: ServiceLimits) -> DiagnoseRequest:
+    """The JSON body of ``POST /v1/diagnose``, validated against the model and ``limits``;
+    :class:`HTTPError` 422 with one message otherwise."""
+    try:
+        return DiagnoseRequest.model_validate_json(body, context={"limits": limits})
+    except ValidationError as exc:
+        raise HTTPError(
+            422, format_errors(exc.errors(include_url=False, include_input=False))
+        ) from None
+
+
+def format_errors(errors: list[dict], prefix: str = "") -> str:
+    """One message from pydantic errors: unknown channels first, then the first few others."""
+    unknown_channels = [
+        str(e["loc"][1])
+        for e in errors
+        if e["type"] == "extra_forbidden" and len(e["loc"]) == 2 and e["loc"][0] == "channels"
+    ]
+    parts = []
+    if unknown_channels:
+        names = ", ".join(repr(n) for n in unknown_channels)
+        truth = [n for n in unknown_channels if n in TRUTH_NAMES or n.startswith(TRUTH_PREFIX)]
+        hint = (
+            f" ({', '.join(truth)}: simulator truth, not a measurement; leave it out)"
+            if truth
+            else ""
+        )
+        parts.append(
+            f"unknown channel(s) {names}; contract channels: {', '.join(CHANNEL_NAMES)}{hint}"
+        )
+    others = [
+        e for e in errors if not (e["type"] == "extra_forbidden" and e["loc"][:1] == ("channels",))
+    ]
+    for e in others[:3]:
+        loc = ".".join(str(p) for p in e["loc"])
+        where = f"{prefix}{loc}" if loc else (prefix.rstrip(".") or "body")
+        if e["type"] == "extra_forbidden":
+            parts.append(f"unknown field {where!r}")
+        else:
+            parts.append(f"{where}: {e['msg']}")
+    if len(others) > 3:
+        parts.append(f"and {len(others) - 3} more error(s)")
+    return "; ".join(parts) or "invalid request"
+
+
+def add_request_schema(schema: dict, limits: ServiceLimits) -> None:
+    """Put the ``DiagnoseRequest`` schema (and its ``Channels``) into an OpenAPI document's
+    components, with the sample-rate bounds of ``limits`` (the body is validated in a worker
+    thread, not by FastAPI, so FastAPI does not document it)."""
+    request = DiagnoseRequest.model_json_schema(ref_template="#/components/schemas/{model}")
+    components = schema.setdefault("components", {}).setdefault("schemas", {})
+    components.update(request.pop("$defs", {}))
+    rate = request["properties"]["sample_rate"]
+    rate["minimum"], rate["maximum"] = limits.min_sample_rate, limits.max_sample_rate
+    components["DiagnoseRequest"] = request
+
+
+def document_limits(schema: dict, limits: ServiceLimits) -> None:
+    """Write the bounds of ``limits`` that routes check at run time into an OpenAPI document."""
+    add_request_schema(schema, limits)
+    for path in ("/v1/assets/{asset_id}/history", "/v1/assets"):
+        for parameter in schema["paths"][path]["get"]["parameters"]:
+            if parameter["name"] == "limit":
+                parameter["schema"]["maximum"] = limits.max_history

@@ -1,0 +1,202 @@
+"""A simulated or recorded run: time, measured channels, truth, labels.
+
+Channel names and units follow the signal-channel contract (:mod:`prsm_health.core.channels`):
+:attr:`Run.channels` holds the measured channels a recording has, :attr:`Run.truth` the
+simulator's truth signals (empty for a recording from hardware); the two never mix. A run as a
+table (:meth:`Run.to_frame`, the single-run Parquet file of :mod:`prsm_health.io.parquet`) has
+the columns ``time``, the measured channels, then ``truth_<name>`` for each truth signal.
+:meth:`Run.validate` is the one place that decides whether a recording can be processed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .channels import CHANNEL_NAMES, TRUTH_NAMES, truth_column
+from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
+
+#: Fewest samples a recording or window needs: below it the spectra have too few bins for the
+#: indicators (a 256-point Welch segment).
+MIN_SAMPLES = 256
+
+
+@dataclass
+class Run:
+    """Sampled channels of one run.
+
+    Attributes
+    ----------
+    time : ndarray [s]
+    channels : dict of name → ndarray
+        Measured contract channels (:data:`~prsm_health.core.channels.CHANNEL_NAMES`), SI: what the
+        sensors gave. A recording may lack some.
+    sample_rate : float [Hz]
+    labels : dict
+        Run labels (contract): clearances [m], nominal speed [rad/s] and load [N], seed, …
+    scenario : dict
+        Everything needed to re-run it (design, health, profile, sensors, options).
+    energy : dict
+        Energy book of the simulation [J] (drive, load, dissipated, friction) — empty for
+        recordings.
+    truth : dict of name → ndarray
+        Truth signals of a simulated run (:data:`~prsm_health.core.channels.TRUTH_NAMES`, without
+        the ``truth_`` prefix), SI, on the same time axis, free of sensor errors — empty for
+        recordings. Never an input of the diagnosis.
+    """
+
+    time: np.ndarray
+    channels: dict[str, np.ndarray]
+    sample_rate: float
+    labels: dict = field(default_factory=dict)
+    scenario: dict = field(default_factory=dict)
+    energy: dict = field(default_factory=dict)
+    truth: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name in self.truth and name not in self.channels:
+            raise PRSMHealthError(
+                f"{name!r} is not a measured channel of this run; its truth is run.truth[{name!r}]"
+            )
+        return lookup_channel(self.time, self.channels, name)
+
+    def __len__(self) -> int:
+        return len(self.time)
+
+    @property
+    def duration(self) -> float:
+        """Time from the first to the last sample [s]."""
+        return float(self.time[-1] - self.time[0]) if len(self.time) else 0.0
+
+    def validate(
+        self,
+        *,
+        min_samples: int = MIN_SAMPLES,
+        max_samples: int | None = None,
+        max_abs: float | None = None,
+        max_time: float | None = None,
+        what: str = "recording",
+    ) -> Run:
+        """Check that the recording can be processed; returns self.
+
+        Parameters
+        ----------
+        min_samples, max_samples : int
+            Accepted length [samples].
+        max_abs : float or None
+            Largest accepted magnitude of a sample (SI); beyond it the indicators overflow.
+            None: no bound.
+        max_time : float or None [s]
+            Largest accepted magnitude of the time axis. None: no bound.
+        what : str
+            How the messages name the recording.
+
+        Raises
+        ------
+        RecordingError
+            Too short, no channel, non-finite or non-increasing time, a channel or truth
+            signal of another length, non-finite samples, out-of-range channel samples.
+        RecordingTooLongError
+            More than ``max_samples`` samples.
+        """
+        n, rate = len(self), float(self.sample_rate)
+        if not (np.isfinite(rate) and rate > 0):
+            raise RecordingError(f"{what}: sample rate {rate:g} Hz must be finite and > 0")
+        if not self.channels:
+            raise RecordingError(f"{what}: no contract channel ({', '.join(CHANNEL_NAMES)})")
+        if n < min_samples:
+            raise RecordingError(
+                f"{what} too short: {n} samples, need at least {min_samples} "
+                f"({min_samples / rate:.3g} s at {rate:g} Hz){ms_hint(rate)}"
+            )
+        if max_samples is not None and n > max_samples:
+            raise RecordingTooLongError(
+                f"{what} too long: {n} samples ({n / rate:.6g} s at {rate:g} Hz); "
+                f"at most {max_samples} samples accepted here"
+            )
+        time = np.asarray(self.time, dtype=float)
+        if not (np.all(np.isfinite(time)) and np.all(np.diff(time) > 0)):
+            raise RecordingError(f"{what}: time must be finite and strictly increasing")
+        if max_time is not None and float(np.max(np.abs(time))) > max_time:
+            raise RecordingError(
+                f"{what}: time beyond ±{max_time:g} s (use time from the recording start)"
+            )
+        for name, values in self.channels.items():
+            values = np.asarray(values, dtype=float)
+            if len(values) != n:
+                raise RecordingError(
+                    f"{what}: channel {name} has {len(values)} samples, time has {n}"
+                )
+            if not np.all(np.isfinite(values)):
+                raise RecordingError(f"{what}: channel {name} contains NaN or infinite values")
+            if max_abs is not None and values.size and float(np.max(np.abs(values))) > max_abs:
+                raise RecordingError(
+                    f"{what}: channel {name} has samples beyond ±{max_abs:g} "
+                    "(SI units expected: m, rad, N, N·m, m/s²)"
+                )
+        for name, values in self.truth.items():
+            values = np.asarray(values, dtype=float)
+            if len(values) != n:
+                raise RecordingError(
+                    f"{what}: truth {name} has {len(values)} samples, time has {n}"
+                )
+            if not np.all(np.isfinite(values)):
+                raise RecordingError(f"{what}: truth {name} contains NaN or infinite values")
+        return self
+
+    def without_truth(self) -> Run:
+        """The same recording with the measured channels only (arrays shared, not copied)."""
+        return Run(
+            self.time, self.channels, self.sample_rate, self.labels, self.scenario, self.energy
+        )
+
+    def slice(self, start: int, stop: int) -> Run:
+        """Samples ``[start, stop)`` as a run (views): channels, truth, labels and scenario; no
+        energy book (it is the whole run's)."""
+        sl = slice(start, stop)
+        return Run(
+            self.time[sl],
+            {k: v[sl] for k, v in self.channels.items()},
+            self.sample_rate,
+            self.labels,
+            self.scenario,
+            truth={k: v[sl] for k, v in self.truth.items()},
+        )
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The run as file columns (contract): ``time``, the measured channels, then
+        ``truth_<name>`` for each truth signal, in contract order."""
+        data = {"time": self.time}
+        data.update({name: self.channels[name] for name in CHANNEL_NAMES if name in self.channels})
+        data.update({truth_column(n): self.truth[n] for n in TRUTH_NAMES if n in self.truth})
+        return data
+
+    def to_frame(self):
+        """pandas DataFrame of :meth:`columns`."""
+        import pandas as pd
+
+        return pd.DataFrame(self.columns())
+
+
+def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str) -> np.ndarray:
+    """``time`` or a named channel; an unknown name is a user error listing the available ones."""
+    if name == "time":
+        return time
+    try:
+        return channels[name]
+    except KeyError:
+        raise PRSMHealthError(
+            f"unknown channel {name!r}; available: time, {', '.join(channels)}"
+        ) from None
+
+
+def ms_hint(rate: float) -> str:
+    """'; is time in ms?' when a sample rate is implausibly low for a vibration recording but
+    plausible × 1000 (20 kHz sampled, time written in ms, reads as 20 Hz)."""
+    if 1.0 <= rate < 100.0:
+        return (
+            f" — the time axis gives {rate:g} Hz; if time is in milliseconds, convert it to "
+            f"seconds ({1000 * rate:g} Hz)"
+        )
+    return ""

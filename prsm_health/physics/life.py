@@ -1,0 +1,584 @@
+"""Life simulation: how a unit's clearances, lubricant and flanks evolve over operating hours.
+
+Quasi-static (no dynamics): the wear and fatigue rates of :mod:`prsm_health.physics.wear` under a unit's
+duty cycle, integrated over its age. What changes with age:
+
+* **lubricant degradation** d(t) = t/T_lube (capped at 1): its additives are used up over the
+  lubricant's life T_lube, which halves for every 15 K above 70 °C (the relubrication-interval
+  rule of rolling-bearing makers, e.g. SKF's catalogue; Arrhenius-like ageing of the base oil
+  and thickener);
+* **clearances** b_screw(t), b_nut(t): b₀ + ∫ ḃ(d(t′)) dt′, the Archard rate of each engagement
+  averaged over the duty cycle's load spectrum and the share of hours in motion; the rate
+  grows as the additives deplete (:meth:`~prsm_health.physics.wear.WearParameters.coefficient`), so
+  wear accelerates through life;
+* **a spall** starts when the fatigue damage of the flanks reaches the unit's drawn Weibull
+  survival (ISO 281, surfaces combined) and then grows in length exponentially.
+
+Since the rates do not depend on the clearance itself, the integral is exact on the
+degradation grid: b(t) = b₀ + T_lube·∫₀^{t/T_lube} ḃ(d) dd while the lubricant ages, then
+linear. A unit **fails** at the first of: mean thread clearance (b_screw + b_nut)/2 reaching
+``failure_clearance`` (the lost-motion limit: the play the diagnosis estimates), or its spall
+reaching ``failure_spall_length``. The gear backlash is not worn in this model (the ring gear
+only synchronises the rollers; its load is the rolling-resistance torque, orders below the
+thread loads): it stays at its built value.
+
+A **fleet** is N units with manufacturing, material and usage scatter (:class:`FleetScatter`),
+each drawn from the recipe seed and its unit id, so the same recipe gives the same fleet.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+
+import numpy as np
+
+from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.faults import Spall
+from prsm_health.actuator.states import HealthState
+from prsm_health.core.errors import require, require_known_keys, require_positive, require_range
+
+from .lubrication import DEFAULT_LUBRICANT, asperity_share, lubricant, stribeck_curve
+from .wear import (
+    SURFACES,
+    WEIBULL_SLOPE,
+    PartGeometry,
+    WearParameters,
+    clearance_growth_rate,
+    contact_states,
+    l10_cycles,
+    stress_cycle_rates,
+)
+
+#: Lubricant life is quoted at 70 °C and halves per 15 K above (doubles per 15 K below).
+LUBRICANT_REFERENCE_TEMPERATURE = 343.15
+LUBRICANT_HALVING = 15.0
+FAILURE_MODES = ("wear", "spall")
+_DEGRADATION_GRID = np.linspace(0.0, 1.0, 101)
+#: Steps of the age grid a unit's wear is accumulated on (up to 4× its expected life).
+_AGE_STEPS = 2000
+
+
+def _pair(table: str, name: str, value, lo: float, hi: float, unit: str = "-") -> tuple:
+    require(
+        isinstance(value, (list, tuple))
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) for v in value)
+        and lo <= value[0] <= value[1] <= hi,
+        f"{table}.{name}",
+        value,
+        f"must be a range [min, max] within [{lo:g}, {hi:g}] {unit}",
+    )
+    return (float(value[0]), float(value[1]))
+
+
+@dataclass(frozen=True)
+class DutyCycle:
+    """What a unit does over its operating hours (SI).
+
+    Parameters
+    ----------
+    speed : float [rad/s]
+        Screw speed while it moves.
+    stroke : float [m]
+        Travel of the reciprocating stroke (spreads the screw's wear track).
+    loads : tuple of float [N]
+        Axial load spectrum: the loads the unit carries while it moves …
+    shares : tuple of float [-]
+        … and the share of motion time at each (sum 1).
+    motion_fraction : float [-]
+        Share of operating hours in motion.
+    temperature : float [K]
+        Lubricant temperature in service.
+    lubricant_life : float [h]
+        Operating hours until the lubricant's additives are used up, at 70 °C.
+    """
+
+    speed: float = 100.0
+    stroke: float = 0.05
+    loads: tuple = (500.0, 1500.0, 3000.0)
+    shares: tuple = (0.5, 0.35, 0.15)
+    motion_fraction: float = 0.3
+    temperature: float = 323.15
+    lubricant_life: float = 2000.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "loads", tuple(float(v) for v in self.loads))
+        object.__setattr__(self, "shares", tuple(float(v) for v in self.shares))
+        require_range("life.duty.speed", self.speed, 1e-3, 2000.0, unit="rad/s")
+        require_range("life.duty.stroke", self.stroke, 0.0, 5.0, unit="m")
+        require(
+            len(self.loads) >= 1 and len(self.loads) == len(self.shares),
+            "life.duty.shares",
+            list(self.shares),
+            f"needs one share per load ({len(self.loads)} loads)",
+        )
+        for value in self.loads:
+            require_range("life.duty.loads", value, -1e6, 1e6, unit="N")
+        require(
+            all(s >= 0 for s in self.shares) and abs(sum(self.shares) - 1.0) < 1e-6,
+            "life.duty.shares",
+            list(self.shares),
+            "must be ≥ 0 and sum to 1",
+        )
+        require_range("life.duty.motion_fraction", self.motion_fraction, 1e-4, 1.0)
+        require_range("life.duty.temperature", self.temperature, 223.15, 473.15, unit="K")
+        require_range("life.duty.lubricant_life", self.lubricant_life, 1.0, 1e7, unit="h")
+
+
+@dataclass(frozen=True)
+class FleetScatter:
+    """Unit-to-unit scatter of a fleet: each unit draws its own values.
+
+    Parameters
+    ----------
+    initial_clearance : (min, max) [m]
+        Half-clearance as built (uniform).
+    wear_coefficient : float [-]
+        σ of ln k: the wear coefficient's lognormal scatter (material, finish).
+    load_scale : (min, max) [-]
+        Multiplies the duty cycle's loads (each unit's own usage; uniform).
+    temperature : (min, max) [K]
+        Added to the duty cycle's temperature (uniform).
+    lubricant_life : float [-]
+        σ of ln T_lube (lognormal).
+    wear_spread : (min, max) [-]
+        Uneven load sharing between rollers, hence uneven wear (uniform; the health state's
+        ``wear_spread`` is this times the share of the clearance that is wear).
+    usage : float [-]
+        σ of the log of the unit's usage intensity (how hard it works compared with the duty
+        cycle: missions, loads, idle spells), which wanders as a mean-reverting
+        (Ornstein–Uhlenbeck) process with correlation time ``usage_time``: wear speeds up and
+        slows down over a unit's life, so no two units, and no unit's two halves of life, wear
+        alike. 0: the duty cycle exactly. Default 0.15: a season's usage of units flying the
+        same missions differs by ≈ ±15 % (engineering estimate; docs/prognostics.md shows the
+        RUL scores at 0 … 0.3).
+    usage_time : float [h]
+        Correlation time of the usage intensity (a season of operation).
+    """
+
+    initial_clearance: tuple = (3e-6, 8e-6)
+    wear_coefficient: float = 0.4
+    load_scale: tuple = (0.8, 1.25)
+    temperature: tuple = (-10.0, 10.0)
+    lubricant_life: float = 0.3
+    wear_spread: tuple = (0.0, 0.3)
+    usage: float = 0.15
+    usage_time: float = 200.0
+
+    def __post_init__(self):
+        t = "life.scatter"
+        object.__setattr__(
+            self,
+            "initial_clearance",
+            _pair(t, "initial_clearance", self.initial_clearance, 0.0, 100e-6, "m"),
+        )
+        object.__setattr__(self, "load_scale", _pair(t, "load_scale", self.load_scale, 0.0, 10.0))
+        object.__setattr__(
+            self, "temperature", _pair(t, "temperature", self.temperature, -100.0, 100.0, "K")
+        )
+        object.__setattr__(self, "wear_spread", _pair(t, "wear_spread", self.wear_spread, 0.0, 1.0))
+        require_range(f"{t}.wear_coefficient", self.wear_coefficient, 0.0, 3.0)
+        require_range(f"{t}.lubricant_life", self.lubricant_life, 0.0, 3.0)
+        require_range(f"{t}.usage", self.usage, 0.0, 2.0)
+        require_range(f"{t}.usage_time", self.usage_time, 1e-3, 1e6, unit="h")
+
+
+@dataclass(frozen=True)
+class LifeSpec:
+    """The ``[life]`` table of a fleet recipe: units, duty cycle, snapshots, failure.
+
+    Parameters
+    ----------
+    units : int
+        Units in the fleet.
+    snapshots : int
+        Dynamic recordings per unit, at ages k/snapshots of its life (k = 0 … snapshots − 1).
+    failure_clearance : float [m]
+        The unit fails when its mean thread half-clearance reaches this.
+    failure_spall_length : float [m]
+        … or when a spall grows this long.
+    max_age : float [h]
+        A unit that has not failed by then is an error (raise the duty or the wear).
+    lubricant : str
+        Built-in lubricant (its film sets the asperity load share).
+    duty, scatter, wear
+        :class:`DutyCycle`, :class:`FleetScatter`, :class:`~prsm_health.physics.wear.WearParameters`.
+    """
+
+    units: int = 20
+    snapshots: int = 30
+    failure_clearance: float = 30e-6
+    failure_spall_length: float = 3e-3
+    max_age: float = 2e5
+    lubricant: str = DEFAULT_LUBRICANT
+    duty: DutyCycle = field(default_factory=DutyCycle)
+    scatter: FleetScatter = field(default_factory=FleetScatter)
+    wear: WearParameters = field(default_factory=WearParameters)
+
+    def __post_init__(self):
+        for name in ("units", "snapshots"):
+            value = getattr(self, name)
+            require(
+                isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= 100_000,
+                f"life.{name}",
+                value,
+                "must be an integer in [1, 100000]",
+            )
+        require_range("life.failure_clearance", self.failure_clearance, 1e-6, 500e-6, unit="m")
+        require_range("life.failure_spall_length", self.failure_spall_length, 1e-4, 10e-3, unit="m")
+        require_positive("life.max_age", self.max_age)
+        lubricant(self.lubricant)  # a known name, or the error naming the choices
+        require(
+            self.failure_clearance > self.scatter.initial_clearance[1],
+            "life.failure_clearance",
+            self.failure_clearance,
+            f"must exceed the largest initial clearance {self.scatter.initial_clearance[1]:g} m",
+        )
+
+    @classmethod
+    def from_dict(cls, values: dict) -> LifeSpec:
+        """From the recipe's ``[life]`` table (``[life.duty]``, ``[life.scatter]``,
+        ``[life.wear]`` nested); unknown keys name the table."""
+        require(isinstance(values, dict), "life", values, "must be a table")
+        values = dict(values)
+        require_known_keys("life", values, [f.name for f in fields(cls)])
+        groups = {"duty": DutyCycle, "scatter": FleetScatter}
+        for name, kind in groups.items():
+            table = values.get(name, {})
+            require(isinstance(table, dict), f"life.{name}", table, "must be a table")
+            require_known_keys(f"life.{name}", table, [f.name for f in fields(kind)])
+            values[name] = kind(**table)
+        values["wear"] = WearParameters.from_dict(values.get("wear", {}))
+        return cls(**values)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class UnitLife:
+    """One unit's life, from its build to its failure (SI; ages in operating hours)."""
+
+    unit_id: int
+    seed: int  # the unit as built: manufacturing variation and roller wear pattern
+    initial_clearance: float
+    wear_spread: float  # uneven roller load sharing (FleetScatter.wear_spread)
+    load_scale: float
+    wear_scale: float  # the unit's wear coefficient ÷ the duty's (lognormal scatter)
+    temperature: float  # [K]
+    lubricant_life: float  # [h] at the unit's temperature
+    ages: np.ndarray  # [h], the grid the wear is accumulated on
+    worn_screw: np.ndarray  # [m] wear of b_screw at those ages
+    worn_nut: np.ndarray
+    spall: Spall | None  # where and how the spall is, its length at initiation
+    spall_age: float  # [h], inf without one
+    spall_doubling: float  # [h]
+    failure_age: float  # [h]
+    failure_mode: str
+    failure_clearance: float
+    failure_spall_length: float
+
+    def degradation(self, age) -> np.ndarray:
+        return np.minimum(np.asarray(age, dtype=float) / self.lubricant_life, 1.0)
+
+    def clearances(self, age) -> tuple[np.ndarray, np.ndarray]:
+        """(b_screw, b_nut) [m] at ``age`` [h] (linear between the grid's ages)."""
+        age = np.asarray(age, dtype=float)
+        return (
+            self.initial_clearance + np.interp(age, self.ages, self.worn_screw),
+            self.initial_clearance + np.interp(age, self.ages, self.worn_nut),
+        )
+
+    def clearance(self, age) -> np.ndarray:
+        """Mean thread half-clearance (b_screw + b_nut)/2 [m]: the failure criterion's."""
+        screw, nut = self.clearances(age)
+        return 0.5 * (screw + nut)
+
+    def spall_length(self, age) -> np.ndarray:
+        """Spall length [m] at ``age`` (0 before it starts)."""
+        age = np.asarray(age, dtype=float)
+        if self.spall is None:
+            return np.zeros_like(age)
+        grown = self.spall.length * 2.0 ** ((age - self.spall_age) / self.spall_doubling)
+        return np.where(age >= self.spall_age, np.minimum(grown, 10e-3), 0.0)
+
+    def rul(self, age) -> np.ndarray:
+        """Remaining useful life [h] at ``age``."""
+        return self.failure_age - np.asarray(age, dtype=float)
+
+    def snapshot_ages(self, n: int) -> np.ndarray:
+        """Ages of n snapshots spread over the life: k/n of the failure age, k = 0 … n − 1."""
+        return self.failure_age * np.arange(n) / n
+
+    def health_at(self, age: float) -> HealthState:
+        """The :class:`~prsm_health.actuator.states.HealthState` the dynamics simulate at ``age``."""
+        screw, nut = (float(v) for v in self.clearances(age))
+        mean = 0.5 * (screw + nut)
+        worn = mean - self.initial_clearance
+        faults = ()
+        length = float(self.spall_length(age))
+        if length > 0.0:
+            faults = (_with_length(self.spall, length),)
+        return HealthState(
+            clearance_screw=screw,
+            clearance_nut=nut,
+            clearance_gear=self.initial_clearance,
+            # roller i's clearance b(1 + s·u_i) with s chosen so its worn part is spread by
+            # wear_spread: b₀ + w(1 + s_w·u_i) = b(1 + (s_w·w/b)·u_i)
+            wear_spread=self.wear_spread * worn / mean if mean > 0 else 0.0,
+            lubricant_degradation=float(self.degradation(age)),
+            faults=faults,
+        )
+
+    def labels(self, age: float) -> dict:
+        """Life labels of a snapshot at ``age`` (the run-label contract's life fields)."""
+        return {
+            "unit_id": self.unit_id,
+            "age_hours": float(age),
+            "rul_hours": float(self.rul(age)),
+            "failure_age_hours": self.failure_age,
+            "failure_mode": self.failure_mode,
+            "clearance_mean_true": float(self.clearance(age)),
+            "spall_length_true": float(self.spall_length(age)),
+        }
+
+
+def _cumulative(rate: np.ndarray) -> np.ndarray:
+    # ∫₀^d rate dd′ on the degradation grid (trapezoid)
+    steps = 0.5 * (rate[1:] + rate[:-1]) * np.diff(_DEGRADATION_GRID)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def _with_length(spall: Spall, length: float) -> Spall:
+    return replace(spall, length=length)
+
+
+def unit_life(
+    design: PRSMDesign, spec: LifeSpec, unit_id: int, fleet_seed: int, geometry=None
+) -> UnitLife:
+    """Simulate one unit's life (deterministic in ``fleet_seed`` and ``unit_id``)."""
+    geometry = geometry or PartGeometry.of(design)
+    rng = np.random.default_rng([fleet_seed, unit_id, 0x4C494645])  # "LIFE"
+    sc, duty, wear = spec.scatter, spec.duty, spec.wear
+    draws = rng.random(5)
+    b0 = sc.initial_clearance[0] + draws[0] * (sc.initial_clearance[1] - sc.initial_clearance[0])
+    load_scale = sc.load_scale[0] + draws[1] * (sc.load_scale[1] - sc.load_scale[0])
+    temperature = (
+        duty.temperature + sc.temperature[0] + draws[2] * (sc.temperature[1] - sc.temperature[0])
+    )
+    spread = sc.wear_spread[0] + draws[3] * (sc.wear_spread[1] - sc.wear_spread[0])
+    survival = float(draws[4])
+    k_scale = math.exp(sc.wear_coefficient * rng.standard_normal())
+    life_scale = math.exp(sc.lubricant_life * rng.standard_normal())
+    t_lube = (
+        duty.lubricant_life
+        * life_scale
+        * 2.0 ** ((LUBRICANT_REFERENCE_TEMPERATURE - temperature) / LUBRICANT_HALVING)
+    )
+    temperature = min(max(temperature, 223.15), 473.15)
+
+    rates = {"screw": np.zeros_like(_DEGRADATION_GRID), "nut": np.zeros_like(_DEGRADATION_GRID)}
+    damage = dict.fromkeys(SURFACES, 0.0)  # L10 lives consumed per operating hour
+    cycles = dict.fromkeys(SURFACES, 0.0)
+    for load, share in zip(duty.loads, duty.shares):
+        load = load * load_scale
+        weight = share * duty.motion_fraction * 3600.0  # seconds in this state per hour
+        contacts = contact_states(design, geometry, load, duty.speed)
+        for side, contact in contacts.items():
+            film = stribeck_curve(
+                design,
+                spec.lubricant,
+                [contact.entrainment_speed],
+                axial_load=load,
+                temperature=temperature,
+                degradation=_DEGRADATION_GRID,
+            )
+            shares = asperity_share(film.film_ratio)
+            k = wear.coefficient(_DEGRADATION_GRID) * k_scale
+            rates[side] += weight * np.array(
+                [
+                    clearance_growth_rate(
+                        geometry,
+                        contact,
+                        side,
+                        stroke=duty.stroke,
+                        asperity_share=float(f),
+                        coefficient=float(kk),
+                    )
+                    for f, kk in zip(shares, k)
+                ]
+            )
+        per_second = stress_cycle_rates(geometry, contacts, duty.stroke)
+        pressure = {
+            "screw": contacts["screw"].max_pressure,
+            "roller": max(contacts["screw"].max_pressure, contacts["nut"].max_pressure),
+            "nut": contacts["nut"].max_pressure,
+        }
+        for surface in SURFACES:
+            cycles[surface] += weight * per_second[surface]
+            damage[surface] += (
+                weight * per_second[surface] / float(l10_cycles(wear, pressure[surface]))
+            )
+
+    # Deterministic wear first (exact on the degradation grid), to size the age grid; then the
+    # unit's wandering usage intensity along it.
+    expected = _expected_failure(rates, b0, t_lube, spec)
+    span = min(spec.max_age, 4.0 * expected)
+    while True:  # a unit whose usage ran low may need a longer grid (same draws otherwise)
+        ages = np.linspace(0.0, span, _AGE_STEPS + 1)
+        usage = _usage_increments(rng, np.diff(ages), sc.usage, sc.usage_time)
+        mid = 0.5 * (ages[1:] + ages[:-1])
+        d_mid = np.minimum(mid / t_lube, 1.0)
+        worn = {
+            side: np.concatenate([[0.0], np.cumsum(np.interp(d_mid, _DEGRADATION_GRID, r) * usage)])
+            for side, r in rates.items()
+        }
+        life = UnitLife(
+            unit_id=unit_id,
+            seed=int(
+                np.random.SeedSequence([fleet_seed, unit_id, 0x554E4954]).generate_state(1)[0]
+            ),
+            initial_clearance=float(b0),
+            wear_spread=float(spread),
+            load_scale=float(load_scale),
+            wear_scale=float(k_scale),
+            temperature=float(temperature),
+            lubricant_life=t_lube,
+            ages=ages,
+            worn_screw=worn["screw"],
+            worn_nut=worn["nut"],
+            spall=None,
+            spall_age=math.inf,
+            spall_doubling=math.inf,
+            failure_age=math.inf,
+            failure_mode="wear",
+            failure_clearance=spec.failure_clearance,
+            failure_spall_length=spec.failure_spall_length,
+        )
+        wear_failure = _crossing(life, spec.failure_clearance)
+        if math.isfinite(wear_failure) or span >= spec.max_age:
+            break
+        span = min(spec.max_age, 4.0 * span)
+
+    # Spall: ISO 281 survival of the surfaces together, S = exp(ln 0.9·Σ (D_i)^e), D_i the
+    # L10 lives consumed; initiation where S reaches the unit's drawn survival.
+    hazard = {s: damage[s] ** WEIBULL_SLOPE for s in SURFACES}
+    total = sum(hazard.values())
+    spall, spall_age, doubling, spall_failure = None, math.inf, math.inf, math.inf
+    if total > 0:
+        spall_age = (math.log(survival) / math.log(0.9)) ** (1 / WEIBULL_SLOPE) / total ** (
+            1 / WEIBULL_SLOPE
+        )
+    if spall_age < min(wear_failure, spec.max_age):
+        pick = rng.random() * total
+        surface = next(s for s in SURFACES if (pick := pick - hazard[s]) <= 0 or s == SURFACES[-1])
+        doubling = wear.spall_doubling / damage[surface]  # hours to double
+        spall = _spall_on(surface, design, duty, wear, rng)
+        spall_failure = spall_age + doubling * math.log2(
+            max(spec.failure_spall_length / spall.length, 1.0)
+        )
+    failure = min(wear_failure, spall_failure)
+    require(
+        failure <= spec.max_age,
+        "life.max_age",
+        spec.max_age,
+        f"unit {unit_id} has not failed by then (clearance "
+        f"{float(life.clearance(spec.max_age)) * 1e6:.1f} µm of "
+        f"{spec.failure_clearance * 1e6:g} µm): raise the duty's loads or the wear "
+        "coefficient, or max_age",
+    )
+    return replace(
+        life,
+        spall=spall,
+        spall_age=spall_age if spall is not None else math.inf,
+        spall_doubling=doubling,
+        failure_age=failure,
+        failure_mode="spall" if spall_failure < wear_failure else "wear",
+    )
+
+
+def _expected_failure(rates: dict, b0: float, t_lube: float, spec: LifeSpec) -> float:
+    """Age [h] at which the duty cycle's mean wear alone brings the mean clearance to the
+    failure threshold (max_age if it never does)."""
+    mean_rate = 0.5 * (rates["screw"] + rates["nut"])  # [m/h] on the degradation grid
+    aged = _cumulative(mean_rate) * t_lube  # wear by the time the lubricant is at d
+    needed = spec.failure_clearance - b0
+    if needed <= aged[-1]:
+        return float(np.interp(needed, aged, _DEGRADATION_GRID)) * t_lube
+    if mean_rate[-1] <= 0:
+        return spec.max_age
+    return min(t_lube + (needed - aged[-1]) / mean_rate[-1], spec.max_age)
+
+
+def _usage_increments(rng, steps: np.ndarray, sigma: float, correlation: float) -> np.ndarray:
+    """Usage [h] in each step: the step times the intensity exp(σX − σ²/2) (mean 1), X a
+    unit-variance Ornstein–Uhlenbeck process with correlation time ``correlation`` [h]
+    (exact discretisation)."""
+    if sigma == 0.0:
+        return steps
+    keep = np.exp(-steps / correlation)
+    shocks = rng.standard_normal(len(steps) + 1)
+    x = np.empty(len(steps))
+    state = shocks[0]
+    for i, (a, z) in enumerate(zip(keep, shocks[1:])):
+        state = a * state + math.sqrt(1.0 - a * a) * z
+        x[i] = state
+    return steps * np.exp(sigma * x - 0.5 * sigma * sigma)
+
+
+def _crossing(life: UnitLife, threshold: float) -> float:
+    """First age at which the mean clearance reaches ``threshold`` (inf if not on the grid)."""
+    clearance = life.clearance(life.ages)
+    above = np.flatnonzero(clearance >= threshold)
+    if above.size == 0:
+        return math.inf
+    i = int(above[0])
+    if i == 0:
+        return 0.0
+    c0, c1 = clearance[i - 1], clearance[i]
+    return float(
+        life.ages[i - 1] + (threshold - c0) / (c1 - c0) * (life.ages[i] - life.ages[i - 1])
+    )
+
+
+def _spall_on(surface: str, design: PRSMDesign, duty: DutyCycle, wear, rng) -> Spall:
+    # Where a spall starts: a random spot of the loaded track of that surface.
+    flank = "loaded" if np.dot(duty.loads, duty.shares) >= 0 else "unloaded"
+    angle = float(rng.uniform(0.0, 2 * math.pi))
+    if surface == "screw":
+        half = 0.45 * min(
+            duty.stroke + design.engaged_threads * design.pitch, design.screw_free_length
+        )
+        return Spall(
+            location="screw",
+            depth=wear.spall_depth,
+            length=wear.spall_initial_length,
+            angle=angle,
+            position=float(rng.uniform(-half, half)),
+            flank=flank,
+        )
+    if surface == "nut":
+        half = 0.5 * design.engaged_threads * design.pitch
+        return Spall(
+            location="nut",
+            depth=wear.spall_depth,
+            length=wear.spall_initial_length,
+            angle=angle,
+            position=float(rng.uniform(-half, half)),
+            flank=flank,
+        )
+    return Spall(
+        location="roller",
+        depth=wear.spall_depth,
+        length=wear.spall_initial_length,
+        angle=angle,
+        roller=int(rng.integers(design.n_rollers)),
+        flank="both",
+    )
+
+
+def fleet_lives(design: PRSMDesign, spec: LifeSpec, fleet_seed: int) -> list[UnitLife]:
+    """Every unit of the fleet (deterministic in ``fleet_seed``)."""
+    geometry = PartGeometry.of(design)
+    return [unit_life(design, spec, u, fleet_seed, geometry) for u in range(spec.units)]

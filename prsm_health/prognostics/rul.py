@@ -1,0 +1,1328 @@
+"""Prognostics: remaining useful life (RUL) of a unit from the history of its diagnoses.
+
+A **history** is a table of diagnoses of one asset over its operating hours (columns
+:data:`HISTORY_COLUMNS`: the age [h] and the diagnosed clearance [m] with its 90 % interval;
+optionally ``design``, ``fault_class``, ``unit_id``). The health indicator is the clearance; a
+unit fails when its true clearance reaches ``threshold`` [m]. A :class:`PrognosticsModel` is
+fitted on a training fleet (the histories of units run to failure and their failure ages) and
+predicts a :class:`Prognosis`: the RUL [h] with a 90 % interval (5 % and 95 % quantiles).
+
+Two methods:
+
+- ``"degradation"`` (default), after Gebraeel et al. [1]_: the exponential degradation model
+  ``S(t) = phi + theta exp(beta t + eps)``, i.e. ``L(t) = ln(S - phi) = ln theta + beta t + eps``,
+  ``eps ~ N(0, sigma^2)`` [1]_, or its linear form ``S(t) = theta + beta t + eps``.
+  ``(ln theta, beta)`` has a bivariate Gaussian prior fitted on the training fleet (per-unit
+  weighted least-squares fits, their mean and covariance, as in [1]_), updated by the unit's
+  history into a Gaussian posterior (the conjugate update of [1]_, with a known variance per
+  diagnosis: ``sigma^2`` plus the measurement variance implied by the diagnosis' 90 % interval,
+  ``(half-width / 1.645)^2``, propagated through the log). The RUL distribution comes from
+  ``n_samples`` posterior draws, each solved for its crossing of the threshold (one draw of
+  ``eps`` per sample: the signal error at the crossing, as in the residual-life distribution
+  of [1]_). Which form a fitted model uses is chosen by the leave-one-unit-out RMSE of RUL on
+  the training fleet.
+- ``"similarity"``, after Wang et al. [2]_: each training unit's smoothed trajectory (its fitted
+  degradation curve) and failure age form a library; the history is aligned to each library
+  curve by the time shift that minimizes its measurement-weighted squared distance, the library
+  units are weighted by a (tempered) Gaussian kernel of that distance, and the RUL is the
+  weighted median (interval: weighted 5 % and 95 % quantiles) of the library units' remaining
+  lives past the aligned age.
+
+Metrics and the fleet evaluation are in :mod:`prsm_health.prognostics.metrics`.
+
+References
+----------
+.. [1] N. Z. Gebraeel, M. A. Lawley, R. Li, J. K. Ryan, "Residual-life distributions from
+   component degradation signals: a Bayesian approach", IIE Transactions 37 (2005) 543-557.
+.. [2] T. Wang, J. Yu, D. Siegel, J. Lee, "A similarity-based prognostics approach for
+   remaining useful life estimation of engineered systems", Int. Conf. on Prognostics and
+   Health Management (PHM 2008), Denver, 2008.
+.. [3] D. A. Harville, "Maximum likelihood approaches to variance component estimation and to
+   related problems", JASA 72 (1977) 320-338 (the restricted likelihood used for ``sigma^2``).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import minimize_scalar
+
+from prsm_health.core.errors import (
+    ModelVersionError,
+    ParameterError,
+    PRSMHealthError,
+    require,
+    require_positive,
+)
+from prsm_health.core.jsonable import json_ready
+
+__all__ = [
+    "HISTORY_COLUMNS",
+    "HistoryError",
+    "Prognosis",
+    "PrognosticsModel",
+    "load_prognostics_model",
+    "prognose",
+    "read_history",
+    "save_prognostics_model",
+    "validate_history",
+]
+
+#: The shipped prognostics model (fitted on datasets/fleet.toml by tools/release/train_prognostics_model.py).
+DEFAULT_PROGNOSTICS_MODEL = Path(__file__).resolve().parents[2] / "models" / "prognostics.json"
+#: Required columns of a history: age [h], clearance estimate and its 90 % interval [m].
+HISTORY_COLUMNS = ("age_hours", "clearance", "clearance_lower", "clearance_upper")
+#: Optional columns a history may carry (checked when present).
+OPTIONAL_COLUMNS = ("design", "fault_class", "unit_id")
+#: Methods :meth:`PrognosticsModel.predict` accepts. ``"degradation"`` uses the form chosen at
+#: fit time; ``"degradation-exponential"`` / ``"degradation-linear"`` force a form.
+METHODS = ("degradation", "degradation-exponential", "degradation-linear", "similarity")
+#: z of the 95 % normal quantile: a diagnosis' 90 % interval is +-1.645 standard deviations.
+Z90 = 1.6448536269514722
+#: Quantiles reported: lower bound, estimate (median), upper bound.
+QUANTILES = (0.05, 0.5, 0.95)
+#: RUL is capped at this multiple of the training fleet's longest life [-] (the horizon):
+#: posterior samples that never reach the threshold (wear rate <= 0) or reach it later get it.
+HORIZON_FACTOR = 3.0
+#: A capped fraction of samples above this moves the 95 % quantile: then a warning says so.
+CAPPED_WARNING_FRACTION = 0.05
+#: A history spanning less than this fraction of the fleet's median life gets a warning.
+SHORT_HISTORY_FRACTION = 0.1
+#: Fewest training units: the leave-one-unit-out prior needs a covariance of at least 2 others.
+MIN_TRAINING_UNITS = 3
+
+_FORMAT = "prsm_health-prognostics"
+_FORMAT_VERSION = 1
+_FORMS = ("exponential", "linear")
+# Floor of sigma^2 in the model's own units (log units; fractions of the threshold): keeps the
+# posterior finite for noiseless histories while being negligible against any real scatter.
+_SIGMA2_FLOOR = 1e-16
+# Ridge added to the prior covariance (scaled parameters, order one): a fleet of identical
+# units still has an invertible prior.
+_PRIOR_RIDGE = 1e-12
+# Candidate margins of phi below the fleet's initial clearance, as fractions of the rise from
+# that level to the threshold (profile-likelihood search, then refined between neighbours).
+_PHI_MARGINS = np.geomspace(1e-3, 1.0, 31)
+# Floor of S - phi in the exponential form, as a fraction of (threshold - phi), for diagnoses
+# without an interval; with an interval the floor is one measurement standard deviation.
+_LOG_FLOOR_FRACTION = 1e-3
+# Similarity alignment: the aligned first diagnosis may lie this fraction of a library unit's
+# life before the unit's first age (its curve extrapolated back). Forbidding it (shifts >= 0
+# only) lets slow units align and penalizes fast or high-starting ones: an upward RUL bias.
+_ALIGN_BEFORE_START = 0.5
+# Similarity alignment: coarse grid of aligned ages, then a fine grid around the best.
+_ALIGN_GRID = 161
+_ALIGN_REFINE = 41
+# Similarity bandwidth: from the excess distance of the k-th nearest library unit,
+# k = max(2, ceil(U/5)).
+_BANDWIDTH_NEIGHBOUR_FRACTION = 0.2
+
+
+class HistoryError(ParameterError):
+    """A history that cannot be used for a prognosis.
+
+    A :class:`~prsm_health.core.errors.ParameterError` whose one-line message names the problem
+    and, where there is one, the offending row (rows counted from 0 in table order).
+    """
+
+    def __init__(self, message: str, field: str = "history", value=None):
+        self.field = field
+        self.value = value
+        self.allowed = message
+        Exception.__init__(self, message)
+
+
+def _package_version() -> str:
+    # Imported lazily: prsm_health/__init__ is outside the layers and may import this module.
+    from prsm_health import __version__
+
+    return __version__
+
+
+def _show(value) -> str:
+    """A table cell for a message: numbers plain (``nan``, ``1e-05``), anything else repr."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float):
+        return f"{value:g}"
+    return repr(value)
+
+
+def _one_line(text) -> str:
+    lines = str(text).strip().splitlines()
+    return lines[0] if lines else type(text).__name__
+
+
+# --------------------------------------------------------------------------------------------
+# Histories
+# --------------------------------------------------------------------------------------------
+
+
+def read_history(path) -> pd.DataFrame:
+    """Read a history table from a CSV or Parquet file (chosen by the suffix).
+
+    Parameters
+    ----------
+    path : str or Path
+        ``*.csv`` or ``*.parquet`` / ``*.pq`` file with the columns :data:`HISTORY_COLUMNS`
+        (``age_hours`` [h], ``clearance``, ``clearance_lower``, ``clearance_upper`` [m]) and
+        optionally ``design``, ``fault_class``, ``unit_id``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The table as read (not yet validated: :func:`validate_history` does that).
+
+    Raises
+    ------
+    PRSMHealthError
+        A missing or unreadable file, an unknown suffix (one line naming the file).
+    HistoryError
+        A required column is missing (the message names the file and the columns).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".csv", ".parquet", ".pq"):
+        raise PRSMHealthError(
+            f"{path}: cannot read history (unknown suffix {suffix!r}; use .csv or .parquet)"
+        )
+    try:
+        table = pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)
+    except FileNotFoundError:
+        raise PRSMHealthError(f"{path}: cannot read history (no such file)") from None
+    except (OSError, ValueError, UnicodeDecodeError, ImportError) as err:
+        raise PRSMHealthError(f"{path}: cannot read history ({_one_line(err)})") from None
+    missing = [c for c in HISTORY_COLUMNS if c not in table.columns]
+    if missing:
+        raise HistoryError(
+            f"{path}: history lacks column(s) {', '.join(missing)} "
+            f"(required: {', '.join(HISTORY_COLUMNS)})",
+            field="history.columns",
+            value=missing,
+        )
+    return table
+
+
+def validate_history(history: pd.DataFrame, model=None) -> pd.DataFrame:
+    """Check a history and return a clean copy (float columns, index 0…n-1, age order).
+
+    Parameters
+    ----------
+    history : pandas.DataFrame
+        Diagnoses of one unit: :data:`HISTORY_COLUMNS` (``age_hours`` [h] strictly increasing
+        from row to row, ``clearance``, ``clearance_lower`` <= ``clearance_upper`` [m], all
+        finite), optionally ``design`` (one design), ``unit_id`` (one unit), ``fault_class``.
+    model : PrognosticsModel, optional
+        When given, a ``design`` column must name ``model.design``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A copy with the required columns as float64 and a fresh index; other columns kept.
+
+    Raises
+    ------
+    HistoryError
+        (a :class:`~prsm_health.core.errors.ParameterError`) with a one-line message: not a table,
+        missing column, fewer than 2 rows, a non-number or non-finite value (column and row),
+        a negative age, ages not strictly increasing (the first offending row), a lower bound
+        above the upper bound (row), several designs or units, a design other than the model's.
+    """
+    if not isinstance(history, pd.DataFrame):
+        raise HistoryError(
+            f"a history must be a pandas DataFrame, not {type(history).__name__}",
+            value=type(history).__name__,
+        )
+    missing = [c for c in HISTORY_COLUMNS if c not in history.columns]
+    if missing:
+        raise HistoryError(
+            f"history lacks column(s) {', '.join(missing)} "
+            f"(required: {', '.join(HISTORY_COLUMNS)})",
+            field="history.columns",
+            value=missing,
+        )
+    n = len(history)
+    if n < 2:
+        raise HistoryError(
+            f"a prognosis needs at least 2 diagnoses over operating hours; the history has {n}",
+            field="history.rows",
+            value=n,
+        )
+    out = history.reset_index(drop=True).copy()
+    for column in HISTORY_COLUMNS:
+        raw = out[column]
+        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size:
+            i = int(bad[0])
+            raise HistoryError(
+                f"history {column} must be a finite number; row {i} has {_show(raw.iloc[i])}",
+                field=f"history.{column}",
+                value=raw.iloc[i],
+            )
+        out[column] = values
+    ages = out["age_hours"].to_numpy()
+    if ages[0] < 0:
+        raise HistoryError(
+            f"history age_hours must be >= 0; row 0 has {ages[0]:g} h",
+            field="history.age_hours",
+            value=float(ages[0]),
+        )
+    steps = np.flatnonzero(np.diff(ages) <= 0)
+    if steps.size:
+        i = int(steps[0]) + 1
+        raise HistoryError(
+            f"history age_hours must be strictly increasing; row {i} has {ages[i]:g} h "
+            f"after {ages[i - 1]:g} h in row {i - 1}",
+            field="history.age_hours",
+            value=float(ages[i]),
+        )
+    lower = out["clearance_lower"].to_numpy()
+    upper = out["clearance_upper"].to_numpy()
+    crossed = np.flatnonzero(lower > upper)
+    if crossed.size:
+        i = int(crossed[0])
+        raise HistoryError(
+            f"history clearance_lower > clearance_upper in row {i} "
+            f"({lower[i]:.6g} m > {upper[i]:.6g} m)",
+            field="history.clearance_lower",
+            value=float(lower[i]),
+        )
+    if "design" in out.columns:
+        designs = sorted({str(d) for d in out["design"].dropna()})
+        if len(designs) > 1:
+            raise HistoryError(
+                f"history mixes designs {', '.join(repr(d) for d in designs)}; "
+                "a prognosis is of one unit of one design",
+                field="history.design",
+                value=designs,
+            )
+        if designs and model is not None and designs[0] != str(model.design):
+            raise HistoryError(
+                f"history is of design {designs[0]!r}, the prognostics model of {model.design!r}",
+                field="history.design",
+                value=designs[0],
+            )
+    if "unit_id" in out.columns:
+        units = out["unit_id"].dropna().unique()
+        if len(units) > 1:
+            shown = ", ".join(_show(u) for u in list(units)[:3])
+            raise HistoryError(
+                f"history mixes units ({shown}{', …' if len(units) > 3 else ''}); "
+                "a prognosis is of one unit",
+                field="history.unit_id",
+                value=len(units),
+            )
+    return out
+
+
+def _arrays(history: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Ages [h], clearance estimates [m] and measurement standard deviations [m]."""
+    t = history["age_hours"].to_numpy(dtype=np.float64)
+    value = history["clearance"].to_numpy(dtype=np.float64)
+    half_width = 0.5 * (
+        history["clearance_upper"].to_numpy(dtype=np.float64)
+        - history["clearance_lower"].to_numpy(dtype=np.float64)
+    )
+    return t, value, half_width / Z90
+
+
+# --------------------------------------------------------------------------------------------
+# Prognosis
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Prognosis:
+    """The remaining useful life of one unit, with the evidence it rests on.
+
+    Attributes
+    ----------
+    rul_hours : dict
+        ``{"estimate", "lower", "upper"}`` [h]: median and 5 % / 95 % quantiles (a 90 %
+        interval); all >= 0.
+    health_indicator : dict
+        ``{"name": "clearance", "unit": "m", "threshold", "ages_hours", "values", "lower",
+        "upper", "current"}``: the history the RUL was predicted from and the failure
+        threshold [m]; ``current`` is the latest clearance estimate [m].
+    model : dict
+        ``{"name", "version", "design", "units_trained", …}``: ``name`` is
+        ``"degradation-exponential"``, ``"degradation-linear"`` or ``"similarity"``; the
+        degradation models add the posterior of ``(ln theta, beta)`` (or ``(theta, beta)``) in
+        physical units [ln m, 1/h] / [m, m/h], ``sigma2``, ``horizon_hours``; the similarity
+        model its ``bandwidth`` and ``effective_units``.
+    warnings : list of str
+        What limits the answer (threshold already crossed, samples capped at the horizon,
+        short history, no wear trend, unit older than the fleet, values below the baseline).
+    """
+
+    rul_hours: dict
+    health_indicator: dict
+    model: dict
+    warnings: list = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        """Plain JSON-ready dict ``{"rul_hours", "health_indicator", "model", "warnings"}``."""
+        return json_ready(
+            {
+                "rul_hours": self.rul_hours,
+                "health_indicator": self.health_indicator,
+                "model": self.model,
+                "warnings": list(self.warnings),
+            }
+        )
+
+
+def _weighted_quantiles(values: np.ndarray, weights: np.ndarray, q) -> np.ndarray:
+    """Quantiles of a weighted sample (linear interpolation between the weight midpoints)."""
+    order = np.argsort(values, kind="stable")
+    v, w = values[order], weights[order]
+    cumulative = (np.cumsum(w) - 0.5 * w) / np.sum(w)
+    return np.interp(q, cumulative, v)
+
+
+# --------------------------------------------------------------------------------------------
+# Degradation model helpers (scaled time tau = t / t_scale)
+# --------------------------------------------------------------------------------------------
+
+
+def _transform(form: str, value, sd, phi: float, threshold: float):
+    """Signal ``y``, its measurement variance and the below-baseline mask for one form.
+
+    Exponential: ``y = ln(max(S - phi, floor))`` with ``floor`` one measurement standard
+    deviation (at least ``_LOG_FLOOR_FRACTION`` of ``threshold - phi``), variance
+    ``(sd / (S - phi))^2`` (delta method). Linear: ``y = S / threshold``.
+    """
+    if form == "linear":
+        return value / threshold, (sd / threshold) ** 2, np.zeros(value.shape, bool)
+    rise = value - phi
+    floor = np.maximum(sd, _LOG_FLOOR_FRACTION * (threshold - phi))
+    x = np.maximum(rise, floor)
+    return np.log(x), (sd / x) ** 2, rise <= 0
+
+
+def _y_threshold(form: str, phi: float, threshold: float) -> float:
+    return 1.0 if form == "linear" else math.log(threshold - phi)
+
+
+def _curve(form: str, a, b, tau, phi: float, threshold: float):
+    """Clearance [m] of the degradation curve ``(a, b)`` at scaled time ``tau``."""
+    if form == "linear":
+        return threshold * (a + b * tau)
+    return phi + np.exp(np.minimum(a + b * tau, 700.0))
+
+
+def _wls_by_unit(tau, y, w, codes, n_units):
+    """Per-unit weighted least squares of ``y = a + b tau``: a, b and det(X'WX) per unit."""
+    sw = np.bincount(codes, w, n_units)
+    st = np.bincount(codes, w * tau, n_units)
+    stt = np.bincount(codes, w * tau * tau, n_units)
+    sy = np.bincount(codes, w * y, n_units)
+    sty = np.bincount(codes, w * tau * y, n_units)
+    det = sw * stt - st * st
+    b = (sw * sty - st * sy) / det
+    a = (sy - b * st) / sw
+    return a, b, det
+
+
+def _neg_reml(sigma2, tau, y, m, codes, n_units) -> float:
+    """-log restricted likelihood (up to a constant) of per-unit lines with variance sigma2+m."""
+    v = sigma2 + m
+    w = 1.0 / v
+    a, b, det = _wls_by_unit(tau, y, w, codes, n_units)
+    r = y - a[codes] - b[codes] * tau
+    return 0.5 * float(np.sum(np.log(v)) + np.sum(r * r * w) + np.sum(np.log(det)))
+
+
+def _fit_sigma2(tau, y, m, codes, n_units) -> tuple[float, float]:
+    """Restricted-maximum-likelihood ``sigma^2`` [3]_ and the minimized objective."""
+    high = max(float(np.var(y)) + 10 * _SIGMA2_FLOOR, 100 * _SIGMA2_FLOOR)
+    at_floor = _neg_reml(_SIGMA2_FLOOR, tau, y, m, codes, n_units)
+    result = minimize_scalar(
+        lambda s: _neg_reml(math.exp(s), tau, y, m, codes, n_units),
+        bounds=(math.log(_SIGMA2_FLOOR), math.log(high)),
+        method="bounded",
+        options={"xatol": 1e-3},
+    )
+    if at_floor <= result.fun:
+        return _SIGMA2_FLOOR, at_floor
+    return math.exp(float(result.x)), float(result.fun)
+
+
+def _profile_phi(tau, value, sd, codes, n_units, c_ref, threshold) -> float:
+    """The baseline phi [m] maximizing the profile likelihood of the clearances ``S``.
+
+    phi = c_ref - margin: for each margin the per-unit lines and sigma^2 are fitted to
+    ``ln(S - phi)`` and the likelihood is transformed back to the clearance with the Jacobian
+    ``1 / (S - phi)``, so margins are compared on the same data.
+    """
+
+    def objective(margin):
+        phi = c_ref - margin
+        y, m, _ = _transform("exponential", value, sd, phi, threshold)
+        _, nll = _fit_sigma2(tau, y, m, codes, n_units)
+        return nll + float(np.sum(y))  # + sum ln(S - phi): the Jacobian of S -> ln(S - phi)
+
+    rise = threshold - c_ref
+    margins = _PHI_MARGINS * rise
+    scores = np.array([objective(mg) for mg in margins])
+    best = int(np.argmin(scores))
+    low = margins[max(best - 1, 0)]
+    high = margins[min(best + 1, len(margins) - 1)]
+    if high > low:
+        refined = minimize_scalar(
+            lambda s: objective(math.exp(s)),
+            bounds=(math.log(low), math.log(high)),
+            method="bounded",
+            options={"xatol": 1e-3},
+        )
+        if refined.fun < scores[best]:
+            return c_ref - math.exp(float(refined.x))
+    return c_ref - float(margins[best])
+
+
+def _prior(params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and covariance (+ ridge) of per-unit parameters (rows: units)."""
+    mean = params.mean(axis=0)
+    cov = np.cov(params, rowvar=False, ddof=1) + _PRIOR_RIDGE * np.eye(2)
+    return mean, cov
+
+
+def _posterior(mean0, cov0, tau, y, v) -> tuple[np.ndarray, np.ndarray]:
+    """Conjugate Gaussian posterior of (a, b) for ``y = a + b tau + e``, ``e ~ N(0, v)``."""
+    precision0 = np.linalg.inv(cov0)
+    w = 1.0 / v
+    xtwx = np.array([[w.sum(), (w * tau).sum()], [(w * tau).sum(), (w * tau * tau).sum()]])
+    xtwy = np.array([(w * y).sum(), (w * tau * y).sum()])
+    precision = precision0 + xtwx
+    cov = np.linalg.inv(precision)
+    cov = 0.5 * (cov + cov.T)
+    return cov @ (precision0 @ mean0 + xtwy), cov
+
+
+def _sample_gaussian(rng, mean, cov, n) -> np.ndarray:
+    values, vectors = np.linalg.eigh(cov)
+    root = vectors * np.sqrt(np.clip(values, 0.0, None))
+    return mean + rng.standard_normal((n, 2)) @ root.T
+
+
+# --------------------------------------------------------------------------------------------
+# The model
+# --------------------------------------------------------------------------------------------
+
+
+class PrognosticsModel:
+    """RUL from a history of diagnoses: Bayesian degradation model and similarity baseline.
+
+    ``__init__`` stores its arguments; :meth:`fit` learns from a training fleet (attributes
+    ending in ``_``); :meth:`predict` returns a :class:`Prognosis`.
+
+    Fitting, degradation model [1]_:
+
+    1. The exponential form's baseline ``phi`` [m] is the fleet's initial clearance level
+       ``c_ref`` (the smallest first diagnosis of a training unit) minus a margin, the margin
+       (between 0.1 % and 100 % of ``threshold - c_ref``) chosen by the profile likelihood of
+       the diagnosed clearances. Diagnoses within one measurement standard deviation of
+       ``phi`` are clipped to ``phi`` + one standard deviation (their log carries no wear
+       information; their variance is then 1 in log units); a history with values at or below
+       ``phi`` gets a warning.
+    2. ``sigma^2`` is the pooled residual variance of per-unit lines, estimated by restricted
+       maximum likelihood [3]_ with each diagnosis' measurement variance added (floored at
+       1e-16 in model units).
+    3. Per-unit weighted least-squares ``(a, b)`` = ``(ln theta, beta)`` (exponential) or
+       ``(theta, beta)`` (linear) give the prior mean and covariance (sample covariance, which
+       includes the per-unit estimation error: a slightly wide, conservative prior).
+    4. The form (exponential or linear) is the one with the lower leave-one-unit-out RMSE of
+       RUL over all history prefixes of >= 2 diagnoses of the training units (each unit
+       predicted with the prior of the others; ``phi`` and ``sigma^2`` kept from the whole
+       fleet; the point prediction is the posterior mean's crossing). Ties go to exponential.
+
+    Prediction: the posterior of ``(a, b)`` given the history (conjugate update), ``n_samples``
+    draws of it and of ``eps``, each solved for the crossing age ``(y_D - a - eps) / b`` with
+    ``y_D = ln(threshold - phi)`` or ``threshold``; RUL = crossing age - current age, clipped
+    to [0, horizon], the horizon being ``3 x`` the fleet's longest life (samples with
+    ``b <= 0`` never cross and get the horizon). When the latest clearance estimate is at or
+    above the threshold the RUL is 0 with a warning.
+
+    Similarity model [2]_: the library curves are the training units' per-unit fits of the
+    chosen form; the alignment distance of library unit i is the weighted sum of squares
+    ``d_i = min_shift sum_j (S_j - c_i(t_j + shift))^2 / (sd_j^2 + r_i^2)`` (``sd_j`` the
+    diagnosis' measurement standard deviation, ``r_i^2`` the unit's residual variance about its
+    curve beyond its measurement noise; the aligned current age ranges from the history's span
+    minus half the unit's life, the curve extrapolated back before its first age, to 1.5 x
+    the unit's life: a grid of 161 ages refined on 41 points around the best). With
+    ``e_i = d_i - min d``, the weight is the Gaussian kernel
+    ``w_i = exp(-e_i / (2 h))``: for ``h = 1`` the likelihood ratio of the history under unit i
+    against the best unit; the bandwidth ``h = max(1, e_(k) / 2)``, ``e_(k)`` the k-th smallest
+    excess, ``k = max(2, ceil(U / 5))``, tempers it so that the k-th nearest unit keeps at least
+    ``exp(-1)`` of the best one's weight (a likelihood over tens of diagnoses would otherwise
+    single out one library unit and give an interval of zero width).
+    ``RUL_i = T_i - aligned current age`` clipped to [0, horizon].
+
+    Parameters
+    ----------
+    method : {"degradation", "similarity", "degradation-exponential", "degradation-linear"}
+        Default method of :meth:`predict`.
+    threshold : float, default 30e-6
+        Clearance at which a unit fails [m], > 0.
+    design : str, default "paper01"
+        Design the model is for; histories with a ``design`` column must match it.
+    n_samples : int, default 4000
+        Posterior samples per degradation prediction, >= 100.
+    random_state : int or None, default 0
+        Seed of the posterior sampling (every prediction restarts from it, so a prediction
+        does not depend on the ones before it); None draws a fresh seed per prediction.
+
+    Attributes
+    ----------
+    form_ : {"exponential", "linear"}
+        Degradation form chosen at fit time.
+    loo_rmse_ : dict
+        Leave-one-unit-out RMSE of RUL [h] of each form.
+    forms_ : dict
+        Per form: ``phi`` [m], ``sigma2``, prior ``mean`` and ``cov``, per-unit ``params``
+        and ``residual_var`` [m^2] (scaled time; linear form in units of the threshold).
+    units_ : list
+        Training unit ids; ``failure_ages_`` [h] in the same order.
+    t_scale_ : float
+        Time scale [h] (median failure age); parameters are fitted against ``age / t_scale_``.
+    horizon_ : float
+        RUL cap [h]: ``HORIZON_FACTOR`` x the longest training life.
+    c_ref_ : float
+        The fleet's initial clearance level [m].
+
+    References
+    ----------
+    .. [1] N. Z. Gebraeel, M. A. Lawley, R. Li, J. K. Ryan, IIE Transactions 37 (2005) 543-557.
+    .. [2] T. Wang, J. Yu, D. Siegel, J. Lee, PHM 2008.
+    .. [3] D. A. Harville, JASA 72 (1977) 320-338.
+    """
+
+    def __init__(
+        self,
+        method="degradation",
+        threshold=30e-6,
+        design="paper01",
+        n_samples=4000,
+        random_state=0,
+    ):
+        self.method = method
+        self.threshold = threshold
+        self.design = design
+        self.n_samples = n_samples
+        self.random_state = random_state
+
+    # ---------------------------------------------------------------------------- parameters
+
+    def _check_params(self) -> None:
+        require(
+            self.method in METHODS, "method", self.method, f"must be one of {', '.join(METHODS)}"
+        )
+        require_positive("threshold", self.threshold)
+        require(
+            isinstance(self.design, str) and self.design != "",
+            "design",
+            self.design,
+            "must be a non-empty design name",
+        )
+        require(
+            isinstance(self.n_samples, (int, np.integer))
+            and not isinstance(self.n_samples, bool)
+            and self.n_samples >= 100,
+            "n_samples",
+            self.n_samples,
+            "must be an integer >= 100",
+        )
+        require(
+            self.random_state is None
+            or (
+                isinstance(self.random_state, (int, np.integer))
+                and not isinstance(self.random_state, bool)
+                and self.random_state >= 0
+            ),
+            "random_state",
+            self.random_state,
+            "must be None or an integer >= 0",
+        )
+
+    def _is_fitted(self) -> bool:
+        return hasattr(self, "forms_")
+
+    def _require_fitted(self) -> None:
+        if not self._is_fitted():
+            raise PRSMHealthError(
+                "the prognostics model is not fitted: call fit(histories, failure_ages) first"
+            )
+
+    # ---------------------------------------------------------------------------- fitting
+
+    def fit(self, histories: pd.DataFrame, failure_ages: Mapping) -> PrognosticsModel:
+        """Fit both methods on a training fleet run to failure.
+
+        Parameters
+        ----------
+        histories : pandas.DataFrame
+            Column ``unit_id`` plus :data:`HISTORY_COLUMNS`: each training unit's diagnoses
+            over its life (ages [h], clearances [m]); each unit needs >= 2 diagnoses.
+        failure_ages : Mapping
+            Unit id -> true age at failure [h] (when its true clearance reached
+            ``threshold``), > 0 for every unit in ``histories``.
+
+        Returns
+        -------
+        PrognosticsModel
+            self.
+
+        Raises
+        ------
+        ParameterError
+            Invalid parameters, fewer than 3 units, a unit without a failure age, a unit's
+            history failing :func:`validate_history` (the message names the unit), a fleet
+            that starts at or above the threshold.
+        """
+        self._check_params()
+        require(
+            isinstance(histories, pd.DataFrame) and "unit_id" in histories.columns,
+            "histories",
+            type(histories).__name__,
+            "must be a pandas DataFrame with a unit_id column",
+        )
+        if isinstance(failure_ages, pd.Series):
+            failure_ages = failure_ages.to_dict()
+        require(
+            isinstance(failure_ages, Mapping),
+            "failure_ages",
+            type(failure_ages).__name__,
+            "must be a mapping unit_id -> age at failure [h]",
+        )
+        units, parts, lives = [], [], []
+        for uid, rows in histories.groupby("unit_id", sort=True):
+            uid = uid.item() if isinstance(uid, np.generic) else uid
+            try:
+                part = validate_history(rows, self)
+            except HistoryError as err:
+                raise HistoryError(f"unit {uid!r}: {err}", err.field, err.value) from None
+            require(uid in failure_ages, "failure_ages", uid, "has no failure age for this unit")
+            life = failure_ages[uid]
+            require(
+                isinstance(life, (int, float, np.number)) and math.isfinite(life) and life > 0,
+                f"failure_ages[{uid!r}]",
+                life,
+                "must be a finite age > 0 [h]",
+            )
+            units.append(uid)
+            parts.append(part)
+            lives.append(float(life))
+        require(
+            len(units) >= MIN_TRAINING_UNITS,
+            "histories",
+            f"{len(units)} unit(s)",
+            f"a prognostics model needs at least {MIN_TRAINING_UNITS} training units",
+        )
+        lives = np.array(lives)
+        c_ref = float(min(p["clearance"].iloc[0] for p in parts))
+        require(
+            self.threshold > c_ref,
+            "threshold",
+            float(self.threshold),
+            f"must exceed the fleet's initial clearance {c_ref:.6g} m",
+        )
+        self.units_ = units
+        self.failure_ages_ = lives
+        self.t_scale_ = float(np.median(lives))
+        self.horizon_ = HORIZON_FACTOR * float(lives.max())
+        self.c_ref_ = c_ref
+
+        codes = np.concatenate([np.full(len(p), i) for i, p in enumerate(parts)])
+        t, value, sd = (np.concatenate(x) for x in zip(*(_arrays(p) for p in parts)))
+        tau = t / self.t_scale_
+        n_units = len(units)
+        thr = float(self.threshold)
+
+        phi = _profile_phi(tau, value, sd, codes, n_units, c_ref, thr)
+        self.forms_ = {}
+        for form in _FORMS:
+            form_phi = phi if form == "exponential" else 0.0
+            y, m, _ = _transform(form, value, sd, form_phi, thr)
+            sigma2, _ = _fit_sigma2(tau, y, m, codes, n_units)
+            a, b, _ = _wls_by_unit(tau, y, 1.0 / (sigma2 + m), codes, n_units)
+            params = np.column_stack([a, b])
+            mean, cov = _prior(params)
+            residual = value - _curve(form, a[codes], b[codes], tau, form_phi, thr)
+            excess = np.bincount(codes, residual**2 - sd**2, n_units) / np.bincount(
+                codes, None, n_units
+            )
+            self.forms_[form] = {
+                "phi": form_phi,
+                "sigma2": sigma2,
+                "mean": mean,
+                "cov": cov,
+                "params": params,
+                "residual_var": np.clip(excess, 0.0, None),
+            }
+        self.loo_rmse_ = {form: self._loo_rmse(form, codes, tau, t, value, sd) for form in _FORMS}
+        self.form_ = min(_FORMS, key=lambda f: (self.loo_rmse_[f], _FORMS.index(f)))
+        return self
+
+    def _loo_rmse(self, form, codes, tau, t, value, sd) -> float:
+        """Leave-one-unit-out RMSE of RUL [h] of one form over every prefix of >= 2 rows."""
+        state = self.forms_[form]
+        thr = float(self.threshold)
+        y, m, _ = _transform(form, value, sd, state["phi"], thr)
+        w = 1.0 / (state["sigma2"] + m)
+        y_d = _y_threshold(form, state["phi"], thr)
+        errors = []
+        for u in range(len(self.units_)):
+            keep = np.arange(len(self.units_)) != u
+            mean0, cov0 = _prior(state["params"][keep])
+            p0 = np.linalg.inv(cov0)
+            r0 = p0 @ mean0
+            rows = codes == u
+            wu, tu, yu = w[rows], tau[rows], y[rows]
+            a00 = p0[0, 0] + np.cumsum(wu)
+            a01 = p0[0, 1] + np.cumsum(wu * tu)
+            a11 = p0[1, 1] + np.cumsum(wu * tu * tu)
+            b0 = r0[0] + np.cumsum(wu * yu)
+            b1 = r0[1] + np.cumsum(wu * tu * yu)
+            det = a00 * a11 - a01 * a01
+            a = (a11 * b0 - a01 * b1) / det
+            b = (a00 * b1 - a01 * b0) / det
+            with np.errstate(divide="ignore", invalid="ignore"):
+                crossing = np.where(b > 0, (y_d - a) / b, np.inf) * self.t_scale_
+            ages = t[rows]
+            rul = np.clip(crossing - ages, 0.0, self.horizon_)
+            rul = np.where(value[rows] >= thr, 0.0, rul)
+            true = self.failure_ages_[u] - ages
+            use = (np.arange(rows.sum()) >= 1) & (true >= 0)
+            errors.append(rul[use] - true[use])
+        errors = np.concatenate(errors)
+        return float(np.sqrt(np.mean(errors**2))) if errors.size else math.inf
+
+    # ---------------------------------------------------------------------------- prediction
+
+    def predict(self, history: pd.DataFrame, method=None) -> Prognosis:
+        """RUL of the unit whose diagnoses ``history`` holds.
+
+        Parameters
+        ----------
+        history : pandas.DataFrame
+            One unit's diagnoses (:data:`HISTORY_COLUMNS`; checked by
+            :func:`validate_history`).
+        method : str, optional
+            One of :data:`METHODS`; default ``self.method``.
+
+        Returns
+        -------
+        Prognosis
+            RUL [h] with its 90 % interval, the health indicator, the model, warnings.
+
+        Raises
+        ------
+        HistoryError
+            A history :func:`validate_history` refuses.
+        ParameterError
+            An unknown method.
+        PRSMHealthError
+            An unfitted model.
+        """
+        self._require_fitted()
+        method = self._resolve_method(method)
+        clean = validate_history(history, self)
+        return self._predict_arrays(*_arrays(clean), method)
+
+    def predict_prefixes(self, history: pd.DataFrame, method=None, min_rows: int = 2) -> list:
+        """Prognoses at every prefix of the history, each from the rows up to it only.
+
+        Parameters
+        ----------
+        history : pandas.DataFrame
+            One unit's diagnoses, validated once by :func:`validate_history`.
+        method : str, optional
+            One of :data:`METHODS`; default ``self.method``.
+        min_rows : int, default 2
+            Shortest prefix predicted from (>= 2).
+
+        Returns
+        -------
+        list of Prognosis
+            One per prefix of ``min_rows`` … ``len(history)`` rows, in age order.
+        """
+        self._require_fitted()
+        method = self._resolve_method(method)
+        require(
+            isinstance(min_rows, (int, np.integer)) and min_rows >= 2,
+            "min_rows",
+            min_rows,
+            "must be an integer >= 2",
+        )
+        t, value, sd = _arrays(validate_history(history, self))
+        return [
+            self._predict_arrays(t[:k], value[:k], sd[:k], method)
+            for k in range(min_rows, len(t) + 1)
+        ]
+
+    def _resolve_method(self, method) -> str:
+        method = self.method if method is None else method
+        require(method in METHODS, "method", method, f"must be one of {', '.join(METHODS)}")
+        return method
+
+    def _predict_arrays(self, t, value, sd, method) -> Prognosis:
+        thr = float(self.threshold)
+        warnings = self._history_warnings(t, value, sd)
+        indicator = {
+            "name": "clearance",
+            "unit": "m",
+            "threshold": thr,
+            "ages_hours": t.tolist(),
+            "values": value.tolist(),
+            "lower": (value - Z90 * sd).tolist(),
+            "upper": (value + Z90 * sd).tolist(),
+            "current": float(value[-1]),
+        }
+        if method == "similarity":
+            rul, model = self._similarity(t, value, sd)
+        else:
+            form = self.form_ if method == "degradation" else method.split("-", 1)[1]
+            rul, model, more = self._degradation(form, t, value, sd)
+            warnings.extend(more)
+        if value[-1] >= thr:
+            warnings.insert(
+                0,
+                f"threshold already crossed: the latest clearance {value[-1]:.4g} m is at or "
+                f"above the threshold {thr:.4g} m; RUL 0",
+            )
+            rul = {"estimate": 0.0, "lower": 0.0, "upper": 0.0}
+        return Prognosis(rul_hours=rul, health_indicator=indicator, model=model, warnings=warnings)
+
+    def _base_model_dict(self, name: str) -> dict:
+        return {
+            "name": name,
+            "version": _package_version(),
+            "design": self.design,
+            "units_trained": len(self.units_),
+            "threshold": float(self.threshold),
+            "horizon_hours": self.horizon_,
+        }
+
+    def _history_warnings(self, t, value, sd) -> list:
+        warnings = []
+        span = float(t[-1] - t[0])
+        median_life = float(np.median(self.failure_ages_))
+        if span < SHORT_HISTORY_FRACTION * median_life:
+            warnings.append(
+                f"history shorter than the model's minimum span: {span:.4g} h < "
+                f"{SHORT_HISTORY_FRACTION:.0%} of the training fleet's median life "
+                f"({median_life:.4g} h); the RUL mostly reflects the fleet"
+            )
+        if t[-1] > self.failure_ages_.max():
+            warnings.append(
+                f"unit age {t[-1]:.4g} h is beyond the longest training life "
+                f"{self.failure_ages_.max():.4g} h: the RUL is extrapolated"
+            )
+        w = 1.0 / (sd**2 + (1e-8 * float(self.threshold)) ** 2)
+        tm = np.sum(w * t) / np.sum(w)
+        slope = np.sum(w * (t - tm) * value)
+        if slope <= 0:
+            warnings.append(
+                "health indicator decreasing: no wear trend yet, interval is the fleet's"
+            )
+        return warnings
+
+    def _degradation(self, form, t, value, sd):
+        state = self.forms_[form]
+        thr = float(self.threshold)
+        phi = state["phi"]
+        y, m, below = _transform(form, value, sd, phi, thr)
+        warnings = []
+        if below.any():
+            warnings.append(
+                f"{int(below.sum())} of {len(value)} diagnoses at or below the model's baseline "
+                f"phi = {phi:.4g} m (the fleet's initial clearance level minus a margin): "
+                "clipped; this unit starts tighter than the training fleet"
+            )
+        tau = t / self.t_scale_
+        mean, cov = _posterior(state["mean"], state["cov"], tau, y, state["sigma2"] + m)
+        rng = np.random.default_rng(self.random_state)
+        draws = _sample_gaussian(rng, mean, cov, int(self.n_samples))
+        eps = rng.standard_normal(int(self.n_samples)) * math.sqrt(state["sigma2"])
+        a, b = draws[:, 0], draws[:, 1]
+        y_d = _y_threshold(form, phi, thr)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            crossing = np.where(b > 0, (y_d - a - eps) / b, np.inf) * self.t_scale_
+        rul = crossing - t[-1]
+        capped = float(np.mean(rul >= self.horizon_))
+        rul = np.clip(rul, 0.0, self.horizon_)
+        low, mid, high = np.quantile(rul, QUANTILES)
+        if capped > CAPPED_WARNING_FRACTION:
+            warnings.append(
+                f"{capped:.0%} of the posterior samples never reach the threshold (wear rate "
+                f"<= 0) or reach it beyond the horizon; their RUL is capped at {self.horizon_:.4g} "
+                f"h ({HORIZON_FACTOR:g}x the fleet's longest life)"
+            )
+        scale = (
+            np.array([1.0, 1.0 / self.t_scale_])
+            if form == "exponential"
+            else np.array([thr, thr / self.t_scale_])
+        )
+        model = self._base_model_dict(f"degradation-{form}")
+        model.update(
+            {
+                "parameters": ["ln_theta", "beta_per_hour"]
+                if form == "exponential"
+                else ["theta_m", "beta_m_per_hour"],
+                "posterior_mean": (mean * scale).tolist(),
+                "posterior_cov": (cov * np.outer(scale, scale)).tolist(),
+                "phi": phi,
+                "sigma2": state["sigma2"],
+                "n_samples": int(self.n_samples),
+                "capped_fraction": capped,
+                "selection": {"form": self.form_, "loo_rmse_hours": dict(self.loo_rmse_)},
+            }
+        )
+        rul_hours = {"estimate": float(mid), "lower": float(low), "upper": float(high)}
+        return rul_hours, model, warnings
+
+    def _similarity(self, t, value, sd):
+        form = self.form_
+        state = self.forms_[form]
+        thr = float(self.threshold)
+        phi = state["phi"]
+        params = state["params"]
+        lives = self.failure_ages_
+        n_units, n = len(lives), len(t)
+        tiny = (1e-8 * thr) ** 2
+        weights = 1.0 / (sd[None, :] ** 2 + state["residual_var"][:, None] + tiny)  # (U, n)
+        # aligned current ages from (history span - half the unit's life) to 1.5 x its life
+        bottom = (t[-1] - t[0]) - _ALIGN_BEFORE_START * lives
+        top = np.maximum(1.5 * lives, bottom + 1e-3 * lives)
+
+        back = (t[-1] - t) / self.t_scale_  # scaled time of each diagnosis before the latest
+        if form == "exponential":  # exp(a + b (A - back)) = exp(a + b A) exp(-b back)
+            decay = np.exp(-params[:, 1, None] * back[None, :])  # (U, n)
+
+        def distances(aligned):  # aligned current ages (U, G) -> weighted squared distance
+            now = aligned / self.t_scale_
+            if form == "exponential":
+                level = np.exp(np.minimum(params[:, 0, None] + params[:, 1, None] * now, 700.0))
+                curve = phi + level[:, :, None] * decay[:, None, :]
+            else:
+                curve = _curve(
+                    form,
+                    params[:, 0, None, None],
+                    params[:, 1, None, None],
+                    now[:, :, None] - back[None, None, :],
+                    phi,
+                    thr,
+                )
+            return np.einsum("un,ugn->ug", weights, (value[None, None, :] - curve) ** 2)
+
+        grid = (
+            bottom[:, None] + (top - bottom)[:, None] * np.linspace(0.0, 1.0, _ALIGN_GRID)[None, :]
+        )
+        d = distances(grid)
+        best = np.argmin(d, axis=1)
+        rows = np.arange(n_units)
+        low = grid[rows, np.maximum(best - 1, 0)]
+        high = grid[rows, np.minimum(best + 1, _ALIGN_GRID - 1)]
+        fine = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, _ALIGN_REFINE)[None, :]
+        d_fine = distances(fine)
+        pick = np.argmin(d_fine, axis=1)
+        aligned = fine[rows, pick]
+        excess = d_fine[rows, pick]
+        excess = excess - excess.min()
+        k = max(2, math.ceil(_BANDWIDTH_NEIGHBOUR_FRACTION * n_units))
+        bandwidth = max(1.0, 0.5 * float(np.sort(excess)[min(k, n_units) - 1]))
+        w = np.exp(-excess / (2.0 * bandwidth))
+        rul = np.clip(lives - aligned, 0.0, self.horizon_)
+        low_q, mid, high_q = _weighted_quantiles(rul, w, QUANTILES)
+        model = self._base_model_dict("similarity")
+        model.update(
+            {
+                "form": form,
+                "bandwidth": bandwidth,
+                "effective_units": float(w.sum() ** 2 / np.sum(w**2)),
+                "nearest_unit": self.units_[int(np.argmin(excess))],
+                "history_points": n,
+            }
+        )
+        rul_hours = {"estimate": float(mid), "lower": float(low_q), "upper": float(high_q)}
+        return rul_hours, model
+
+    # ---------------------------------------------------------------------------- persistence
+
+    def to_dict(self) -> dict:
+        """Plain JSON-able dict of the parameters and the fitted state (no pickle)."""
+        out = {
+            "format": _FORMAT,
+            "format_version": _FORMAT_VERSION,
+            "version": _package_version(),
+            "params": {
+                "method": self.method,
+                "threshold": self.threshold,
+                "design": self.design,
+                "n_samples": self.n_samples,
+                "random_state": self.random_state,
+            },
+            "fitted": None,
+        }
+        if self._is_fitted():
+            out["fitted"] = {
+                "units": list(self.units_),
+                "failure_ages": self.failure_ages_,
+                "t_scale": self.t_scale_,
+                "horizon": self.horizon_,
+                "c_ref": self.c_ref_,
+                "form": self.form_,
+                "selection_rule": "lower leave-one-unit-out RMSE of RUL on the training fleet",
+                "loo_rmse": dict(self.loo_rmse_),
+                "forms": self.forms_,
+            }
+        return json_ready(out)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> PrognosticsModel:
+        """Rebuild a model from :meth:`to_dict` output.
+
+        Raises
+        ------
+        PRSMHealthError
+            Not a prognostics-model dict, or a malformed one (one line naming the problem).
+        ModelVersionError
+            A dict of another format version.
+        """
+        if not isinstance(d, dict) or d.get("format") != _FORMAT:
+            raise PRSMHealthError("not a prsm_health prognostics model (unknown format)")
+        if d.get("format_version") != _FORMAT_VERSION:
+            raise ModelVersionError(
+                f"prognostics model format version {d.get('format_version')!r}; this "
+                f"prsm_health {_package_version()} reads version {_FORMAT_VERSION}"
+            )
+        try:
+            model = cls(**d["params"])
+            model._check_params()
+            fitted = d["fitted"]
+            if fitted is not None:
+                model.units_ = list(fitted["units"])
+                model.failure_ages_ = np.asarray(fitted["failure_ages"], dtype=np.float64)
+                model.t_scale_ = float(fitted["t_scale"])
+                model.horizon_ = float(fitted["horizon"])
+                model.c_ref_ = float(fitted["c_ref"])
+                model.loo_rmse_ = {f: float(fitted["loo_rmse"][f]) for f in _FORMS}
+                form = fitted["form"]
+                if form not in _FORMS:
+                    raise ValueError(f"unknown form {form!r}")
+                model.form_ = form
+                forms = {}
+                for name in _FORMS:
+                    s = fitted["forms"][name]
+                    forms[name] = {
+                        "phi": float(s["phi"]),
+                        "sigma2": float(s["sigma2"]),
+                        "mean": np.asarray(s["mean"], dtype=np.float64).reshape(2),
+                        "cov": np.asarray(s["cov"], dtype=np.float64).reshape(2, 2),
+                        "params": np.asarray(s["params"], dtype=np.float64).reshape(-1, 2),
+                        "residual_var": np.asarray(s["residual_var"], dtype=np.float64),
+                    }
+                    units = len(model.units_)
+                    if len(forms[name]["params"]) != units or len(model.failure_ages_) != units:
+                        raise ValueError("unit count mismatch")
+                    if not all(np.all(np.isfinite(v)) for v in forms[name].values()):
+                        raise ValueError("non-finite parameter")
+                model.forms_ = forms
+        except ParameterError as err:
+            raise PRSMHealthError(f"malformed prognostics model ({_one_line(err)})") from None
+        except (KeyError, TypeError, ValueError, AttributeError) as err:
+            what = f"missing {err}" if isinstance(err, KeyError) else _one_line(err)
+            raise PRSMHealthError(f"malformed prognostics model ({what})") from None
+        return model
+
+
+def save_prognostics_model(path, model: PrognosticsModel) -> Path:
+    """Write a fitted model as a JSON file (atomically: temporary file, then rename).
+
+    Parameters
+    ----------
+    path : str or Path
+        Destination (conventionally ``*.json``); replaced if it exists.
+    model : PrognosticsModel
+        A fitted model.
+
+    Returns
+    -------
+    Path
+        The written file.
+
+    Raises
+    ------
+    ParameterError
+        Not a fitted :class:`PrognosticsModel`.
+    PRSMHealthError
+        An unwritable path.
+    """
+    path = Path(path)
+    require(
+        isinstance(model, PrognosticsModel) and model._is_fitted(),
+        "model",
+        type(model).__name__,
+        "must be a fitted PrognosticsModel",
+    )
+    from prsm_health.diagnostics.model_files import write_atomic
+
+    text = json.dumps(model.to_dict(), indent=1, allow_nan=False)
+    write_atomic(path, text.encode("utf-8"), "prognostics model")
+    return path
+
+
+def load_prognostics_model(path=None) -> PrognosticsModel:
+    """Read a model written by :func:`save_prognostics_model` (default: the shipped one,
+    :data:`DEFAULT_PROGNOSTICS_MODEL`).
+
+    Raises
+    ------
+    PRSMHealthError
+        A missing, unreadable, non-JSON or malformed file (one line naming the file).
+    ModelVersionError
+        A file of another format version.
+    """
+    path = DEFAULT_PROGNOSTICS_MODEL if path is None else path
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise PRSMHealthError(f"{path}: cannot read prognostics model (no such file)") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise PRSMHealthError(f"{path}: cannot read prognostics model ({_one_line(err)})") from None
+    try:
+        d = json.loads(text)
+    except ValueError as err:
+        raise PRSMHealthError(f"{path}: not a prognostics model (invalid JSON: {err})") from None
+    try:
+        return PrognosticsModel.from_dict(d)
+    except ModelVersionError as err:
+        raise ModelVersionError(f"{path}: {err}") from None
+    except PRSMHealthError as err:
+        raise PRSMHealthError(f"{path}: {err}") from None
+
+
+def prognose(history: pd.DataFrame, model: PrognosticsModel, method=None) -> Prognosis:
+    """RUL of one unit: :func:`validate_history` then :meth:`PrognosticsModel.predict`.
+
+    Parameters
+    ----------
+    history : pandas.DataFrame
+        One unit's diagnoses (:data:`HISTORY_COLUMNS`).
+    model : PrognosticsModel
+        A fitted model.
+    method : str, optional
+        One of :data:`METHODS`; default ``model.method``.
+
+    Returns
+    -------
+    Prognosis
+    """
+    require(
+        isinstance(model, PrognosticsModel),
+        "model",
+        type(model).__name__,
+        "must be a PrognosticsModel",
+    )
+    clean = validate_history(history, model)
+    return model.predict(clean, method=method)
+
+
+def fleet_histories(
+    dataset,
+    bundle=None,
+    *,
+    units=None,
+    until_age: float | None = None,
+    progress: bool = False,
+    batch: int = 32,
+) -> pd.DataFrame:
+    """Diagnose the snapshots of a fleet dataset (a life recipe's) in batches: one history row
+    per snapshot.
+
+    Parameters
+    ----------
+    dataset : str, Path or :class:`~prsm_health.datasets.dataset.Dataset`
+    bundle : ModelBundle, default the shipped diagnosis model
+    units : iterable of int or None
+        The units to diagnose (default all).
+    until_age : float or None [h]
+        Only snapshots at ages ≤ this (what was known then).
+    progress : bool
+        A progress bar on stderr.
+
+    Returns
+    -------
+    DataFrame
+        ``unit_id``, :data:`HISTORY_COLUMNS`, ``design``, ``fault_class``, and the labels a
+        prognosis is scored against: ``split``, ``rul_hours``, ``failure_age_hours``,
+        ``failure_mode``, ``clearance_mean_true`` — sorted by unit and age.
+
+    Raises
+    ------
+    PRSMHealthError
+        A dataset without life labels (not made from a recipe with ``[life]``), or no
+        snapshot left after ``units`` and ``until_age``.
+    """
+    from prsm_health.datasets import Dataset
+    from prsm_health.diagnostics.diagnosis import diagnose_runs, load_bundle
+
+    dataset = dataset if isinstance(dataset, Dataset) else Dataset(dataset)
+    labels = dataset.runs
+    if "unit_id" not in labels.columns:
+        raise PRSMHealthError(
+            f"{dataset.path}: not a fleet dataset (no unit_id label): generate it from a recipe "
+            "with a [life] table (docs/prognostics.md)"
+        )
+    chosen = labels
+    if units is not None:
+        wanted = {int(u) for u in units}
+        unknown = sorted(wanted - set(labels["unit_id"].astype(int)))
+        if unknown:
+            raise PRSMHealthError(
+                f"{dataset.path}: no unit {unknown[0]} (units 0–{int(labels['unit_id'].max())})"
+            )
+        chosen = chosen[chosen["unit_id"].astype(int).isin(wanted)]
+    if until_age is not None:
+        chosen = chosen[chosen["age_hours"] <= until_age]
+    if chosen.empty:
+        raise PRSMHealthError(
+            f"{dataset.path}: no snapshot at or before {until_age:g} h for the chosen unit"
+        )
+    chosen = chosen.sort_values(["unit_id", "age_hours"])
+    bundle = bundle or load_bundle()
+    ids = [int(i) for i in chosen["run_id"]]
+    diagnoses = []
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(ids), desc="diagnosing snapshots", unit="run")
+    for start in range(0, len(ids), batch):
+        runs = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
+        diagnoses.extend(diagnose_runs(runs, bundle))
+        if bar is not None:
+            bar.update(len(runs))
+    if bar is not None:
+        bar.close()
+    out = pd.DataFrame(
+        {
+            "unit_id": chosen["unit_id"].astype(int).to_numpy(),
+            "age_hours": chosen["age_hours"].to_numpy(float),
+            "clearance": [d.clearance["estimate"] for d in diagnoses],
+            "clearance_lower": [d.clearance["lower"] for d in diagnoses],
+            "clearance_upper": [d.clearance["upper"] for d in diagnoses],
+            "design": chosen["design"].to_numpy(),
+            "fault_class": [d.fault_class for d in diagnoses],
+        }
+    )
+    for label in ("split", "rul_hours", "failure_age_hours", "failure_mode", "clearance_mean_true"):
+        out[label] = chosen[label].to_numpy()
+    return out.reset_index(drop=True)

@@ -1,0 +1,716 @@
+"""Condition indicators of a run or a window: gear mesh, shifted axial frequency, classic, torque.
+
+Every indicator is a named float with a documented unit (:data:`FEATURES`); an indicator that a
+window cannot support (no reversal for lost motion, no speed for mesh lines) is NaN — the
+estimators handle missing values. Spectra use Hann windows with explicit scaling:
+
+* amplitude spectra are corrected for the window's coherent gain (a sinusoid of amplitude A
+  reads A) — :func:`prsm_health.signals.spectra.amplitude_spectrum`;
+* power spectral densities are Welch estimates (Hann, 75 % overlap, density scaling, units²/Hz);
+  band energies integrate them (units², i.e. the band's mean-square value).
+
+Indicators are computed from the measured channels (:attr:`Run.channels`) only. A channel the
+recording lacks (an instrumentation profile without the load cell, without some accelerometer
+axes) makes the indicators that need it NaN: the indicator set is always :data:`FEATURES`.
+Truth signals (:attr:`Run.truth`, simulator only) are read only when the caller names them
+(``extract_features(run, truth=("friction_torque",))``, :data:`TRUTH_FEATURES`): research
+indicators, never a model input by default.
+
+Gear-mesh lines are located from the measured screw speed through the design's rigid-body
+carrier ratio (from the true carrier speed only when ``"carrier_speed"`` is asked for); when the
+speed varies by more than 5 % in a window the signal is resampled to uniform screw angle (order
+domain) before the spectrum.
+
+The shifted-axial-frequency indicator compares the dominant nut axial frequency with the healthy
+baseline the physics predicts for the same design and load: √(k_axial/m_N)/2π, k_axial the
+paper-04 thread stiffness of all rollers (screw and nut sides in series) at the run's mean load.
+
+References
+----------
+Paper 01 §3.2–3.3 (mesh frequency, axial frequency shift with clearance); paper 04 (axial
+stiffness); paper 02 (friction torque, efficiency).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+from prsm_health.actuator.design import PRSMDesign, preset
+from prsm_health.core.channels import CHANNEL_NAMES, VIBRATION
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.run import MIN_SAMPLES, Run, ms_hint
+from prsm_health.physics.kinematics import defect_frequencies, speed_ratios
+
+from .envelope_analysis import defect_lines_batch
+from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
+from .kernels import (
+    hysteresis_crossings,
+    moment_sums,
+    screw_power_sums,
+    step_polynomial_normal_equations,
+    subtract_polynomial,
+)
+from .spectra import amplitude_spectrum, peak_frequency, welch_psd
+
+SHORT = {
+    "nut_axial_accel": "ax",
+    "nut_tangential_accel": "tan",
+    "nut_radial_x_accel": "rx",
+    "nut_radial_y_accel": "ry",
+}
+BANDS = ((50.0, 300.0), (300.0, 1000.0), (1000.0, 3000.0), (3000.0, 10000.0))
+MESH_CHANNELS = ("nut_tangential_accel", "nut_radial_x_accel")
+#: Channels averaged synchronously (TSA) and the periods averaged over: a carrier revolution
+#: (the ring gear meshes z_ring times in it) and a roller spin relative to the carrier (its gear
+#: meshes z_roller times) — both non-integer numbers of screw turns (docs/gear-indicators.md).
+TSA_CHANNELS = ("nut_axial_accel", "nut_tangential_accel")
+TSA_PERIODS = ("carrier", "roller")
+TSA_INDICATORS = tuple(n for n in GEAR_INDICATORS if n != "periods")
+#: Channels whose envelope is read at the defect frequencies (docs/envelope-analysis.md), and the
+#: defect locations (prsm_health.physics.kinematics.defect_frequencies).
+ENVELOPE_CHANNELS = ("nut_axial_accel", "nut_tangential_accel")
+DEFECTS = (
+    "screw_flank",
+    "nut_flank",
+    "roller_flank",
+    "ring_gear_tooth",
+    "roller_gear_tooth",
+    "carrier",
+)
+ORDER_TRACKING_SPREAD = 0.05
+#: Most windows processed together by :func:`extract_features_batch` (memory: the
+#: mean-removed vibration of a window of 20,000 samples takes 0.64 MB).
+BATCH_WINDOWS = 16
+#: The design of a rig that is not a PRSM (imported recordings): no design-dependent indicators.
+NO_DESIGN = "none"
+
+
+def _feature_table() -> dict[str, str]:
+    units = {}
+    for s in SHORT.values():
+        units[f"{s}_rms"] = "m/s²"
+        units[f"{s}_peak"] = "m/s²"
+        units[f"{s}_crest"] = "-"
+        units[f"{s}_kurtosis"] = "-"
+        units[f"{s}_skewness"] = "-"
+        for lo, hi in BANDS:
+            units[f"{s}_band_{int(lo)}_{int(hi)}"] = "(m/s²)²"
+    for ch in MESH_CHANNELS:
+        s = SHORT[ch]
+        for k in (1, 2, 3):
+            units[f"{s}_mesh_h{k}"] = "m/s²"
+        units[f"{s}_mesh_sidebands"] = "m/s²"
+    for ch in ENVELOPE_CHANNELS:
+        s = SHORT[ch]
+        units[f"{s}_sk_max"] = "-"
+        units[f"{s}_sk_band_centre"] = "Hz"
+        for defect in DEFECTS:
+            units[f"{s}_env_{defect}"] = "m/s²"
+            units[f"{s}_env_{defect}_ratio"] = "-"
+            units[f"{s}_env_{defect}_ratio_sum"] = "-"
+    for ch in TSA_CHANNELS:
+        for period in TSA_PERIODS:
+            for name in TSA_INDICATORS:
+                unit = "m/s²" if name in ("tsa_rms", "sideband_index") else "-"
+                units[f"{SHORT[ch]}_tsa_{period}_{name}"] = unit
+    units.update(
+        {
+            "mesh_frequency": "Hz",
+            "axial_dominant_frequency": "Hz",
+            "axial_baseline_frequency": "Hz",
+            "axial_frequency_shift": "Hz",
+            "axial_frequency_shift_relative": "-",
+            "axial_dominant_amplitude": "m/s²",
+            "drive_torque_mean": "N·m",
+            "drive_torque_ripple": "N·m",
+            "efficiency": "-",
+            "lost_motion": "m",
+            "torque_rattle_rate": "1/s",
+            "speed_mean": "rad/s",
+            "load_mean": "N",
+            "load_range": "N",
+            "reversal": "-",
+        }
+    )
+    return units
+
+
+#: Indicator name → unit, in the column order of :func:`extract_features`: measured channels only.
+FEATURES: dict[str, str] = _feature_table()
+
+#: Truth signals :func:`extract_features` reads when asked (``truth=(name, …)``), and the
+#: indicators each adds (after :data:`FEATURES`). ``carrier_speed`` adds none: it locates the
+#: mesh lines from the true carrier speed instead of the measured screw speed.
+TRUTH_FEATURES: dict[str, dict[str, str]] = {
+    "friction_torque": {"friction_torque_mean": "N·m", "friction_torque_ripple": "N·m"},
+    "carrier_speed": {},
+}
+
+#: Indicator groups for importance and ablation studies.
+GROUPS = {
+    "mesh": [k for k in FEATURES if "_mesh_" in k] + ["mesh_frequency"],
+    "axial_frequency": [k for k in FEATURES if k.startswith("axial_")],
+    "classic": [
+        k
+        for k in FEATURES
+        if k.split("_")[0] in SHORT.values()
+        and not any(tag in k for tag in ("_mesh_", "_tsa_", "_env_", "_sk_"))
+    ],
+    "gear": [k for k in FEATURES if "_tsa_" in k],
+    "envelope": [k for k in FEATURES if "_env_" in k or "_sk_" in k],
+    "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
+    "lost_motion": ["lost_motion"],
+    "torque_rattle": ["torque_rattle_rate"],
+    "operating": ["speed_mean", "load_mean", "load_range", "reversal"],
+}
+
+
+@dataclass(frozen=True)
+class Needs:
+    """The measured channels an indicator group reads: all of ``all_of`` and, when ``any_of``
+    is not empty, at least one of it."""
+
+    all_of: tuple[str, ...] = ()
+    any_of: tuple[str, ...] = ()
+
+    def missing(self, channels) -> list[str]:
+        """What a set of channels lacks for this group (``a or b`` for an any-of set)."""
+        out = [c for c in self.all_of if c not in channels]
+        if self.any_of and not any(c in channels for c in self.any_of):
+            out.append(" or ".join(self.any_of))
+        return out
+
+
+#: The channels each indicator group needs: declared once. A window without them has the
+#: group's indicators NaN; a diagnosis names the groups it could not compute and why.
+GROUP_CHANNELS: dict[str, Needs] = {
+    "mesh": Needs(("screw_speed",), MESH_CHANNELS),
+    "axial_frequency": Needs(("nut_axial_accel",)),
+    "classic": Needs(any_of=VIBRATION),
+    "gear": Needs(("screw_angle",), TSA_CHANNELS),
+    "envelope": Needs(("screw_speed",), ENVELOPE_CHANNELS),
+    "torque": Needs(("drive_torque",)),
+    "lost_motion": Needs(("nut_position", "screw_angle")),
+    "torque_rattle": Needs(("drive_torque",)),
+    "operating": Needs(any_of=("screw_speed", "axial_load", "drive_torque")),
+}
+
+
+def indicator_groups(row: dict, channels) -> dict[str, str]:
+    """Each indicator group of a window's indicators → ``"computed"`` (at least one finite
+    value), or why not: the channels it lacks, or that the window does not support it."""
+    out = {}
+    for group, members in GROUPS.items():
+        values = [row.get(name) for name in members]
+        if any(v is not None and np.isfinite(v) for v in values):
+            out[group] = "computed"
+        elif missing := GROUP_CHANNELS[group].missing(channels):
+            out[group] = "missing channel(s) " + ", ".join(missing)
+        else:
+            out[group] = "not supported by this window (e.g. no reversal, too slow or too short)"
+    return out
+
+
+@lru_cache(maxsize=256)
+def axial_baseline_frequency(design: PRSMDesign, load: float) -> float:
+    """Healthy nut axial frequency √(k_axial/m_N)/2π [Hz] at an axial load [N] (paper 04 stiffness)."""
+    from prsm_health.physics.stiffness.thread import roller_side_stiffness
+
+    per_roller = max(abs(load), 20.0) / design.n_rollers
+    k_s = float(roller_side_stiffness(design, per_roller, "screw"))
+    k_n = float(roller_side_stiffness(design, per_roller, "nut"))
+    k = design.n_rollers * k_s * k_n / (k_s + k_n)
+    return math.sqrt(k / design.masses.nut_mass) / (2 * math.pi)
+
+
+def _classic(centred: np.ndarray, rate: float) -> dict[str, np.ndarray]:
+    """Classic indicators of mean-removed signals (..., n): name suffix → array (...)."""
+    # moments about the mean, biased (scipy.stats.kurtosis(fisher=False) and skew): the sums
+    # of x², x³, x⁴ and the extremes in one compiled pass (numpy made five over the batch)
+    sums = np.empty(centred.shape[:-1] + (5,))
+    moment_sums(centred.reshape(-1, centred.shape[-1]), sums.reshape(-1, 5))
+    m2, m3, m4 = (sums[..., k] / centred.shape[-1] for k in range(3))
+    rms = np.sqrt(m2)
+    peak = np.maximum(sums[..., 3], -sums[..., 4])
+    live = rms > 0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = {
+            "rms": rms,
+            "peak": peak,
+            "crest": np.where(live, peak / rms, np.nan),
+            "kurtosis": np.where(live, m4 / m2**2, np.nan),
+            "skewness": np.where(live, m3 / m2**1.5, np.nan),
+        }
+    nperseg = min(1024, centred.shape[-1])
+    f, psd = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
+    df = f[1] - f[0]
+    for lo, hi in BANDS:
+        a, b = np.searchsorted(f, (lo, min(hi, rate / 2)))  # the bins lo ≤ f < hi
+        out[f"band_{int(lo)}_{int(hi)}"] = (
+            np.sum(psd[..., a:b], axis=-1) * df if b > a else np.full(psd.shape[:-1], np.nan)
+        )
+    return out
+
+
+def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
+    # Largest amplitude within ±max(2 bins, 0.5 %) of the target: the line may fall between
+    # bins and the speed estimate carries its own error.
+    if not np.isfinite(target) or target <= 0 or target >= freq[-1]:
+        return np.nan
+    half = max(2 * (freq[1] - freq[0]), 0.005 * target)
+    a = np.searchsorted(freq, target - half, side="left")
+    b = np.searchsorted(freq, target + half, side="right")
+    return float(np.max(amp[a:b])) if b > a else np.nan
+
+
+def _order_resample(x: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, float]:
+    # Uniform screw-angle grid with the same number of samples: spectrum in orders per radian.
+    grid = np.linspace(angle[0], angle[-1], len(angle))
+    return np.interp(grid, angle, x), (grid[1] - grid[0])
+
+
+def _truth_request(run: Run, truth) -> tuple[str, ...]:
+    """The truth signals asked for, checked: known to :data:`TRUTH_FEATURES` and in the run."""
+    if isinstance(truth, str):
+        raise PRSMHealthError(f"truth = {truth!r}: give a tuple of names, e.g. ({truth!r},)")
+    truth = tuple(truth)
+    unknown = [n for n in truth if n not in TRUTH_FEATURES]
+    if unknown:
+        raise PRSMHealthError(
+            f"no truth indicator reads {', '.join(map(repr, unknown))}; "
+            f"available: {', '.join(TRUTH_FEATURES)}"
+        )
+    missing = [n for n in truth if n not in run.truth]
+    if missing:
+        raise PRSMHealthError(
+            f"truth {', '.join(missing)} asked for, but the run has no such truth signal "
+            "(only simulated runs have truth)"
+        )
+    return truth
+
+
+def extract_features(
+    run: Run,
+    design: PRSMDesign | str | None = None,
+    *,
+    truth: tuple[str, ...] = (),
+    lead: float | None = None,
+) -> dict[str, float]:
+    """All indicators of one run or window.
+
+    Parameters
+    ----------
+    run : Run
+        Measured channels at ``run.sample_rate``; missing channels give NaN indicators.
+        ``run.truth`` is not read unless named in ``truth``.
+    design : PRSMDesign, preset name, :data:`NO_DESIGN` or None
+        Default: the run's ``labels["design"]``, else paper01. :data:`NO_DESIGN` (or a run
+        labelled ``design = None``, an imported rig that is not a PRSM): the indicators that
+        need the design's kinematics (mesh, gear, envelope, axial baseline) are NaN.
+    lead : float or None [m per revolution of screw_angle]
+        Without a design, the lead lost motion needs (default the run's ``labels["lead"]``).
+    truth : tuple of str
+        Truth signals to use (keys of :data:`TRUTH_FEATURES`), research only: each adds its
+        indicators; ``"carrier_speed"`` locates the mesh lines from the true carrier speed.
+
+    Returns
+    -------
+    dict of name → float, in :data:`FEATURES` order and units, then the indicators of the
+    truth signals asked for.
+
+    Raises
+    ------
+    RecordingError
+        The measured channels (or the truth signals asked for) cannot be processed.
+    PRSMHealthError
+        No nut acceleration and no nut position; an unknown or absent truth signal asked for.
+    """
+    return extract_features_batch([run], design, truth=truth, lead=lead)[0]
+
+
+def extract_features_batch(
+    runs: list[Run],
+    design: PRSMDesign | str | None = None,
+    *,
+    truth: tuple[str, ...] = (),
+    lead: float | None = None,
+) -> list[dict[str, float]]:
+    """:func:`extract_features` of several windows, one dict each, equal to one at a time.
+
+    Windows of one length, sample rate, channel set and design (the windows of a recording)
+    are processed together, up to :data:`BATCH_WINDOWS` at a time: each step takes all their
+    channels in one call (the Welch spectra, kurtograms and envelopes then transform them row
+    by row, where a row's frames stay in the cache).
+    """
+    prepared = [_prepare(run, design, truth, lead) for run in runs]
+    groups: dict[tuple, list[int]] = {}
+    for i, (run, run_design, run_lead) in enumerate(prepared):
+        key = (len(run), run.sample_rate, tuple(sorted(run.channels)), run_design, run_lead)
+        groups.setdefault(key, []).append(i)
+    rows: list = [None] * len(runs)
+    for index in groups.values():
+        for start in range(0, len(index), BATCH_WINDOWS):
+            chunk = index[start : start + BATCH_WINDOWS]
+            _, run_design, run_lead = prepared[chunk[0]]
+            found = _extract([prepared[i][0] for i in chunk], run_design, run_lead)
+            for i, row in zip(chunk, found):
+                rows[i] = row
+    return rows
+
+
+def _prepare(run: Run, design, truth, lead) -> tuple[Run, PRSMDesign | None, float | None]:
+    """(the window with only what is read, checked; its design; the lead without a design)."""
+    truth = _truth_request(run, truth)
+    # Only what is read: the measured channels and the truth signals asked for.
+    run = Run(
+        run.time,
+        run.channels,
+        run.sample_rate,
+        run.labels,
+        truth={name: run.truth[name] for name in truth},
+    ).validate(what="window")
+    if not any(name in CHANNEL_NAMES for name in run.channels):
+        raise PRSMHealthError(
+            "no usable channels: the recording has no measured channel of the contract "
+            f"({', '.join(CHANNEL_NAMES)})"
+        )
+    if design is None:
+        design = run.labels.get("design", "paper01")
+    if design is None or design == NO_DESIGN:
+        design = None
+        lead = lead if lead is not None else run.labels.get("lead")
+    elif isinstance(design, str):
+        design = preset(design)
+    return run, design, lead
+
+
+def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> list[dict]:
+    """The indicators of windows of one length, rate, channel set and design."""
+    rate = runs[0].sample_rate
+    rows = []
+    for run in runs:
+        row = dict.fromkeys(FEATURES, np.nan)
+        for name in run.truth:
+            row.update(dict.fromkeys(TRUTH_FEATURES[name], np.nan))
+        rows.append(row)
+    present = runs[0].channels
+    vibration = [name for name in SHORT if name in present]
+    # mean-removed vibration (channel, window, sample): what every spectral indicator reads
+    centred = {}
+    if vibration:
+        stacked = np.stack([[run.channels[name] for run in runs] for name in vibration])
+        stacked = stacked - np.mean(stacked, axis=-1, keepdims=True)
+        centred = dict(zip(vibration, stacked))
+        for suffix, values in _classic(stacked, rate).items():
+            for c, name in enumerate(vibration):
+                for row, value in zip(rows, values[c]):
+                    row[f"{SHORT[name]}_{suffix}"] = float(value)
+
+    ratios = speed_ratios(design) if design is not None else None
+    for run, row in zip(runs, rows):
+        _operating(run, row)
+    _mesh(runs, rows, design, ratios, centred)
+    # ---- time-synchronous averages and the gear indicators (docs/gear-indicators.md)
+    if "screw_angle" in present and design is not None:
+        _gear(runs, design, ratios, rows)
+    # ---- envelope lines at the defect frequencies, band by spectral kurtosis
+    if design is not None:
+        _envelope(runs, rows, design)
+    # ---- shifted axial frequency
+    if "nut_axial_accel" in centred:
+        _axial(centred["nut_axial_accel"], rate, design, rows)
+    # nut travel per screw radian: the design's kinematics, or the rig's lead
+    nut_per_rad = ratios.nut if ratios is not None else (lead / (2 * math.pi) if lead else None)
+    for run, row in zip(runs, rows):
+        _torque_and_reversals(run, nut_per_rad, row)
+    return rows
+
+
+def _operating(run: Run, out: dict) -> None:
+    speed, load = run.channels.get("screw_speed"), run.channels.get("axial_load")
+    if speed is not None:
+        out["speed_mean"] = float(np.mean(speed))
+    if load is not None:
+        out["load_mean"] = float(np.mean(load))
+        out["load_range"] = float(np.ptp(load))
+
+
+def _carrier_frequency(run: Run, ratios) -> float:
+    """Carrier rotation frequency [Hz]: measured screw speed × carrier ratio, or the truth."""
+    speed = run.channels.get("screw_speed")
+    if "carrier_speed" in run.truth:
+        return abs(float(np.mean(run.truth["carrier_speed"]))) / (2 * math.pi)
+    if speed is not None and ratios:
+        return abs(ratios.carrier * float(np.mean(speed))) / (2 * math.pi)
+    return np.nan
+
+
+def _mesh(runs, rows, design, ratios, centred: dict) -> None:
+    """Gear mesh lines: the windows at steady speed share one spectrum call per channel."""
+    if design is None or design.gear is None:
+        return
+    z = design.gear.ring_teeth
+    rate = runs[0].sample_rate
+    steady = []
+    for w, (run, row) in enumerate(zip(runs, rows)):
+        f_c = _carrier_frequency(run, ratios)
+        if not (np.isfinite(f_c) and f_c > 0):
+            continue
+        row["mesh_frequency"] = z * f_c
+        ch = run.channels
+        speed = ch.get("screw_speed")
+        varying = speed is not None and np.std(speed) > ORDER_TRACKING_SPREAD * abs(np.mean(speed))
+        if (
+            varying
+            and "screw_angle" in ch
+            and np.all(np.diff(ch["screw_angle"]) * np.sign(np.mean(speed)) > 0)
+        ):
+            # order domain: mesh order = z·(carrier/screw) per screw radian
+            for name in MESH_CHANNELS:
+                if name in ch:
+                    x, d_angle = _order_resample(ch[name], ch["screw_angle"])
+                    orders, amp = amplitude_spectrum(x, 1.0 / d_angle)
+                    per_rad = abs(ratios.carrier) / (2 * math.pi)
+                    _mesh_lines(orders, amp, z * per_rad, per_rad, SHORT[name], row)
+        else:
+            steady.append((w, f_c))
+    for name in MESH_CHANNELS:
+        if name in centred and steady:
+            freq, amp = amplitude_spectrum(centred[name][[w for w, _ in steady]], rate)
+            for (w, f_c), spectrum in zip(steady, amp):
+                _mesh_lines(freq, spectrum, z * f_c, f_c, SHORT[name], rows[w])
+
+
+def _mesh_lines(freq, amp, base: float, side: float, prefix: str, out: dict) -> None:
+    for k in (1, 2, 3):
+        out[f"{prefix}_mesh_h{k}"] = _line(freq, amp, k * base)
+    out[f"{prefix}_mesh_sidebands"] = np.nansum(
+        [_line(freq, amp, base - side), _line(freq, amp, base + side)]
+    )
+
+
+def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
+    """Dominant nut axial frequency and its shift from the healthy baseline, every window's
+    Welch spectrum in one call."""
+    nperseg = min(512, centred.shape[-1])
+    f, psds = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
+    for psd, out in zip(psds, rows):
+        f_dom = peak_frequency(f, psd, (100.0, min(2000.0, 0.45 * rate)))
+        out["axial_dominant_frequency"] = f_dom
+        band = (f > 0.9 * f_dom) & (f < 1.1 * f_dom)
+        out["axial_dominant_amplitude"] = (
+            float(np.sqrt(np.sum(psd[band]) * (f[1] - f[0]))) if band.any() else np.nan
+        )
+        mean_load = abs(out["load_mean"]) if np.isfinite(out["load_mean"]) else 100.0
+        if design is not None and design.gear is not None:
+            f0 = axial_baseline_frequency(design, round(mean_load, 1))
+            out["axial_baseline_frequency"] = f0
+            out["axial_frequency_shift"] = f_dom - f0
+            out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
+
+
+def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> None:
+    ch = run.channels
+    speed, load = ch.get("screw_speed"), ch.get("axial_load")
+    rate = run.sample_rate
+    # ---- torque
+    if "friction_torque" in run.truth:
+        out["friction_torque_mean"] = float(np.mean(run.truth["friction_torque"]))
+        out["friction_torque_ripple"] = float(np.std(run.truth["friction_torque"]))
+    if "drive_torque" in ch:
+        out["drive_torque_mean"] = float(np.mean(ch["drive_torque"]))
+        out["drive_torque_ripple"] = float(np.std(ch["drive_torque"]))
+        if speed is not None and load is not None and "nut_position" in ch:
+            out["efficiency"] = _window_efficiency(
+                ch["drive_torque"], speed, load, ch["nut_position"], run.time
+            )
+
+    # ---- reversals: of the motion, of the load (load cell), or of the drive torque when no
+    # load cell is fitted (the motor current reverses with the load it carries)
+    torque = ch.get("drive_torque")
+    # the motor torque averaged over 5 ms: current noise and ripple out, load reversals kept
+    slow_torque = None if torque is None else uniform_filter1d(torque, max(1, int(0.005 * rate)))
+    reversal = (
+        (speed is not None and np.min(speed) < 0 < np.max(speed))
+        or (load is not None and np.min(load) < 0 < np.max(load))
+        or (load is None and slow_torque is not None and _reverses(slow_torque))
+    )
+    if speed is not None or load is not None or torque is not None:
+        out["reversal"] = float(reversal)
+    if reversal and torque is not None:
+        out["torque_rattle_rate"] = _rattle_rate(torque, rate)
+    # lost motion: nut lag behind the rigid kinematics across a reversal
+    if "nut_position" in ch and "screw_angle" in ch and nut_per_rad is not None:
+        if reversal:
+            if speed is not None and np.min(speed) < 0 < np.max(speed):
+                side = np.sign(speed)
+            else:  # the load's sign, from the load cell or else the drive torque
+                force = load if load is not None else slow_torque
+                side = np.sign(force - 0.5 * (np.max(force) + np.min(force)))
+            out["lost_motion"] = _lost_motion(
+                ch["nut_position"], ch["screw_angle"], nut_per_rad, side
+            )
+
+
+def _envelope(runs, rows, design: PRSMDesign) -> None:
+    """Envelope lines of every window with a speed: all windows' and channels' kurtograms and
+    envelope spectra together."""
+    present = [name for name in ENVELOPE_CHANNELS if name in runs[0].channels]
+    jobs = []  # (window, channel, its defect frequencies)
+    for w, run in enumerate(runs):
+        speed = run.channels.get("screw_speed")
+        if speed is not None and abs(float(np.mean(speed))) > 0:
+            frequencies = defect_frequencies(design, float(np.mean(speed)))
+            names = {k: v for k, v in frequencies.items() if k in DEFECTS}
+            jobs += [(w, name, names) for name in present]
+    if not jobs:
+        return
+    x = np.stack([runs[w].channels[name] for w, name, _ in jobs])
+    results = defect_lines_batch(x, runs[0].sample_rate, [names for _, _, names in jobs])
+    for (w, name, _), result in zip(jobs, results):
+        if isinstance(result, PRSMHealthError):  # no band fits (low sample rate, short window)
+            continue
+        s, out = SHORT[name], rows[w]
+        out[f"{s}_sk_max"] = result["sk"]
+        out[f"{s}_sk_band_centre"] = 0.5 * sum(result["band"])
+        for defect, line in result["lines"].items():
+            out[f"{s}_env_{defect}"] = line["amplitude"]
+            out[f"{s}_env_{defect}_ratio"] = line["ratio"]
+            out[f"{s}_env_{defect}_ratio_sum"] = line["ratio_sum"]
+
+
+def _gear(runs, design: PRSMDesign, ratios, rows) -> None:
+    """TSA indicators over carrier and roller periods: each period's TSAs of every window
+    and channel in one call."""
+    periods = {"carrier": (ratios.carrier, None), "roller": (ratios.roller_spin_relative, None)}
+    if design.gear is not None and design.variant != "recirculating":
+        periods = {
+            "carrier": (ratios.carrier, design.gear.ring_teeth),
+            "roller": (ratios.roller_spin_relative, design.gear.roller_teeth),
+        }
+    present = [name for name in TSA_CHANNELS if name in runs[0].channels]
+    if not present:
+        return
+    for period, (ratio, teeth) in periods.items():
+        by_count: dict[int, list] = {}  # periods averaged → [(window, TSAs of its channels)]
+        for w, run in enumerate(runs):
+            x = np.stack([run.channels[name] for name in present])
+            averages = synchronous_averages(
+                x, run.channels["screw_angle"], 2 * math.pi / abs(ratio)
+            )
+            if averages is not None:
+                by_count.setdefault(averages[1], []).append((w, averages[0]))
+        for count, found in by_count.items():
+            values = tsa_indicators(np.concatenate([tsa for _, tsa in found]), count, teeth)
+            for k, (w, name) in enumerate((w, name) for w, _ in found for name in present):
+                for key in TSA_INDICATORS:
+                    rows[w][f"{SHORT[name]}_tsa_{period}_{key}"] = float(values[key][k])
+
+
+def _lost_motion(position: np.ndarray, angle: np.ndarray, lead: float, side: np.ndarray) -> float:
+    """Spread (1st–99th percentile) of the nut's lag behind the rigid kinematics [m].
+
+    The residual nut position − lead·angle jumps by the play at each reversal. A smooth function
+    of the position — the position sensor's nonlinearity (an LVDT's ±0.25 % of full scale is
+    hundreds of µm over a stroke) and the screw's cumulative lead error — is removed first: a
+    7th-degree polynomial in the position, fitted together with a step on the flank side
+    (``side`` = ±1: the sign of the speed or of the load) so that it does not absorb the jumps,
+    and only the polynomial subtracted.
+    """
+    residual = position - lead * angle
+    lo, hi = float(np.min(position)), float(np.max(position))
+    if hi > lo:
+        # Chebyshev polynomials of the position mapped onto [-1, 1]: the same degree-7 space as
+        # plain powers, but nearly orthogonal, so the 9 × 9 normal equations are well
+        # conditioned and cost a fraction of an SVD least-squares solve of 20,000 rows; summed
+        # block by block by a kernel (a 20,000 × 9 basis was most of the time)
+        position = np.ascontiguousarray(position, float)
+        side = np.ascontiguousarray(side, float)
+        gram, rhs = np.empty((9, 9)), np.empty(9)
+        step_polynomial_normal_equations(position, side, residual, lo, hi, 7, gram, rhs)
+        # (least squares on the small system: a step collinear with the polynomial stays solvable)
+        coef = np.linalg.lstsq(gram, rhs, rcond=None)[0]
+        subtract_polynomial(position, residual, lo, hi, coef[:8], residual)
+    low, high = np.percentile(residual, [1, 99])
+    return float(high - low)
+
+
+def _reverses(x: np.ndarray) -> bool:
+    # A sign change beyond the noise: both signs reached by a tenth of the range or more (of a
+    # smoothed signal: a steady run's noise around a small mean must not count).
+    margin = 0.1 * float(np.ptp(x))
+    return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
+
+
+def _window_efficiency(torque, speed, load, position, time) -> float:
+    """A window's efficiency from its energy balance: the power through the screw over itself
+    plus the friction loss, ⟨|F·v|⟩ / (⟨|F·v|⟩ + ⟨T·ω − F·v⟩) [-].
+
+    Paper 02's form, F·p_s / (F·p_s + 2π·T_loss), with the loss measured as input minus output
+    power: under a steady driving load it is the efficiency η; under a load that reverses it
+    stays defined (the ratio of mean powers ⟨F·v⟩/⟨T·ω⟩ does not: both means swing through 0)
+    and falls as the friction rises — 1 / (1 + (1/η − η)/2) for a load driving and back-driving
+    half the time each. The inertias' kinetic energy is taken as unchanged over the window (a
+    speed held by the drive). NaN without power through the screw. T·ω: drive torque × screw
+    speed; F·v: axial load × nut speed (``np.gradient`` of the position over time), both
+    summed in one compiled pass.
+    """
+    arrays = (np.ascontiguousarray(a, float) for a in (torque, speed, load, position, time))
+    through, loss = screw_power_sums(*arrays)
+    through, total = through / len(time), (through + loss) / len(time)
+    return through / total if through > 0 and total > 0 else np.nan
+
+
+def _rattle_rate(torque: np.ndarray, rate: float) -> float:
+    """Crossings per second of the drive torque's mid level, with ±10 % hysteresis [1/s].
+
+    Across a reversal the nut crosses the 2b gap and strikes the other flanks; each bounce
+    unloads and reloads the screw, so the motor torque swings through its mid level once per
+    bounce. More clearance, faster impacts, more bounces (docs/validation.md, clearance-
+    signature map). The hysteresis (10 % of the 5–95 % range) keeps sensor noise from counting.
+    """
+    lo, hi = np.percentile(torque, [5, 95])
+    mid, band = 0.5 * (lo + hi), 0.1 * (hi - lo)
+    crossings = hysteresis_crossings(np.ascontiguousarray(torque, float), mid - band, mid + band)
+    return crossings / (len(torque) / rate)
+
+
+def windows(run: Run, length: float, hop: float | None = None):
+    """Split a run into windows of ``length`` seconds (hop defaults to length), as Runs."""
+    n = int(round(length * run.sample_rate))
+    step = int(round((hop or length) * run.sample_rate))
+    if n < MIN_SAMPLES:
+        raise PRSMHealthError(
+            f"window length {length:g} s gives {n} samples, need at least {MIN_SAMPLES}"
+            f"{ms_hint(run.sample_rate)}"
+        )
+    for start in range(0, len(run) - n + 1, step):
+        yield run.slice(start, start + n)
+
+
+def dataset_features(dataset, run_ids=None, progress: bool = False, truth: tuple[str, ...] = ()):
+    """Indicators of every run of a :class:`~prsm_health.datasets.dataset.Dataset` as a DataFrame.
+
+    Columns: :data:`FEATURES` (then the indicators of the truth signals named in ``truth``, see
+    :func:`extract_features`) plus the run labels (run_id, split, fault_class, clearances, …).
+    """
+    import pandas as pd
+
+    rows = []
+    ids = list(dataset.runs["run_id"] if run_ids is None else run_ids)
+    iterator = ids
+    if progress:
+        from tqdm import tqdm
+
+        iterator = tqdm(ids, unit="run", desc="features")
+    for run_id in iterator:
+        run = dataset.run(int(run_id), truth=bool(truth))
+        row = extract_features(run, truth=truth)
+        row.update(run.labels)
+        rows.append(row)
+    return pd.DataFrame(rows)

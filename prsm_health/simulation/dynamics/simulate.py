@@ -1,0 +1,278 @@
+"""Run orchestration: step choice, step guard, chunked RK4 integration, instrumentation, Run.
+
+:func:`simulate` is the public entry point (re-exported as ``prsm_health.simulate``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from prsm_health.core.channels import TRUTH_NAMES
+from prsm_health.core.errors import SimulationError
+from prsm_health.core.run import Run
+
+from ..decimation import decimate
+from . import _kernels
+from . import layout as L
+from .model import (
+    AUTO_MAX_STEP,
+    AUTO_STABLE_FRACTION,
+    Model,
+    build_model,
+    initial_state,
+    realised_clearances,
+)
+
+#: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
+STABILITY_MARGIN = 0.9
+
+
+def _rk4_amplification(z: np.ndarray) -> np.ndarray:
+    return np.abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+
+def linearised_eigenvalues(model: Model) -> np.ndarray:
+    """Eigenvalues [1/s] of the model linearised on the loaded flanks at the operating load
+    (:func:`linearised_modes`)."""
+    return linearised_modes(model)[0]
+
+
+def linearised_modes(model: Model) -> tuple[np.ndarray, np.ndarray, list[int]]:
+    """Eigenvalues [1/s], eigenvectors (columns) and the state indices they span, of the model
+    linearised on the loaded flanks at the operating load.
+
+    Clearances are closed and every roller carries the operating load on one flank of each
+    thread and on the gear, so all contact stiffnesses act (at their tangent values for the
+    Hertzian law): the stiffest state a run normally meets. The Jacobian is taken by central
+    differences of the kernel's right-hand side; the prescribed screw angle is not a state.
+    """
+    nq = model.n_coordinates
+    rollers = model.rollers.copy()
+    # clearances closed, interference (preload) kept
+    rollers[:, L.R_B_S] = np.minimum(rollers[:, L.R_B_S], 0.0)
+    rollers[:, L.R_B_N] = np.minimum(rollers[:, L.R_B_N], 0.0)
+    rollers[:, L.R_B_G] = 0.0
+    operating = model.roller_load * model.n_rollers
+    loaded = replace(
+        model, rollers=rollers, load_knots=np.array([[0.0, 1.0], [operating, operating]])
+    )
+    y0 = initial_state(loaded)
+    p = model.params
+    held = set(range(2 * nq, 2 * nq + L.N_EXTRA))  # energies and the loop integrator
+    if p[L.P_DRIVE_MODE] == L.DRIVE_PRESCRIBED:
+        held |= {L.Q_THM, nq + L.Q_THM}
+    if p[L.P_COUPLED] != 1.0:  # the screw angle is the motor's
+        held |= {L.Q_THS, nq + L.Q_THS}
+    if p[L.P_AXIAL_FREE] != 1.0:
+        held |= {L.Q_ZS, nq + L.Q_ZS}
+    if p[L.P_ON_PAYLOAD] != 1.0:  # the payload coordinate follows the nut
+        held |= {L.Q_ZL, nq + L.Q_ZL}
+    free = [j for j in range(model.n_state) if j not in held]
+    velocity = (np.arange(model.n_state) >= nq) & (np.arange(model.n_state) < 2 * nq)
+    scale = np.where(velocity, 1e-7, 1e-10)
+    f_plus = np.empty(model.n_state)
+    f_minus = np.empty(model.n_state)
+    aux = np.zeros(L.n_aux(model.n_rollers))
+    jac = np.empty((len(free), len(free)))
+    args = (model.params, rollers, model.mesh_table, loaded.motion, loaded.load_knots, model.errors)
+    for col, j in enumerate(free):
+        y = y0.copy()
+        y[j] += scale[j]
+        _kernels.rhs(0.0, y, *args, f_plus, aux)
+        y[j] -= 2 * scale[j]
+        _kernels.rhs(0.0, y, *args, f_minus, aux)
+        jac[:, col] = (f_plus[free] - f_minus[free]) / (2 * scale[j])
+    values, vectors = np.linalg.eig(jac)
+    return values, vectors, free
+
+
+def max_stable_step(model: Model) -> tuple[float, float]:
+    """Largest stable RK4 step [s] (with :data:`STABILITY_MARGIN`) and the highest natural frequency [Hz]."""
+    eig = linearised_eigenvalues(model)
+    omega_max = float(np.max(np.abs(eig)))
+    # Slow modes (rigid-body motion, the rolling mechanism, friction creep) are resolved by any
+    # usable step; their finite-difference noise must not decide the step limit.
+    eig = eig[np.abs(eig) > 1e-3 * omega_max]
+    lo, hi = 0.0, 4.0 / max(omega_max, 1.0)
+    for _ in range(60):  # bisection on the RK4 stability region
+        mid = 0.5 * (lo + hi)
+        # A mode that physically grows (friction can feed a slow one) may grow in the
+        # integration too: the step only must not amplify faster than the exact exp(hλ).
+        allowed = np.maximum(1.0, np.exp(mid * eig.real)) * (1.0 + 1e-9)
+        if np.all(_rk4_amplification(mid * eig) <= allowed):
+            lo = mid
+        else:
+            hi = mid
+    return STABILITY_MARGIN * lo, omega_max / (2 * math.pi)
+
+
+def settling_model(model: Model) -> Model:
+    """The model with the nut axial motion critically damped about its rigid-body speed, and
+    coupling, thrust bearing and linkage critically damped.
+
+    Used before t = 0 only: the rollers find their (uneven) load shares and the drive train its
+    static deflections without ringing, so a run starts in its loaded steady state.
+    """
+    from prsm_health.physics.kinematics import speed_ratios
+
+    params = model.params.copy()
+    k_axial = model.n_rollers / (1 / model.thread_stiffness[0] + 1 / model.thread_stiffness[1])
+    c_settle = 2.0 * math.sqrt(k_axial * params[L.P_M_N])
+    c_guide = params[L.P_C_NA]
+    v_rigid = speed_ratios(model.design).nut * float(model.motion[1, 0])
+    # settling damper c_s·(v − v_rigid) plus the guide's own c_g·v, as one damper
+    params[L.P_C_NA] = c_settle + c_guide
+    params[L.P_V_NUT_REF] = c_settle * v_rigid / (c_settle + c_guide)
+    m, dt = model.design.masses, model.drive_train
+    j_pair = dt.motor_inertia * m.screw_inertia / (dt.motor_inertia + m.screw_inertia)
+    params[L.P_C_COUP] = 2.0 * math.sqrt(dt.coupling_stiffness * j_pair)
+    params[L.P_C_BEAR] = 2.0 * math.sqrt(dt.thrust_bearing_stiffness * m.screw_mass)
+    params[L.P_C_LINK] = 2.0 * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
+    return replace(model, params=params)
+
+
+def choose_step(max_step: float, sample_rate: float) -> tuple[float, int]:
+    """Integration step h = 1/(m·f_s) ≤ max_step with the smallest integer m."""
+    m = max(1, math.ceil(1.0 / (max_step * sample_rate) - 1e-9))
+    return 1.0 / (m * sample_rate), m
+
+
+def integration_step(
+    max_step: float | str, h_stable: float, f_max: float, sample_rate: float
+) -> tuple[float, int]:
+    """The RK4 step h = 1/(m·f_s) and m, for ``options.max_step`` and the model's stable step.
+
+    ``"auto"``: the largest such step below both :data:`AUTO_STABLE_FRACTION` of the stable step
+    and :data:`AUTO_MAX_STEP`, so a stiffer or more damped model takes a smaller step instead of
+    failing. A given
+    ``max_step`` is the user's bound: above the stable step it is refused, naming the limit.
+    """
+    if max_step == "auto":
+        if h_stable < 1e-8:
+            raise SimulationError(
+                f"stable step {h_stable:.3g} s of this model (highest natural frequency "
+                f"{f_max:.0f} Hz) is below 1e-8 s: soften the contacts or the contact damping"
+            )
+        return choose_step(min(AUTO_MAX_STEP, AUTO_STABLE_FRACTION * h_stable), sample_rate)
+    h, factor = choose_step(max_step, sample_rate)
+    if h > h_stable:
+        raise SimulationError(
+            f"integration step {h:.3g} s is above the stable limit {h_stable:.3g} s of this model "
+            f"(highest natural frequency {f_max:.0f} Hz, RK4 needs ω·h ≤ 2.8): lower "
+            'options.max_step (or "auto"), or soften the contacts (lower load, or '
+            "options.traction_stiffness_ratio)"
+        )
+    return h, factor
+
+
+def simulate_scenario(scenario, *, progress: bool = False) -> Run:
+    """Simulate a :class:`~prsm_health.simulation.scenario.Scenario`; see :func:`simulate`."""
+    design, health, profile = scenario.design, scenario.health, scenario.profile
+    instrumentation, options, seed = scenario.instrumentation, scenario.options, scenario.seed
+    model = build_model(design, health, profile, options, seed, scenario.drive_train)
+    h_stable, f_max = max_stable_step(model)
+    h, factor = integration_step(options.max_step, h_stable, f_max, instrumentation.sample_rate)
+    n_steps = int(round(profile.duration / h))
+    n_settle = int(round(options.settle_time / h))
+    y = initial_state(model, -n_settle * h)
+    if n_settle:
+        _integrate(settling_model(model), y, h, n_settle, False, t0=-n_settle * h, record=False)
+        y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
+            0.0  # energy book starts at t = 0
+        )
+    truth_raw = _truth_from_record(_integrate(model, y, h, n_steps, progress))
+    channels = instrumentation.measure(
+        truth_raw,
+        1.0 / h,
+        np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
+    )
+    truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
+    n_out = len(next(iter(truth.values())))
+    time = np.arange(n_out) / instrumentation.sample_rate
+    nq = model.n_coordinates
+    energy = {
+        "drive": float(y[2 * nq + L.X_W_DRIVE]),
+        "load": float(y[2 * nq + L.X_W_LOAD]),
+        "dissipated": float(y[2 * nq + L.X_W_DISS]),
+        "friction": float(y[2 * nq + L.X_W_FRIC]),
+    }
+    return Run(
+        time=time,
+        channels=channels,
+        sample_rate=instrumentation.sample_rate,
+        labels={**scenario.labels(), **realised_clearances(model)},
+        scenario={
+            **scenario.to_dict(),
+            "integration_step": h,
+            "stable_step": h_stable,
+            "highest_natural_frequency": f_max,
+        },
+        energy=energy,
+        truth=truth,
+    )
+
+
+def _truth_from_record(raw: np.ndarray) -> dict[str, np.ndarray]:
+    """Truth signals by name from the kernel's record, whose columns (layout ``C_*``) are the
+    truth signals in contract order (prsm_health.core.channels.TRUTH_CHANNELS)."""
+    return {name: raw[:, k] for k, name in enumerate(TRUTH_NAMES)}
+
+
+def _integrate(
+    model: Model,
+    y: np.ndarray,
+    h: float,
+    n_steps: int,
+    progress: bool,
+    t0: float = 0.0,
+    record: bool = True,
+) -> np.ndarray:
+    raw = np.empty((n_steps if record else 1, L.N_CHANNELS))
+    work = [np.empty(model.n_state) for _ in range(5)]
+    aux = np.zeros(L.n_aux(model.n_rollers))
+    chunk = max(1, min(n_steps, int(0.02 / h)))  # 20 ms of simulated time per kernel call
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(
+            total=n_steps * h,
+            unit="sim s",
+            unit_scale=False,
+            bar_format="{l_bar}{bar}| {n:.3f}/{total:.3f} s [{elapsed}<{remaining}]",
+        )
+    done = 0
+    while done < n_steps:
+        count = min(chunk, n_steps - done)
+        status, step = _kernels.integrate(
+            y,
+            t0 + done * h,
+            h,
+            count,
+            1 if record else count + 1,
+            model.params,
+            model.rollers,
+            model.mesh_table,
+            model.motion,
+            model.load_knots,
+            model.errors,
+            raw[done : done + count] if record else raw,
+            *work,
+            aux,
+        )
+        if status != 0:
+            t_fail = t0 + (done + step) * h
+            raise SimulationError(
+                f"the state became non-finite at t = {t_fail:.6g} s: the step {h:.3g} s is too "
+                "large for the contact stiffness reached there (a load or clearance impact "
+                "beyond the linearised bound) — lower options.max_step"
+            )
+        done += count
+        if bar is not None:
+            bar.update(count * h)
+    if bar is not None:
+        bar.close()
+    return raw

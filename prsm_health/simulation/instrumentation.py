@@ -1,0 +1,950 @@
+"""Instrumentation profiles: the sensors an actuator carries, and what each makes of the truth.
+
+The simulator gives *truth* signals at its integration rate f_int (motor_angle, motor_speed,
+motor_torque, nut_position, nut_*_accel, axial_load, …: the channel contract). An
+:class:`Instrumentation` fits at most one sensor per measured channel and turns the truth into
+the fitted channels at its sample rate f_s = f_int / m (m an integer):
+
+- ``screw_angle``: :class:`AngleSensor` (motor encoder or resolver) reads motor_angle;
+- ``screw_speed``: :class:`SpeedEstimate`, the drive's estimate from the measured screw_angle;
+- ``nut_position``: :class:`PositionSensor` (LVDT or linear scale) reads nut_position;
+- ``nut_*_accel``: :class:`Accelerometer` reads the nut acceleration of its axis (and, through
+  its transverse sensitivity, the two across it);
+- ``drive_torque``: :class:`TorqueEstimate` (phase current × nominal k_t) reads motor_torque;
+- ``axial_load``: :class:`LoadCell` reads axial_load.
+
+Order of operations inside every sensor: what the sensor does to the continuous signal —
+gain error, cross-axis coupling, nonlinearity, drift, bandwidth, mounting resonance,
+saturation — acts on the integration-rate signal; the logger then decimates with its
+anti-alias filter (:func:`prsm_health.simulation.decimation.decimate`); white noise and quantisation come
+last, at f_s. Digital position sensors (encoder, resolver-to-digital converter) are read at f_s,
+so their periodic angle error is evaluated at the sample instants and aliases as in a drive.
+
+Every random per-run quantity (a gain error, the phase of an error harmonic, a drift rate) and
+every noise sample comes from the generator handed to :meth:`Instrumentation.measure`, through
+one child stream per measured channel: a seed gives a bit-identical run, and fitting or
+removing one sensor leaves the others' draws unchanged.
+
+Profiles are TOML files; the built-ins (:func:`list_profiles`) ship in
+``prsm_health/simulation/instrumentation_profiles/`` with every figure's source (docs/instrumentation.md).
+Fields are SI; a few datasheet units are accepted as aliases whose name says the unit
+(``noise_density_ug`` in µg/√Hz, ``range_g`` in g, ``harmonic_error_arcmin``, ``*_percent``)
+and converted at load.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+from scipy import signal
+
+from prsm_health.core.errors import ParameterError, require, require_known_keys, require_range
+from prsm_health.core.tomlfile import read_toml, toml_value
+
+from .decimation import decimate
+
+#: Standard gravity [m/s²] (datasheets state accelerations in g).
+STANDARD_GRAVITY = 9.80665
+ARCMIN = math.pi / (180.0 * 60.0)
+#: Built-in profile files, and the profile used wherever none is named.
+PROFILE_DIR = Path(__file__).with_name("instrumentation_profiles")
+DEFAULT_PROFILE = "flight-ema"
+DEFAULT_SAMPLE_RATE = 20_000.0
+#: Filters whose corner is above this fraction of the rate they run at are left out: their
+#: effect lies beyond the band that rate resolves (the response is flat where it is logged).
+_MAX_CORNER = 0.45
+#: The two nut accelerations spanning the plane across each accelerometer axis (transverse
+#: sensitivity). The sensor sits on the nut housing where the radial direction is x; a
+#: radial_y sensor sits 90° away, where the x translation is its tangential direction.
+TRANSVERSE = {
+    "axial": ("tangential", "radial_x"),
+    "tangential": ("axial", "radial_x"),
+    "radial_x": ("axial", "tangential"),
+    "radial_y": ("axial", "radial_x"),
+}
+
+
+# ----------------------------------------------------------------------------- signal blocks
+def _lowpass(x: np.ndarray, corner: float, rate: float) -> np.ndarray:
+    """First-order causal low-pass at ``corner`` [Hz], started in steady state at x[0]."""
+    if corner <= 0 or corner >= _MAX_CORNER * rate:
+        return x
+    sos = signal.butter(1, corner, btype="low", fs=rate, output="sos")
+    return signal.sosfilt(sos, x, zi=signal.sosfilt_zi(sos) * x[0])[0]
+
+
+def _highpass(x: np.ndarray, corner: float, rate: float) -> np.ndarray:
+    """First-order causal high-pass (an AC-coupled sensor), settled on x[0] (output 0)."""
+    if corner <= 0 or corner >= _MAX_CORNER * rate:
+        return x
+    sos = signal.butter(1, corner, btype="high", fs=rate, output="sos")
+    return signal.sosfilt(sos, x, zi=signal.sosfilt_zi(sos) * x[0])[0]
+
+
+def _resonance(x: np.ndarray, frequency: float, q: float, rate: float) -> np.ndarray:
+    """Mounted-sensor resonance: ω²/(s² + s·ω/Q + ω²), unit gain at DC, peak ≈ Q at ``frequency``.
+
+    Bilinear transform prewarped at the resonance, so the peak sits at the right frequency.
+    """
+    if frequency <= 0 or frequency >= _MAX_CORNER * rate:
+        return x
+    w = 2 * rate * math.tan(math.pi * frequency / rate)
+    b, a = signal.bilinear([w * w], [1.0, w / q, w * w], fs=rate)
+    sos = signal.tf2sos(b, a)
+    return signal.sosfilt(sos, x, zi=signal.sosfilt_zi(sos) * x[0])[0]
+
+
+def _s_curve(x: np.ndarray, span: float) -> np.ndarray:
+    """Smooth odd S-shaped error shape, zero at mid-span and both ends, extreme ±1 inside.
+
+    u = x / (span/2) clipped to ±1; e = (3√3/2)·(u − u³) peaks at ±1 for u = ±1/√3. Beyond the
+    span the error stays 0 (the end-point straight line), documented as a simplification.
+    """
+    u = np.clip(x / (0.5 * span), -1.0, 1.0)
+    return 1.5 * math.sqrt(3.0) * (u - u**3)
+
+
+def _quantise(x: np.ndarray, step: float) -> np.ndarray:
+    return np.round(x / step) * step if step > 0 else x
+
+
+def _harmonics(angle: np.ndarray, orders, amplitudes, phases) -> np.ndarray:
+    return sum(a * np.sin(k * angle + p) for k, a, p in zip(orders, amplitudes, phases))
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _truth(truth: dict, name: str, channel: str) -> np.ndarray:
+    try:
+        return np.asarray(truth[name], dtype=float)
+    except KeyError:
+        raise ValueError(
+            f"{channel} reads the truth signal {name!r}, which the simulation did not provide "
+            f"(got {', '.join(truth)})"
+        ) from None
+
+
+# ----------------------------------------------------------------------------- sensors
+@dataclass(frozen=True)
+class _Sensor:
+    """Common parts of a sensor spec: validation helpers, dict/TOML form, unit aliases.
+
+    ``UNITS`` gives every field's unit; ``ALIASES`` the accepted datasheet-unit spellings
+    (alias → (field, factor to SI, alias unit)).
+    """
+
+    KIND: ClassVar[str] = ""
+    UNITS: ClassVar[dict[str, str]] = {}
+    ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = {}
+
+    device: str = ""
+
+    def _validate(self) -> None:
+        require(isinstance(self.device, str), "device", self.device, "must be a string")
+
+    def _range(self, name: str, low: float, high: float) -> None:
+        require_range(name, getattr(self, name), low, high, unit=self.UNITS.get(name, ""))
+
+    def _integer(self, name: str, low: int, high: int) -> None:
+        value = getattr(self, name)
+        require(
+            _is_int(value) and low <= value <= high,
+            name,
+            value,
+            f"must be an integer in [{low}, {high}]",
+        )
+
+    def _harmonic_pairs(self, orders_name: str, amplitudes_name: str, high: float) -> None:
+        """Two equally long lists (stored as tuples): integer orders ≥ 1, amplitudes in [0, high]."""
+        for name in (orders_name, amplitudes_name):
+            value = getattr(self, name)
+            require(isinstance(value, (list, tuple)), name, value, "must be a list (TOML array)")
+            object.__setattr__(self, name, tuple(value))
+        orders, amplitudes = getattr(self, orders_name), getattr(self, amplitudes_name)
+        unit = self.UNITS.get(amplitudes_name, "")
+        require(
+            all(_is_int(k) and k >= 1 for k in orders),
+            orders_name,
+            list(orders),
+            "must be integers ≥ 1",
+        )
+        require(
+            all(_is_number(a) and 0 <= a <= high for a in amplitudes),
+            amplitudes_name,
+            list(amplitudes),
+            f"must be numbers in [0, {high:g}] {unit}".rstrip(),
+        )
+        require(
+            len(orders) == len(amplitudes),
+            amplitudes_name,
+            list(amplitudes),
+            f"needs one amplitude per entry of {orders_name} ({len(orders)})",
+        )
+
+    def to_dict(self) -> dict:
+        """Fields under their names, SI, tuples as lists."""
+        return {
+            f.name: list(getattr(self, f.name))
+            if isinstance(getattr(self, f.name), tuple)
+            else getattr(self, f.name)
+            for f in fields(self)
+        }
+
+    def rows(self) -> list[tuple[str, object, str]]:
+        """(field, value, unit) of every field."""
+        return [(k, v, self.UNITS.get(k, "")) for k, v in self.to_dict().items()]
+
+    @classmethod
+    def allowed_keys(cls) -> list[str]:
+        return [f.name for f in fields(cls)] + list(cls.ALIASES)
+
+    @classmethod
+    def from_table(cls, table: dict, where: str, start: _Sensor | None = None) -> _Sensor:
+        """A spec from a TOML table (aliases converted) over ``start``'s fields (overrides).
+
+        Errors name ``where.field`` and, for an unknown key, list the allowed keys.
+        """
+        known = {f.name for f in fields(cls)}
+        values = start.to_dict() if start is not None else {}
+        given_as: dict[str, str] = {}
+        for key, value in table.items():
+            if key in cls.ALIASES:
+                name, factor, _ = cls.ALIASES[key]
+                require(
+                    name not in table,
+                    f"{where}.{key}",
+                    value,
+                    f"give either {key} or {name}, not both",
+                )
+                if isinstance(value, list):
+                    ok = all(_is_number(v) for v in value)
+                    converted = [v * factor for v in value] if ok else value
+                else:
+                    ok = _is_number(value)
+                    converted = value * factor if ok else value
+                require(ok, f"{where}.{key}", value, "must be a number (or a list of numbers)")
+                values[name] = converted
+                given_as[name] = key
+            elif key in known:
+                values[key] = value
+            else:
+                raise ParameterError(
+                    f"{where}.{key}",
+                    value,
+                    f"unknown key; allowed: {', '.join(cls.allowed_keys())}, fitted",
+                )
+        try:
+            return cls(**values)
+        except ParameterError as exc:
+            if exc.field in given_as:
+                alias = given_as[exc.field]
+                raise ParameterError(
+                    f"{where}.{alias}",
+                    table[alias],
+                    f"{exc.allowed} after conversion to {exc.field} [{cls.UNITS.get(exc.field, '')}]",
+                ) from None
+            raise ParameterError(f"{where}.{exc.field}", exc.value, exc.allowed) from None
+
+
+@dataclass(frozen=True)
+class AngleSensor(_Sensor):
+    """Motor encoder or resolver with its converter → ``screw_angle`` (from ``motor_angle``).
+
+    measured = θ + Σ_k e_k·sin(k·p·θ + φ_k) + n, quantised to 2π/counts_per_rev, read at f_s.
+    θ: motor angle; p: ``pole_pairs`` (speed of the resolver, 1X = 1; encoders 1), so the
+    ``harmonic_orders`` are orders of its electrical angle p·θ; φ_k uniform per run (a unit's
+    own error pattern); n: white noise. Resolver errors are mainly the 1st (offsets) and 2nd
+    (amplitude imbalance, quadrature) harmonics; an encoder's are once per turn (eccentricity)
+    and its line count (interpolation).
+
+    Parameters
+    ----------
+    counts_per_rev : int
+        Output counts per mechanical revolution (0: not quantised).
+    pole_pairs : int
+    harmonic_orders : list of int
+    harmonic_error : list of float [rad]
+        Amplitude of each harmonic (alias ``harmonic_error_arcmin``).
+    noise : float [rad]
+        RMS white noise (alias ``noise_arcmin``).
+    """
+
+    KIND: ClassVar[str] = "angle sensor"
+    UNITS: ClassVar[dict[str, str]] = {
+        "counts_per_rev": "counts/rev",
+        "harmonic_error": "rad",
+        "noise": "rad",
+    }
+    ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = {
+        "harmonic_error_arcmin": ("harmonic_error", ARCMIN, "arcmin"),
+        "noise_arcmin": ("noise", ARCMIN, "arcmin"),
+    }
+    SOURCE: ClassVar[str] = "motor_angle"
+
+    counts_per_rev: int = 0
+    pole_pairs: int = 1
+    harmonic_orders: tuple[int, ...] = ()
+    harmonic_error: tuple[float, ...] = ()
+    noise: float = 0.0
+
+    def __post_init__(self):
+        self._validate()
+        self._integer("counts_per_rev", 0, 2**40)
+        self._integer("pole_pairs", 1, 64)
+        self._harmonic_pairs("harmonic_orders", "harmonic_error", 0.1)
+        self._range("noise", 0.0, 0.1)
+
+    def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
+        theta = decimate(_truth(truth, self.SOURCE, channel), factor)
+        phases = rng.uniform(0.0, 2 * np.pi, len(self.harmonic_orders))
+        if self.harmonic_orders:
+            theta = theta + _harmonics(
+                self.pole_pairs * theta, self.harmonic_orders, self.harmonic_error, phases
+            )
+        if self.noise:
+            theta = theta + rng.normal(0.0, self.noise, theta.shape)
+        return _quantise(theta, 2 * np.pi / self.counts_per_rev if self.counts_per_rev else 0.0)
+
+
+@dataclass(frozen=True)
+class SpeedEstimate(_Sensor):
+    """The drive's speed estimate → ``screw_speed``, from the *measured* ``screw_angle``.
+
+    As a servo drive computes it: backward difference of the sampled angle (ω[n] = (θ[n] −
+    θ[n−1])·f_s), then a first-order low-pass at ``bandwidth`` (the velocity feedback filter),
+    which smooths the quantisation and harmonic errors of the angle and delays the estimate.
+
+    Parameters
+    ----------
+    bandwidth : float [Hz]
+        Velocity filter corner (0: the raw difference).
+    exact : bool
+        The truth motor speed, decimated, instead of an estimate (the ``ideal`` profile only:
+        no drive has it).
+    """
+
+    KIND: ClassVar[str] = "speed estimate"
+    UNITS: ClassVar[dict[str, str]] = {"bandwidth": "Hz"}
+    SOURCE: ClassVar[str] = "motor_speed"
+
+    bandwidth: float = 0.0
+    exact: bool = False
+
+    def __post_init__(self):
+        self._validate()
+        self._range("bandwidth", 0.0, 1e6)
+        require(isinstance(self.exact, bool), "exact", self.exact, "must be true or false")
+
+    def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
+        if self.exact:
+            return decimate(_truth(truth, self.SOURCE, channel), factor)
+        angle = measured["screw_angle"]
+        sample_rate = rate / factor
+        speed = np.empty_like(angle)
+        speed[1:] = np.diff(angle) * sample_rate
+        speed[0] = speed[1] if len(speed) > 1 else 0.0
+        return _lowpass(speed, self.bandwidth, sample_rate)
+
+
+@dataclass(frozen=True)
+class TorqueEstimate(_Sensor):
+    """Phase current × nominal torque constant → ``drive_torque`` (from ``motor_torque``).
+
+    measured = g·LP(τ) + τ_r(θ) + n, where g = k_t,nominal / k_t,actual = 1 + N(0, gain_sigma)
+    per run (torque-constant tolerance: the drive scales the current with the nameplate k_t);
+    LP: first-order low-pass at ``bandwidth`` (the current loop: the real current lags the
+    torque the simulated drive commands); τ_r = rated_torque·Σ_k r_k·sin(k·p·θ + φ_k), the
+    cogging and torque ripple at orders of the electrical angle p·θ, which the shaft feels but
+    the current does not show (the simulated motor has none, so here it is an error of the
+    estimate; φ_k uniform per run); n: RMS current-sensor noise as torque.
+
+    Parameters
+    ----------
+    gain_sigma : float [-]
+        Standard deviation of g (alias ``gain_sigma_percent``).
+    noise : float [N·m]
+    bandwidth : float [Hz]
+        Current-loop bandwidth (0: none).
+    rated_torque : float [N·m]
+        Reference of the ripple amplitudes.
+    pole_pairs : int
+    ripple_orders : list of int
+    ripple : list of float [-]
+        Fractions of ``rated_torque`` (alias ``ripple_percent``).
+    """
+
+    KIND: ClassVar[str] = "torque estimate"
+    UNITS: ClassVar[dict[str, str]] = {
+        "gain_sigma": "-",
+        "noise": "N*m",
+        "bandwidth": "Hz",
+        "rated_torque": "N*m",
+        "ripple": "-",
+    }
+    ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = {
+        "gain_sigma_percent": ("gain_sigma", 0.01, "%"),
+        "ripple_percent": ("ripple", 0.01, "% of rated_torque"),
+    }
+    SOURCE: ClassVar[str] = "motor_torque"
+
+    gain_sigma: float = 0.0
+    noise: float = 0.0
+    bandwidth: float = 0.0
+    rated_torque: float = 0.0
+    pole_pairs: int = 1
+    ripple_orders: tuple[int, ...] = ()
+    ripple: tuple[float, ...] = ()
+
+    def __post_init__(self):
+        self._validate()
+        self._range("gain_sigma", 0.0, 0.5)
+        self._range("noise", 0.0, 1e3)
+        self._range("bandwidth", 0.0, 1e6)
+        self._range("rated_torque", 0.0, 1e5)
+        self._integer("pole_pairs", 1, 64)
+        self._harmonic_pairs("ripple_orders", "ripple", 0.5)
+        require(
+            self.rated_torque > 0 or not any(self.ripple),
+            "rated_torque",
+            self.rated_torque,
+            "must be > 0 when ripple is given (the ripple is a fraction of it)",
+        )
+
+    def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
+        gain = 1.0 + rng.normal(0.0, self.gain_sigma)
+        phases = rng.uniform(0.0, 2 * np.pi, len(self.ripple_orders))
+        x = gain * _lowpass(_truth(truth, self.SOURCE, channel), self.bandwidth, rate)
+        if self.ripple_orders:
+            electrical = self.pole_pairs * _truth(truth, "motor_angle", channel)
+            x = x + self.rated_torque * _harmonics(
+                electrical, self.ripple_orders, self.ripple, phases
+            )
+        y = decimate(x, factor)
+        if self.noise:
+            y = y + rng.normal(0.0, self.noise, y.shape)
+        return y
+
+
+@dataclass(frozen=True)
+class _LinearTransducer(_Sensor):
+    """A transducer with a static characteristic: position sensor, load cell.
+
+    measured = Q(LP(g·x + s·nonlinearity·full_scale·S(x) + d·t) + n), where g = 1 + N(0,
+    gain_sigma) per run (sensitivity tolerance); S: the smooth odd S-shaped error of
+    :func:`_s_curve` over ``full_scale`` (the span, centred on truth 0), sign s = ±1 per run;
+    d = N(0, drift_sigma) per run (thermal zero drift, linear over the run); LP: first-order
+    low-pass at ``bandwidth`` (the conditioning electronics); n: RMS white noise; Q:
+    quantisation to ``resolution``.
+    """
+
+    SOURCE: ClassVar[str] = ""
+
+    full_scale: float = 0.0
+    nonlinearity: float = 0.0
+    gain_sigma: float = 0.0
+    drift_sigma: float = 0.0
+    bandwidth: float = 0.0
+    noise: float = 0.0
+    resolution: float = 0.0
+
+    def __post_init__(self):
+        self._validate()
+        self._range("full_scale", 0.0, 1e7)
+        self._range("nonlinearity", 0.0, 0.2)
+        self._range("gain_sigma", 0.0, 0.5)
+        self._range("drift_sigma", 0.0, 1e3)
+        self._range("bandwidth", 0.0, 1e6)
+        self._range("noise", 0.0, 1e6)
+        self._range("resolution", 0.0, 1e6)
+        require(
+            self.full_scale > 0 or self.nonlinearity == 0,
+            "full_scale",
+            self.full_scale,
+            "must be > 0 when nonlinearity is given (it is a fraction of the full scale)",
+        )
+
+    def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
+        gain = 1.0 + rng.normal(0.0, self.gain_sigma)
+        sign = 1.0 if rng.random() < 0.5 else -1.0
+        drift = rng.normal(0.0, self.drift_sigma)
+        truth_x = _truth(truth, self.SOURCE, channel)
+        x = gain * truth_x
+        if self.nonlinearity:
+            x = x + sign * self.nonlinearity * self.full_scale * _s_curve(truth_x, self.full_scale)
+        if self.drift_sigma:
+            x = x + drift * np.arange(len(x)) / rate
+        y = decimate(_lowpass(x, self.bandwidth, rate), factor)
+        if self.noise:
+            y = y + rng.normal(0.0, self.noise, y.shape)
+        return _quantise(y, self.resolution)
+
+
+_LINEAR_ALIASES = {
+    "nonlinearity_percent": ("nonlinearity", 0.01, "% of full_scale"),
+    "gain_sigma_percent": ("gain_sigma", 0.01, "%"),
+}
+
+
+@dataclass(frozen=True)
+class PositionSensor(_LinearTransducer):
+    """LVDT on the rod or linear scale → ``nut_position`` (see :class:`_LinearTransducer`).
+
+    Parameters
+    ----------
+    full_scale : float [m]
+        Measuring span (stroke), centred on truth position 0.
+    nonlinearity : float [-]
+        Largest S-curve error as a fraction of ``full_scale`` (alias ``nonlinearity_percent``).
+    gain_sigma : float [-]
+    drift_sigma : float [m/s]
+        Thermal zero drift rate, standard deviation over runs.
+    bandwidth : float [Hz]
+    noise : float [m]
+    resolution : float [m]
+    """
+
+    KIND: ClassVar[str] = "position sensor"
+    UNITS: ClassVar[dict[str, str]] = {
+        "full_scale": "m",
+        "nonlinearity": "-",
+        "gain_sigma": "-",
+        "drift_sigma": "m/s",
+        "bandwidth": "Hz",
+        "noise": "m",
+        "resolution": "m",
+    }
+    ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = _LINEAR_ALIASES
+    SOURCE: ClassVar[str] = "nut_position"
+
+
+@dataclass(frozen=True)
+class LoadCell(_LinearTransducer):
+    """Strain-gauge load cell in the linkage → ``axial_load`` (see :class:`_LinearTransducer`).
+
+    Parameters
+    ----------
+    full_scale : float [N]
+        Span: twice the rated capacity of a tension/compression cell.
+    nonlinearity, gain_sigma : float [-]
+    drift_sigma : float [N/s]
+    bandwidth : float [Hz]
+    noise, resolution : float [N]
+    """
+
+    KIND: ClassVar[str] = "load cell"
+    UNITS: ClassVar[dict[str, str]] = {
+        "full_scale": "N",
+        "nonlinearity": "-",
+        "gain_sigma": "-",
+        "drift_sigma": "N/s",
+        "bandwidth": "Hz",
+        "noise": "N",
+        "resolution": "N",
+    }
+    ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = _LINEAR_ALIASES
+    SOURCE: ClassVar[str] = "axial_load"
+
+
+@dataclass(frozen=True)
+class Accelerometer(_Sensor):
+    """Accelerometer on the nut housing → one ``nut_<axis>_accel`` channel (its axis).
+
+    measured = clip(HP(LP(R(g·(a + t·(cos φ·a₁ + sin φ·a₂))))) → decimate → + n, then clip.
+    a: truth acceleration of the sensor's axis; a₁, a₂: the two nut accelerations across it
+    (:data:`TRANSVERSE`); t: ``transverse_sensitivity``, its direction φ uniform per run;
+    g = 1 + N(0, gain_sigma) per run; R: mounted resonance (``resonance_frequency``,
+    ``resonance_q``); LP, HP: first-order electrical low-/high-pass (``bandwidth``, ``highpass``:
+    an AC-coupled piezo sensor); clip: ±``range`` (the sensor saturates, and the logger's input
+    range is the sensor's); n: white noise of density ``noise_density`` over the logged band
+    0…f_s/2 (RMS = density·√(f_s/2)), low-passed like the signal when ``bandwidth`` < f_s/2.
+
+    Parameters
+    ----------
+    noise_density : float [m/s²/√Hz]
+        (alias ``noise_density_ug`` in µg/√Hz)
+    transverse_sensitivity : float [-]
+        (alias ``transverse_sensitivity_percent``)
+    resonance_frequency : float [Hz]
+        Mounted resonance (0: none).
+    resonance_q : float [-]
+    bandwidth, highpass : float [Hz]
+        0: none.
+    gain_sigma : float [-]
+        (alias ``gain_sigma_percent``)
+    range : float [m/s²]
+        Measuring range ± (0: unlimited; alias ``range_g``).
+    """
+
+    KIND: ClassVar[str] = "accelerometer"
+    UNITS: ClassVar[dict[str, str]] = {
+        "noise_density": "m/s^2/sqrt(Hz)",
+        "transverse_sensitivity": "-",
+        "resonance_frequency": "Hz",
+        "resonance_q": "-",
+        "bandwidth": "Hz",
+        "highpass": "Hz",
+        "gain_sigma": "-",
+        "range": "m/s^2",
+    }
+    ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = {
+        "noise_density_ug": ("noise_density", 1e-6 * STANDARD_GRAVITY, "µg/√Hz"),
+        "range_g": ("range", STANDARD_GRAVITY, "g"),
+        "transverse_sensitivity_percent": ("transverse_sensitivity", 0.01, "%"),
+        "gain_sigma_percent": ("gain_sigma", 0.01, "%"),
+    }
+
+    noise_density: float = 0.0
+    transverse_sensitivity: float = 0.0
+    resonance_frequency: float = 0.0
+    resonance_q: float = 10.0
+    bandwidth: float = 0.0
+    highpass: float = 0.0
+    gain_sigma: float = 0.0
+    range: float = 0.0
+
+    def __post_init__(self):
+        self._validate()
+        self._range("noise_density", 0.0, 1.0)
+        self._range("transverse_sensitivity", 0.0, 0.5)
+        self._range("resonance_frequency", 0.0, 1e7)
+        self._range("resonance_q", 0.5, 1e4)
+        self._range("bandwidth", 0.0, 1e7)
+        self._range("highpass", 0.0, 1e3)
+        self._range("gain_sigma", 0.0, 0.5)
+        self._range("range", 0.0, 1e7)
+
+    @staticmethod
+    def axis(channel: str) -> str:
+        """``nut_radial_x_accel`` → ``radial_x``."""
+        return channel.removeprefix("nut_").removesuffix("_accel")
+
+    def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
+        gain = 1.0 + rng.normal(0.0, self.gain_sigma)
+        direction = rng.uniform(0.0, 2 * np.pi)
+        x = _truth(truth, channel, channel)
+        if self.transverse_sensitivity:
+            first, second = (f"nut_{a}_accel" for a in TRANSVERSE[self.axis(channel)])
+            x = x + self.transverse_sensitivity * (
+                math.cos(direction) * _truth(truth, first, channel)
+                + math.sin(direction) * _truth(truth, second, channel)
+            )
+        x = gain * x
+        x = _resonance(x, self.resonance_frequency, self.resonance_q, rate)
+        x = _highpass(_lowpass(x, self.bandwidth, rate), self.highpass, rate)
+        if self.range:
+            x = np.clip(x, -self.range, self.range)
+        y = decimate(x, factor)
+        sample_rate = rate / factor
+        if self.noise_density:
+            noise = rng.normal(0.0, self.noise_density * math.sqrt(0.5 * sample_rate), y.shape)
+            y = y + _lowpass(noise, self.bandwidth, sample_rate)
+        if self.range:
+            y = np.clip(y, -self.range, self.range)
+        return y
+
+
+# ----------------------------------------------------------------------------- profile
+#: Sensor class of every measured channel, in measuring order (the angle before the speed
+#: estimate that differentiates it). The channel set is the contract's measured channels.
+SENSOR_CLASSES: dict[str, type[_Sensor]] = {
+    "screw_angle": AngleSensor,
+    "screw_speed": SpeedEstimate,
+    "nut_position": PositionSensor,
+    "nut_axial_accel": Accelerometer,
+    "nut_tangential_accel": Accelerometer,
+    "nut_radial_x_accel": Accelerometer,
+    "nut_radial_y_accel": Accelerometer,
+    "drive_torque": TorqueEstimate,
+    "axial_load": LoadCell,
+}
+_TOP_KEYS = ("name", "description", "sample_rate")
+
+
+@dataclass(frozen=True)
+class Instrumentation:
+    """The sensors of an actuator and the logger's sample rate.
+
+    One attribute per measured channel: its sensor spec, or None where no sensor is fitted.
+    Build from a profile with :func:`load_instrumentation`.
+
+    Parameters
+    ----------
+    name, description : str
+    sample_rate : float [Hz]
+        Output rate f_s; the integration rate is an integer multiple of it.
+    screw_angle : AngleSensor or None
+    screw_speed : SpeedEstimate or None
+    nut_position : PositionSensor or None
+    nut_axial_accel, nut_tangential_accel, nut_radial_x_accel, nut_radial_y_accel :
+        Accelerometer or None
+    drive_torque : TorqueEstimate or None
+    axial_load : LoadCell or None
+    """
+
+    name: str = "custom"
+    description: str = ""
+    sample_rate: float = DEFAULT_SAMPLE_RATE
+    screw_angle: AngleSensor | None = None
+    screw_speed: SpeedEstimate | None = None
+    nut_position: PositionSensor | None = None
+    nut_axial_accel: Accelerometer | None = None
+    nut_tangential_accel: Accelerometer | None = None
+    nut_radial_x_accel: Accelerometer | None = None
+    nut_radial_y_accel: Accelerometer | None = None
+    drive_torque: TorqueEstimate | None = None
+    axial_load: LoadCell | None = None
+
+    def __post_init__(self):
+        require(
+            isinstance(self.name, str) and self.name != "",
+            "instrumentation.name",
+            self.name,
+            "must be a non-empty string",
+        )
+        require(
+            isinstance(self.description, str),
+            "instrumentation.description",
+            self.description,
+            "must be a string",
+        )
+        require_range("instrumentation.sample_rate", self.sample_rate, 100.0, 1e6, unit="Hz")
+        for channel, kind in SENSOR_CLASSES.items():
+            spec = getattr(self, channel)
+            require(
+                spec is None or isinstance(spec, kind),
+                f"instrumentation.{channel}",
+                type(spec).__name__,
+                f"must be a {kind.__name__} or None",
+            )
+        require(
+            bool(self.fitted),
+            "instrumentation",
+            self.name,
+            f"fits no sensor; fit at least one of {', '.join(SENSOR_CLASSES)}",
+        )
+        speed = self.screw_speed
+        require(
+            speed is None or speed.exact or self.screw_angle is not None,
+            "instrumentation.screw_speed",
+            "fitted",
+            "is estimated from the measured screw_angle: fit screw_angle too",
+        )
+
+    @property
+    def fitted(self) -> tuple[str, ...]:
+        """Names of the measured channels this profile gives, in measuring order."""
+        return tuple(ch for ch in SENSOR_CLASSES if getattr(self, ch) is not None)
+
+    def sensors(self) -> dict:
+        """Fitted channel → sensor spec."""
+        return {ch: getattr(self, ch) for ch in self.fitted}
+
+    def measure(
+        self, truth_raw: dict[str, np.ndarray], integration_rate: float, rng
+    ) -> dict[str, np.ndarray]:
+        """The fitted measured channels at :attr:`sample_rate` from truth at ``integration_rate``.
+
+        Parameters
+        ----------
+        truth_raw : dict of name → ndarray [SI]
+            Truth signals at the integration rate (the names each fitted sensor reads).
+        integration_rate : float [Hz]
+            An integer multiple of :attr:`sample_rate`.
+        rng : numpy.random.Generator
+            Source of every random quantity (one child stream per measured channel).
+
+        Returns
+        -------
+        dict of fitted channel → float64 ndarray at :attr:`sample_rate`
+        """
+        factor = int(round(integration_rate / self.sample_rate))
+        require(
+            factor >= 1
+            and abs(factor * self.sample_rate - integration_rate) < 1e-6 * integration_rate,
+            "instrumentation.sample_rate",
+            self.sample_rate,
+            f"must divide the integration rate {integration_rate:g} Hz",
+        )
+        streams = rng.integers(0, 2**63 - 1, size=len(SENSOR_CLASSES))
+        out: dict[str, np.ndarray] = {}
+        for (channel, _), seed in zip(SENSOR_CLASSES.items(), streams):
+            spec = getattr(self, channel)
+            if spec is not None:
+                child = np.random.default_rng(int(seed))
+                out[channel] = spec.measure(
+                    channel, truth_raw, integration_rate, factor, child, out
+                )
+        return out
+
+    # ------------------------------------------------------------------ dict / TOML / display
+    def to_dict(self) -> dict:
+        """Complete dict form (no ``profile`` key): :func:`load_instrumentation` reads it back."""
+        out = {"name": self.name, "description": self.description, "sample_rate": self.sample_rate}
+        out.update({ch: spec.to_dict() for ch, spec in self.sensors().items()})
+        return out
+
+    def toml_tables(self, prefix: str | None = None) -> list[str]:
+        """The complete form as TOML lines (under ``[prefix]`` if given, e.g. in a scenario)."""
+        data = self.to_dict()
+        lines = [f"[{prefix}]"] if prefix else []
+        lines += [f"{k} = {toml_value(data.pop(k))}" for k in _TOP_KEYS]
+        for channel, values in data.items():
+            table = f"{prefix}.{channel}" if prefix else channel
+            lines += ["", f"[{table}]"] + [f"{k} = {toml_value(v)}" for k, v in values.items()]
+        return lines
+
+    def describe(self) -> dict:
+        """Everything a person needs: each fitted sensor with its kind, what it reads, and every
+        parameter with its unit (``prsm-health instrumentation show``)."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "sample_rate": self.sample_rate,
+            "sensors": {
+                channel: {
+                    "kind": spec.KIND,
+                    "reads": _reads(channel, spec),
+                    "parameters": [{"name": k, "value": v, "unit": u} for k, v, u in spec.rows()],
+                }
+                for channel, spec in self.sensors().items()
+            },
+        }
+
+
+def _reads(channel: str, spec: _Sensor) -> str:
+    if isinstance(spec, Accelerometer):
+        return channel
+    if isinstance(spec, SpeedEstimate) and not spec.exact:
+        return "screw_angle (measured)"
+    return spec.SOURCE
+
+
+# ----------------------------------------------------------------------------- loading
+def list_profiles() -> tuple[str, ...]:
+    """Names of the built-in profiles."""
+    return tuple(sorted(p.stem for p in PROFILE_DIR.glob("*.toml")))
+
+
+@functools.cache
+def _builtin(name: str) -> Instrumentation:
+    path = PROFILE_DIR / f"{name}.toml"
+    return _from_table(read_toml(path, "instrumentation profile"), path.parent, name)
+
+
+def load_instrumentation(
+    source: str | Path | dict | Instrumentation, base: Path | None = None
+) -> Instrumentation:
+    """An instrumentation from a built-in name, a profile TOML file, a dict, or as is.
+
+    Parameters
+    ----------
+    source : str, Path, dict or Instrumentation
+        A built-in name (:func:`list_profiles`); a path to a profile TOML file (relative to
+        ``base``, else the working directory); or the dict form. A dict or file either is
+        complete (``name``, ``description``, ``sample_rate`` and one table per fitted channel)
+        or starts from another profile: ``profile = "flight-ema"`` (or a file) plus overrides —
+        ``sample_rate``, ``name``, ``description``, and per-channel tables whose keys replace
+        the sensor's fields (``[nut_axial_accel] noise_density_ug = 40``), fit a sensor the
+        profile lacks, or remove one (``fitted = false``).
+    base : Path, optional
+
+    Raises
+    ------
+    ParameterError
+        An unknown profile name (the message lists the built-ins), an unknown key (the message
+        names the table and lists the allowed keys) or a value out of range.
+    """
+    if isinstance(source, Instrumentation):
+        return source
+    if isinstance(source, dict):
+        return _from_table(source, base, "custom")
+    if isinstance(source, str) and source in list_profiles():
+        return _builtin(source)
+    if not isinstance(source, (str, Path)) or not str(source):
+        raise ParameterError(
+            "instrumentation", source, "must be a profile name, a profile TOML file or a table"
+        )
+    path = Path(source)
+    if not path.is_absolute() and base is not None:
+        path = Path(base) / path
+    if path.suffix != ".toml" and not path.exists():
+        raise ParameterError(
+            "instrumentation",
+            str(source),
+            f"unknown profile; built-in profiles: {', '.join(list_profiles())} "
+            "(or a profile TOML file, *.toml)",
+        )
+    return _from_table(read_toml(path, "instrumentation profile"), path.parent, path.stem)
+
+
+def _from_table(data: dict, base: Path | None, default_name: str) -> Instrumentation:
+    """A profile from its dict form: complete, or ``profile = …`` plus overrides."""
+    data = dict(data)
+    allowed = ["profile", *_TOP_KEYS, *SENSOR_CLASSES]
+    require_known_keys("instrumentation", data, allowed)
+    if "profile" in data:
+        ref = data.pop("profile")
+        require(
+            isinstance(ref, (str, Path)),
+            "instrumentation.profile",
+            ref,
+            f"must be a profile name ({', '.join(list_profiles())}) or a profile TOML file",
+        )
+        start = load_instrumentation(ref, base)
+        values = {f.name: getattr(start, f.name) for f in fields(start)}
+    else:
+        values = {"name": default_name}
+    values.update({k: data.pop(k) for k in _TOP_KEYS if k in data})
+    for channel, table in data.items():
+        where = f"instrumentation.{channel}"
+        require(
+            isinstance(table, dict),
+            where,
+            table,
+            "must be a table of sensor parameters (or fitted = false)",
+        )
+        table = dict(table)
+        fitted = table.pop("fitted", True)
+        require(isinstance(fitted, bool), f"{where}.fitted", fitted, "must be true or false")
+        if not fitted:
+            require(not table, where, sorted(table), "fitted = false takes no other key")
+            values[channel] = None
+            continue
+        kind = SENSOR_CLASSES[channel]
+        values[channel] = kind.from_table(table, where, values.get(channel))
+    return Instrumentation(**values)
+
+
+def instrumentation_ref(instrumentation: Instrumentation) -> str | dict:
+    """The built-in name if ``instrumentation`` is an unmodified built-in, else its full dict."""
+    name = instrumentation.name
+    if name in list_profiles() and instrumentation == _builtin(name):
+        return name
+    return instrumentation.to_dict()
+
+
+__all__ = [
+    "Accelerometer",
+    "AngleSensor",
+    "DEFAULT_PROFILE",
+    "Instrumentation",
+    "LoadCell",
+    "PositionSensor",
+    "SENSOR_CLASSES",
+    "SpeedEstimate",
+    "TorqueEstimate",
+    "instrumentation_ref",
+    "list_profiles",
+    "load_instrumentation",
+]

@@ -1,0 +1,298 @@
+"""Train and score the shipped prognostics model (models/prognostics.json) on the fleet recipe.
+
+    python tools/release/train_prognostics_model.py [--dataset build/fleet] [--workers 2]
+        [--evaluate-only]
+
+1. Generates datasets/fleet.toml (20 units × 30 snapshots) into ``--dataset`` unless it is
+   complete (resumable), timed.
+2. Diagnoses every snapshot with the shipped diagnosis model (batched), as the histories a
+   user's fleet would give (cached beside the dataset as ``<dataset>-diagnoses.parquet``).
+3. Fits :class:`prsm_health.prognostics.rul.PrognosticsModel` on the training units. Its failure
+   threshold is in the units of the health indicator, the *diagnosed* clearance: the diagnosed
+   clearance at failure, learnt from the training units (median over them of a straight-line
+   fit to their last diagnoses, evaluated at their failure age) — the recipe's limit is on the
+   true clearance, which the diagnosis reads with its own bias.
+4. Scores both methods (degradation model, similarity baseline) on the held-out units, every
+   history prefix: RMSE, α–λ accuracy (α = 0.2) after half of life, 90 % interval coverage,
+   prognostic horizon (prsm_health.prognostics.metrics), with a sensitivity table by unit
+   life and failure mode.
+5. Writes models/prognostics.json, models/PROGNOSTICS_CARD.md and models/figures/prognostics_*.png.
+   ``--evaluate-only`` re-scores the shipped model without fitting.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from prsm_health.datasets import Dataset, generate, load_recipe
+from prsm_health.prognostics import (
+    DEFAULT_PROGNOSTICS_MODEL,
+    PrognosticsModel,
+    fleet_histories,
+    load_prognostics_model,
+    save_prognostics_model,
+)
+from prsm_health.prognostics.metrics import evaluate_units
+
+ROOT = Path(__file__).resolve().parents[2]
+
+RECIPE = ROOT / "datasets" / "fleet.toml"
+CARD = ROOT / "models" / "PROGNOSTICS_CARD.md"
+FIGURES = ROOT / "models" / "figures"
+ALPHA = 0.2
+#: Sensitivity study: usage variability and health-indicator noise (life model only, no
+#: dynamics): 60 units each, 40 to fit, 20 to score.
+USAGE_LEVELS = (0.0, 0.15, 0.3)
+NOISE_LEVELS = (0.0, 1e-6, 2e-6)  # m, 1σ of a diagnosis' error (the shipped one: ≈ 2 µm)
+#: Diagnoses of a unit's last share of life used to read the indicator at failure.
+LAST_SHARE = 0.25
+
+
+def diagnosed_threshold(train: pd.DataFrame) -> float:
+    """The diagnosed clearance at failure [m]: median over the training units of a straight
+    line through their diagnoses in the last LAST_SHARE of life, evaluated at failure."""
+    values = []
+    for _, unit in train.groupby("unit_id"):
+        failure = float(unit["failure_age_hours"].iloc[0])
+        late = unit[unit["age_hours"] >= (1 - LAST_SHARE) * failure]
+        slope, intercept = np.polyfit(late["age_hours"], late["clearance"], 1)
+        values.append(intercept + slope * failure)
+    return float(np.median(values))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--dataset", default=str(ROOT / "build" / "fleet"))
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--evaluate-only", action="store_true")
+    args = parser.parse_args()
+
+    recipe = load_recipe(RECIPE)
+    t0 = time.perf_counter()
+    report = generate(recipe, args.dataset, workers=args.workers, progress=True)
+    generation = time.perf_counter() - t0
+    print(
+        f"fleet: {report.total_runs} snapshots ({report.resumed_runs} already there) in "
+        f"{generation:.1f} s on {args.workers} workers"
+    )
+    cache = Path(str(args.dataset).rstrip("/") + "-diagnoses.parquet")
+    dataset = Dataset(args.dataset)
+    if cache.exists():
+        histories = pd.read_parquet(cache)
+    else:
+        t0 = time.perf_counter()
+        histories = fleet_histories(dataset, progress=True)
+        print(f"diagnosed {len(histories)} snapshots in {time.perf_counter() - t0:.1f} s")
+        histories.to_parquet(cache)
+    failure = histories.groupby("unit_id")["failure_age_hours"].first().to_dict()
+    train = histories[histories["split"] == "train"]
+    test = histories[histories["split"] == "test"]
+
+    if args.evaluate_only:
+        model = load_prognostics_model(DEFAULT_PROGNOSTICS_MODEL)
+    else:
+        threshold = diagnosed_threshold(train)
+        print(
+            f"diagnosed clearance at failure {threshold * 1e6:.2f} µm "
+            f"(true limit {recipe.life_spec.failure_clearance * 1e6:g} µm)"
+        )
+        model = PrognosticsModel(threshold=threshold, design=recipe.design)
+        model.fit(train, {u: failure[u] for u in train["unit_id"].unique()})
+        save_prognostics_model(DEFAULT_PROGNOSTICS_MODEL, model)
+
+    t0 = time.perf_counter()
+    predictions, summary = evaluate_units(
+        test, {u: failure[u] for u in test["unit_id"].unique()}, model, alpha=ALPHA
+    )
+    print(f"scored {len(predictions)} predictions in {time.perf_counter() - t0:.1f} s")
+    for method, s in summary.items():
+        print(
+            f"{method:12s} α–λ {s['alpha_lambda']:.3f}  coverage after half {s['coverage_after']:.3f}"
+            f"  (all {s['coverage']:.3f})  RMSE after half {s['rmse_after']:.0f} h"
+            f"  PH {s['prognostic_horizon']:.0f} h"
+        )
+    sensitivity = sensitivity_table(recipe)
+    _write_card(recipe, model, histories, predictions, summary, generation, report, sensitivity)
+
+
+def sensitivity_table(recipe) -> list[str]:
+    """α–λ accuracy and coverage (degradation / similarity) against usage variability and
+    health-indicator noise: the life model's trajectories observed with Gaussian errors of a
+    given σ (intervals ±1.645σ, at least ±0.2 µm), so what limits a RUL is seen apart from
+    the diagnosis."""
+    from dataclasses import replace
+
+    from prsm_health.actuator.design_files import load_design
+    from prsm_health.physics.life import fleet_lives
+
+    spec0 = recipe.life_spec
+    rows = []
+    for usage in USAGE_LEVELS:
+        spec = replace(spec0, units=60, scatter=replace(spec0.scatter, usage=usage))
+        lives = fleet_lives(load_design(recipe.design), spec, recipe.seed + 1)
+        failure = {u.unit_id: u.failure_age for u in lives}
+        cells = []
+        for noise in NOISE_LEVELS:
+            rng = np.random.default_rng([recipe.seed, int(noise * 1e9)])
+            frames = []
+            for unit in lives:
+                ages = unit.snapshot_ages(spec.snapshots)
+                value = unit.clearance(ages) + rng.normal(0.0, noise, len(ages))
+                half = max(1.645 * noise, 0.2e-6)
+                frames.append(
+                    pd.DataFrame(
+                        {
+                            "unit_id": unit.unit_id,
+                            "age_hours": ages,
+                            "clearance": value,
+                            "clearance_lower": value - half,
+                            "clearance_upper": value + half,
+                        }
+                    )
+                )
+            table = pd.concat(frames, ignore_index=True)
+            train, test = table[table["unit_id"] < 40], table[table["unit_id"] >= 40]
+            model = PrognosticsModel(threshold=spec.failure_clearance, design=recipe.design)
+            model.fit(train, {u: failure[u] for u in range(40)})
+            _, summary = evaluate_units(
+                test, {u: failure[u] for u in range(40, 60)}, model, alpha=ALPHA
+            )
+            d, s = summary["degradation"], summary["similarity"]
+            cells.append(
+                f"{d['alpha_lambda']:.2f} / {s['alpha_lambda']:.2f} — "
+                f"{d['coverage_after']:.2f} / {s['coverage_after']:.2f}"
+            )
+        rows.append(f"| {usage:g} | " + " | ".join(cells) + " |")
+        print(rows[-1])
+    return rows
+
+
+def _write_card(
+    recipe, model, histories, predictions, summary, generation, report, sensitivity
+) -> None:
+    from prsm_health.apps.plots import plot_prognostics
+
+    FIGURES.mkdir(parents=True, exist_ok=True)
+    figures = plot_prognostics(histories, predictions, model, FIGURES, alpha=ALPHA)
+    test = histories[histories["split"] == "test"]
+    spec = recipe.life_spec
+    lives = histories.groupby("unit_id")[["failure_age_hours", "failure_mode", "split"]].first()
+    by_unit = _sensitivity(predictions, lives)
+    lines = [
+        "# Prognostics card — `models/prognostics.json`",
+        "",
+        "*Generated by `tools/release/train_prognostics_model.py`; every number below was measured by it.*",
+        "",
+        "**What it is.** The default model of `prsm-health prognose` and of the service's "
+        "`GET /v1/assets/{id}/prognosis`: remaining useful life [h] with a 90 % interval from a "
+        "history of diagnoses of one asset over its operating hours, for a paper-01 PRSM "
+        "measured by the `flight-ema` instrumentation and diagnosed by the default model "
+        "(`models/default.skops`). Health indicator: the diagnosed clearance (mean of screw and "
+        f"nut half-clearances). Default method: degradation model `{model.form_}` form with "
+        "Bayesian updating (Gebraeel et al. 2005); baseline: similarity (Wang et al. 2008).",
+        "",
+        f"**Data.** `datasets/fleet.toml`: {spec.units} units × {spec.snapshots} snapshots of "
+        f"{recipe.duration:g} s ({report.total_runs} runs"
+        + (
+            f"; generated in {generation:.0f} s on 2 workers"
+            if report.resumed_runs == 0
+            else "; generation timed in docs/prognostics.md"
+        )
+        + "). Each unit wears by Archard wear of its thread contacts, "
+        "faster as its lubricant's additives deplete, with unit-to-unit scatter of build, wear "
+        "coefficient, lubricant life, temperature, loads and a wandering usage intensity "
+        "(docs/prognostics.md); it fails when its true mean half-clearance reaches "
+        f"{spec.failure_clearance * 1e6:g} µm or a spall grows {spec.failure_spall_length * 1e3:g} "
+        f"mm long. Lives {lives['failure_age_hours'].min():.0f}–"
+        f"{lives['failure_age_hours'].max():.0f} h; failure modes "
+        + ", ".join(f"{k} {v}" for k, v in lives["failure_mode"].value_counts().items())
+        + f". Trained on {int((lives['split'] == 'train').sum())} units, scored on the "
+        f"{int((lives['split'] == 'test').sum())} held-out units "
+        f"({sorted(int(u) for u in test['unit_id'].unique())}): run seeds never used in "
+        "training, every prefix of their histories (≥ 2 diagnoses) predicted on its own.",
+        "",
+        f"**Threshold.** The model's threshold is on the diagnosed clearance: "
+        f"{model.threshold * 1e6:.2f} µm, the diagnosed clearance at failure learnt from the "
+        f"training units (the true limit is {spec.failure_clearance * 1e6:g} µm; the diagnosis "
+        "reads worn units between the mean and the screw-side clearance, screw wear being "
+        "≈ 25× the nut's).",
+        "",
+        "## Metrics on the held-out units (Saxena et al. 2010)",
+        "",
+        "| method | α–λ accuracy (α = 0.2), after half of life | 90 % coverage after half of life | coverage, all | RMSE after half of life [h] | RMSE, all [h] | prognostic horizon (mean) [h] | predictions |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for method, s in summary.items():
+        lines.append(
+            f"| {method} | {s['alpha_lambda']:.3f} | {s['coverage_after']:.3f} | "
+            f"{s['coverage']:.3f} | {s['rmse_after']:.0f} | {s['rmse']:.0f} | "
+            f"{s['prognostic_horizon']:.0f} | {s['n_predictions']} |"
+        )
+    lines += [
+        "",
+        "### Per held-out unit (degradation model, after half of life)",
+        "",
+        "| unit | life [h] | failure mode | α–λ accuracy | coverage | RMSE [h] |",
+        "|---|---|---|---|---|---|",
+    ]
+    lines += by_unit
+    lines += [
+        "",
+        "### What limits it: usage variability and indicator noise",
+        "",
+        "The life model's own trajectories (60 units, 40 fitted, 20 scored; no dynamics), "
+        "observed with Gaussian errors of σ (the shipped diagnosis: bias ≈ +2.4 µm, learnt "
+        "into the threshold, and scatter ≈ 2 µm); cells: α–λ accuracy degradation / "
+        "similarity — 90 % coverage degradation / similarity, after half of life.",
+        "",
+        "| usage σ | " + " | ".join(f"indicator σ {n * 1e6:g} µm" for n in NOISE_LEVELS) + " |",
+        "|---|" + "---|" * len(NOISE_LEVELS),
+        *sensitivity,
+        "",
+        "Reading it: the first column is the models' own error with a perfect indicator — for "
+        "the degradation model, the misfit of one fleet-wide baseline φ to units whose initial "
+        "clearance and wear amplitude differ (its intervals are then too narrow); the other "
+        "columns add the diagnosis' scatter, which at the end of life, where the clearance "
+        "grows by 0.01–0.02 µm/h, is worth ±100–200 h against an α bound of ±0.2·RUL. The usage "
+        "rows add the unpredictable future of a unit's usage.",
+        "",
+        "Figures: " + ", ".join(f"[{p.stem}](figures/{p.name})" for p in figures) + ".",
+        "",
+        "## What it cannot do",
+        "",
+        "- A spall's start is random (rolling-contact fatigue, ISO 281 scatter) and the "
+        "diagnosis rarely sees a young spall: a unit that fails by a spall before it wears out "
+        "is predicted as if it would wear out (its RUL overestimated). The fleet recipe's duty "
+        "makes such failures rare; a heavier duty would not.",
+        "- One duty cycle family, one design, one instrumentation: another actuator needs its "
+        "own fleet recipe and `tools/release/train_prognostics_model.py` run on it.",
+        "- The health indicator is the clearance alone; lubricant degradation and spall "
+        "probabilities of the diagnosis are not used.",
+    ]
+    CARD.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print(f"wrote {CARD.relative_to(ROOT)}")
+
+
+def _sensitivity(predictions: pd.DataFrame, lives: pd.DataFrame) -> list[str]:
+    rows = []
+    chosen = predictions[predictions["method"] == "degradation"]
+    for unit, p in chosen.groupby("unit_id"):
+        life = float(lives.loc[unit, "failure_age_hours"])
+        late = p[p["age_hours"] >= 0.5 * life]
+        err = late["estimate"] - late["true_rul"]
+        inside = (np.abs(err) <= ALPHA * late["true_rul"]).mean()
+        covered = ((late["lower"] <= late["true_rul"]) & (late["true_rul"] <= late["upper"])).mean()
+        rows.append(
+            f"| {unit} | {life:.0f} | {lives.loc[unit, 'failure_mode']} | {inside:.2f} | "
+            f"{covered:.2f} | {np.sqrt(np.mean(err**2)):.0f} |"
+        )
+    return rows
+
+
+if __name__ == "__main__":
+    main()
