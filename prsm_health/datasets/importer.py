@@ -1,7 +1,7 @@
 """Your own rig's recordings as a dataset: CSV, Parquet or MCAP files plus a labels table.
 
 ``prsm-health import RECORDINGS… --labels LABELS.csv --map MAP.toml --out DIR`` (docs/import.md)
-writes the dataset layout of :mod:`prsm_health.datasets.dataset` — one Parquet shard per recording, the
+writes the dataset layout of :mod:`prsm_health.datasets` — one Parquet shard per recording, the
 labels table ``runs.parquet``, ``manifest.json`` — so ``train`` and ``evaluate`` work on it as on
 a generated dataset.
 
@@ -339,7 +339,7 @@ def import_recordings(
     from prsm_health import __version__
     from prsm_health.actuator.faults import FAULT_CLASSES
 
-    from .dataset import dataset_counts
+    from .store import dataset_counts
 
     out = Path(out)
     if not (0 <= test_fraction < 1):

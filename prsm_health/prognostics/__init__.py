@@ -1,24 +1,20 @@
-"""Prognostics: remaining useful life from a unit's history of diagnoses, its models, their
-files, fleet pipelines and the prognostic metrics (docs/prognostics.md).
+"""Prognostics: remaining useful life from a unit's history of diagnoses (docs/prognostics.md).
+
+- :mod:`.history` — the history table: columns, reading a file, validation with row-naming errors
+- :mod:`.degradation` — the Bayesian degradation model's arithmetic (Gebraeel et al. 2005)
+- :mod:`.rul` — :class:`PrognosticsModel` (degradation model, similarity baseline) → :class:`Prognosis`
+- :mod:`.model_files` — JSON model files
+- :mod:`.fleet` — a fleet dataset's snapshots diagnosed into histories
+- :mod:`.metrics` — RMSE, α–λ accuracy, prognostic horizon, coverage (Saxena et al. 2010)
 
 Import from here, not from the modules: their split is this package's business.
 """
 
-from .rul import (
-    DEFAULT_PROGNOSTICS_MODEL,
-    HISTORY_COLUMNS,
-    HORIZON_FACTOR,
-    METHODS,
-    HistoryError,
-    Prognosis,
-    PrognosticsModel,
-    fleet_histories,
-    load_prognostics_model,
-    prognose,
-    read_history,
-    save_prognostics_model,
-    validate_history,
-)
+from .fleet import fleet_histories
+from .history import HISTORY_COLUMNS, HistoryError, read_history, validate_history
+from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
+from .prognosis import Prognosis
+from .rul import HORIZON_FACTOR, METHODS, PrognosticsModel, prognose
 
 __all__ = [
     "DEFAULT_PROGNOSTICS_MODEL",

@@ -30,7 +30,8 @@ import pandas as pd
 
 from prsm_health.core.errors import ParameterError, require, require_range
 
-from .rul import HISTORY_COLUMNS, PrognosticsModel
+from .history import HISTORY_COLUMNS
+from .rul import PrognosticsModel
 
 __all__ = [
     "alpha_lambda_accuracy",
@@ -215,7 +216,7 @@ def evaluate_units(
     ----------
     histories : pandas.DataFrame
         Column ``unit_id`` plus the history columns
-        (:data:`prsm_health.prognostics.rul.HISTORY_COLUMNS`).
+        (:data:`prsm_health.prognostics.HISTORY_COLUMNS`).
     failure_ages : Mapping
         Unit id -> true failure age [h].
     model : PrognosticsModel
@@ -224,7 +225,7 @@ def evaluate_units(
         The alpha-lambda accuracy and the ``*_after`` entries use the predictions made at
         ages >= ``after_fraction`` x the unit's failure age, in [0, 1).
     methods : sequence of str, default ("degradation", "similarity")
-        Methods to evaluate (:data:`prsm_health.prognostics.rul.METHODS`).
+        Methods to evaluate (:data:`prsm_health.prognostics.METHODS`).
     alpha : float, default 0.2
         Accuracy bound of the alpha-lambda accuracy and of the prognostic horizon.
 

@@ -43,15 +43,11 @@ References
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.optimize import minimize_scalar
 
 from prsm_health.core.errors import (
     ModelVersionError,
@@ -62,29 +58,24 @@ from prsm_health.core.errors import (
 )
 from prsm_health.core.jsonable import json_ready
 
-__all__ = [
-    "HISTORY_COLUMNS",
-    "HistoryError",
-    "Prognosis",
-    "PrognosticsModel",
-    "load_prognostics_model",
-    "prognose",
-    "read_history",
-    "save_prognostics_model",
-    "validate_history",
-]
+from .degradation import (
+    curve,
+    fit_sigma2,
+    posterior,
+    prior,
+    profile_phi,
+    sample_gaussian,
+    transform,
+    weighted_quantiles,
+    wls_by_unit,
+    y_threshold,
+)
+from .history import Z90, HistoryError, history_arrays, one_line, validate_history
+from .prognosis import Prognosis
 
-#: The shipped prognostics model (fitted on datasets/fleet.toml by tools/release/train_prognostics_model.py).
-DEFAULT_PROGNOSTICS_MODEL = Path(__file__).resolve().parents[2] / "models" / "prognostics.json"
-#: Required columns of a history: age [h], clearance estimate and its 90 % interval [m].
-HISTORY_COLUMNS = ("age_hours", "clearance", "clearance_lower", "clearance_upper")
-#: Optional columns a history may carry (checked when present).
-OPTIONAL_COLUMNS = ("design", "fault_class", "unit_id")
 #: Methods :meth:`PrognosticsModel.predict` accepts. ``"degradation"`` uses the form chosen at
 #: fit time; ``"degradation-exponential"`` / ``"degradation-linear"`` force a form.
 METHODS = ("degradation", "degradation-exponential", "degradation-linear", "similarity")
-#: z of the 95 % normal quantile: a diagnosis' 90 % interval is +-1.645 standard deviations.
-Z90 = 1.6448536269514722
 #: Quantiles reported: lower bound, estimate (median), upper bound.
 QUANTILES = (0.05, 0.5, 0.95)
 #: RUL is capped at this multiple of the training fleet's longest life [-] (the horizon):
@@ -100,18 +91,6 @@ MIN_TRAINING_UNITS = 3
 _FORMAT = "prsm_health-prognostics"
 _FORMAT_VERSION = 1
 _FORMS = ("exponential", "linear")
-# Floor of sigma^2 in the model's own units (log units; fractions of the threshold): keeps the
-# posterior finite for noiseless histories while being negligible against any real scatter.
-_SIGMA2_FLOOR = 1e-16
-# Ridge added to the prior covariance (scaled parameters, order one): a fleet of identical
-# units still has an invertible prior.
-_PRIOR_RIDGE = 1e-12
-# Candidate margins of phi below the fleet's initial clearance, as fractions of the rise from
-# that level to the threshold (profile-likelihood search, then refined between neighbours).
-_PHI_MARGINS = np.geomspace(1e-3, 1.0, 31)
-# Floor of S - phi in the exponential form, as a fraction of (threshold - phi), for diagnoses
-# without an interval; with an interval the floor is one measurement standard deviation.
-_LOG_FLOOR_FRACTION = 1e-3
 # Similarity alignment: the aligned first diagnosis may lie this fraction of a library unit's
 # life before the unit's first age (its curve extrapolated back). Forbidding it (shifts >= 0
 # only) lets slow units align and penalizes fast or high-starting ones: an upward RUL bias.
@@ -124,20 +103,6 @@ _ALIGN_REFINE = 41
 _BANDWIDTH_NEIGHBOUR_FRACTION = 0.2
 
 
-class HistoryError(ParameterError):
-    """A history that cannot be used for a prognosis.
-
-    A :class:`~prsm_health.core.errors.ParameterError` whose one-line message names the problem
-    and, where there is one, the offending row (rows counted from 0 in table order).
-    """
-
-    def __init__(self, message: str, field: str = "history", value=None):
-        self.field = field
-        self.value = value
-        self.allowed = message
-        Exception.__init__(self, message)
-
-
 def _package_version() -> str:
     # Imported lazily: prsm_health/__init__ is outside the layers and may import this module.
     from prsm_health import __version__
@@ -145,371 +110,9 @@ def _package_version() -> str:
     return __version__
 
 
-def _show(value) -> str:
-    """A table cell for a message: numbers plain (``nan``, ``1e-05``), anything else repr."""
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float):
-        return f"{value:g}"
-    return repr(value)
-
-
-def _one_line(text) -> str:
-    lines = str(text).strip().splitlines()
-    return lines[0] if lines else type(text).__name__
-
-
-# --------------------------------------------------------------------------------------------
-# Histories
-# --------------------------------------------------------------------------------------------
-
-
-def read_history(path) -> pd.DataFrame:
-    """Read a history table from a CSV or Parquet file (chosen by the suffix).
-
-    Parameters
-    ----------
-    path : str or Path
-        ``*.csv`` or ``*.parquet`` / ``*.pq`` file with the columns :data:`HISTORY_COLUMNS`
-        (``age_hours`` [h], ``clearance``, ``clearance_lower``, ``clearance_upper`` [m]) and
-        optionally ``design``, ``fault_class``, ``unit_id``.
-
-    Returns
-    -------
-    pandas.DataFrame
-        The table as read (not yet validated: :func:`validate_history` does that).
-
-    Raises
-    ------
-    PRSMHealthError
-        A missing or unreadable file, an unknown suffix (one line naming the file).
-    HistoryError
-        A required column is missing (the message names the file and the columns).
-    """
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in (".csv", ".parquet", ".pq"):
-        raise PRSMHealthError(
-            f"{path}: cannot read history (unknown suffix {suffix!r}; use .csv or .parquet)"
-        )
-    try:
-        table = pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)
-    except FileNotFoundError:
-        raise PRSMHealthError(f"{path}: cannot read history (no such file)") from None
-    except (OSError, ValueError, UnicodeDecodeError, ImportError) as err:
-        raise PRSMHealthError(f"{path}: cannot read history ({_one_line(err)})") from None
-    missing = [c for c in HISTORY_COLUMNS if c not in table.columns]
-    if missing:
-        raise HistoryError(
-            f"{path}: history lacks column(s) {', '.join(missing)} "
-            f"(required: {', '.join(HISTORY_COLUMNS)})",
-            field="history.columns",
-            value=missing,
-        )
-    return table
-
-
-def validate_history(history: pd.DataFrame, model=None) -> pd.DataFrame:
-    """Check a history and return a clean copy (float columns, index 0…n-1, age order).
-
-    Parameters
-    ----------
-    history : pandas.DataFrame
-        Diagnoses of one unit: :data:`HISTORY_COLUMNS` (``age_hours`` [h] strictly increasing
-        from row to row, ``clearance``, ``clearance_lower`` <= ``clearance_upper`` [m], all
-        finite), optionally ``design`` (one design), ``unit_id`` (one unit), ``fault_class``.
-    model : PrognosticsModel, optional
-        When given, a ``design`` column must name ``model.design``.
-
-    Returns
-    -------
-    pandas.DataFrame
-        A copy with the required columns as float64 and a fresh index; other columns kept.
-
-    Raises
-    ------
-    HistoryError
-        (a :class:`~prsm_health.core.errors.ParameterError`) with a one-line message: not a table,
-        missing column, fewer than 2 rows, a non-number or non-finite value (column and row),
-        a negative age, ages not strictly increasing (the first offending row), a lower bound
-        above the upper bound (row), several designs or units, a design other than the model's.
-    """
-    if not isinstance(history, pd.DataFrame):
-        raise HistoryError(
-            f"a history must be a pandas DataFrame, not {type(history).__name__}",
-            value=type(history).__name__,
-        )
-    missing = [c for c in HISTORY_COLUMNS if c not in history.columns]
-    if missing:
-        raise HistoryError(
-            f"history lacks column(s) {', '.join(missing)} "
-            f"(required: {', '.join(HISTORY_COLUMNS)})",
-            field="history.columns",
-            value=missing,
-        )
-    n = len(history)
-    if n < 2:
-        raise HistoryError(
-            f"a prognosis needs at least 2 diagnoses over operating hours; the history has {n}",
-            field="history.rows",
-            value=n,
-        )
-    out = history.reset_index(drop=True).copy()
-    for column in HISTORY_COLUMNS:
-        raw = out[column]
-        values = pd.to_numeric(raw, errors="coerce").to_numpy(dtype=np.float64, na_value=np.nan)
-        bad = np.flatnonzero(~np.isfinite(values))
-        if bad.size:
-            i = int(bad[0])
-            raise HistoryError(
-                f"history {column} must be a finite number; row {i} has {_show(raw.iloc[i])}",
-                field=f"history.{column}",
-                value=raw.iloc[i],
-            )
-        out[column] = values
-    ages = out["age_hours"].to_numpy()
-    if ages[0] < 0:
-        raise HistoryError(
-            f"history age_hours must be >= 0; row 0 has {ages[0]:g} h",
-            field="history.age_hours",
-            value=float(ages[0]),
-        )
-    steps = np.flatnonzero(np.diff(ages) <= 0)
-    if steps.size:
-        i = int(steps[0]) + 1
-        raise HistoryError(
-            f"history age_hours must be strictly increasing; row {i} has {ages[i]:g} h "
-            f"after {ages[i - 1]:g} h in row {i - 1}",
-            field="history.age_hours",
-            value=float(ages[i]),
-        )
-    lower = out["clearance_lower"].to_numpy()
-    upper = out["clearance_upper"].to_numpy()
-    crossed = np.flatnonzero(lower > upper)
-    if crossed.size:
-        i = int(crossed[0])
-        raise HistoryError(
-            f"history clearance_lower > clearance_upper in row {i} "
-            f"({lower[i]:.6g} m > {upper[i]:.6g} m)",
-            field="history.clearance_lower",
-            value=float(lower[i]),
-        )
-    if "design" in out.columns:
-        designs = sorted({str(d) for d in out["design"].dropna()})
-        if len(designs) > 1:
-            raise HistoryError(
-                f"history mixes designs {', '.join(repr(d) for d in designs)}; "
-                "a prognosis is of one unit of one design",
-                field="history.design",
-                value=designs,
-            )
-        if designs and model is not None and designs[0] != str(model.design):
-            raise HistoryError(
-                f"history is of design {designs[0]!r}, the prognostics model of {model.design!r}",
-                field="history.design",
-                value=designs[0],
-            )
-    if "unit_id" in out.columns:
-        units = out["unit_id"].dropna().unique()
-        if len(units) > 1:
-            shown = ", ".join(_show(u) for u in list(units)[:3])
-            raise HistoryError(
-                f"history mixes units ({shown}{', …' if len(units) > 3 else ''}); "
-                "a prognosis is of one unit",
-                field="history.unit_id",
-                value=len(units),
-            )
-    return out
-
-
-def _arrays(history: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Ages [h], clearance estimates [m] and measurement standard deviations [m]."""
-    t = history["age_hours"].to_numpy(dtype=np.float64)
-    value = history["clearance"].to_numpy(dtype=np.float64)
-    half_width = 0.5 * (
-        history["clearance_upper"].to_numpy(dtype=np.float64)
-        - history["clearance_lower"].to_numpy(dtype=np.float64)
-    )
-    return t, value, half_width / Z90
-
-
 # --------------------------------------------------------------------------------------------
 # Prognosis
 # --------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Prognosis:
-    """The remaining useful life of one unit, with the evidence it rests on.
-
-    Attributes
-    ----------
-    rul_hours : dict
-        ``{"estimate", "lower", "upper"}`` [h]: median and 5 % / 95 % quantiles (a 90 %
-        interval); all >= 0.
-    health_indicator : dict
-        ``{"name": "clearance", "unit": "m", "threshold", "ages_hours", "values", "lower",
-        "upper", "current"}``: the history the RUL was predicted from and the failure
-        threshold [m]; ``current`` is the latest clearance estimate [m].
-    model : dict
-        ``{"name", "version", "design", "units_trained", …}``: ``name`` is
-        ``"degradation-exponential"``, ``"degradation-linear"`` or ``"similarity"``; the
-        degradation models add the posterior of ``(ln theta, beta)`` (or ``(theta, beta)``) in
-        physical units [ln m, 1/h] / [m, m/h], ``sigma2``, ``horizon_hours``; the similarity
-        model its ``bandwidth`` and ``effective_units``.
-    warnings : list of str
-        What limits the answer (threshold already crossed, samples capped at the horizon,
-        short history, no wear trend, unit older than the fleet, values below the baseline).
-    """
-
-    rul_hours: dict
-    health_indicator: dict
-    model: dict
-    warnings: list = field(default_factory=list)
-
-    def as_dict(self) -> dict:
-        """Plain JSON-ready dict ``{"rul_hours", "health_indicator", "model", "warnings"}``."""
-        return json_ready(
-            {
-                "rul_hours": self.rul_hours,
-                "health_indicator": self.health_indicator,
-                "model": self.model,
-                "warnings": list(self.warnings),
-            }
-        )
-
-
-def _weighted_quantiles(values: np.ndarray, weights: np.ndarray, q) -> np.ndarray:
-    """Quantiles of a weighted sample (linear interpolation between the weight midpoints)."""
-    order = np.argsort(values, kind="stable")
-    v, w = values[order], weights[order]
-    cumulative = (np.cumsum(w) - 0.5 * w) / np.sum(w)
-    return np.interp(q, cumulative, v)
-
-
-# --------------------------------------------------------------------------------------------
-# Degradation model helpers (scaled time tau = t / t_scale)
-# --------------------------------------------------------------------------------------------
-
-
-def _transform(form: str, value, sd, phi: float, threshold: float):
-    """Signal ``y``, its measurement variance and the below-baseline mask for one form.
-
-    Exponential: ``y = ln(max(S - phi, floor))`` with ``floor`` one measurement standard
-    deviation (at least ``_LOG_FLOOR_FRACTION`` of ``threshold - phi``), variance
-    ``(sd / (S - phi))^2`` (delta method). Linear: ``y = S / threshold``.
-    """
-    if form == "linear":
-        return value / threshold, (sd / threshold) ** 2, np.zeros(value.shape, bool)
-    rise = value - phi
-    floor = np.maximum(sd, _LOG_FLOOR_FRACTION * (threshold - phi))
-    x = np.maximum(rise, floor)
-    return np.log(x), (sd / x) ** 2, rise <= 0
-
-
-def _y_threshold(form: str, phi: float, threshold: float) -> float:
-    return 1.0 if form == "linear" else math.log(threshold - phi)
-
-
-def _curve(form: str, a, b, tau, phi: float, threshold: float):
-    """Clearance [m] of the degradation curve ``(a, b)`` at scaled time ``tau``."""
-    if form == "linear":
-        return threshold * (a + b * tau)
-    return phi + np.exp(np.minimum(a + b * tau, 700.0))
-
-
-def _wls_by_unit(tau, y, w, codes, n_units):
-    """Per-unit weighted least squares of ``y = a + b tau``: a, b and det(X'WX) per unit."""
-    sw = np.bincount(codes, w, n_units)
-    st = np.bincount(codes, w * tau, n_units)
-    stt = np.bincount(codes, w * tau * tau, n_units)
-    sy = np.bincount(codes, w * y, n_units)
-    sty = np.bincount(codes, w * tau * y, n_units)
-    det = sw * stt - st * st
-    b = (sw * sty - st * sy) / det
-    a = (sy - b * st) / sw
-    return a, b, det
-
-
-def _neg_reml(sigma2, tau, y, m, codes, n_units) -> float:
-    """-log restricted likelihood (up to a constant) of per-unit lines with variance sigma2+m."""
-    v = sigma2 + m
-    w = 1.0 / v
-    a, b, det = _wls_by_unit(tau, y, w, codes, n_units)
-    r = y - a[codes] - b[codes] * tau
-    return 0.5 * float(np.sum(np.log(v)) + np.sum(r * r * w) + np.sum(np.log(det)))
-
-
-def _fit_sigma2(tau, y, m, codes, n_units) -> tuple[float, float]:
-    """Restricted-maximum-likelihood ``sigma^2`` [3]_ and the minimized objective."""
-    high = max(float(np.var(y)) + 10 * _SIGMA2_FLOOR, 100 * _SIGMA2_FLOOR)
-    at_floor = _neg_reml(_SIGMA2_FLOOR, tau, y, m, codes, n_units)
-    result = minimize_scalar(
-        lambda s: _neg_reml(math.exp(s), tau, y, m, codes, n_units),
-        bounds=(math.log(_SIGMA2_FLOOR), math.log(high)),
-        method="bounded",
-        options={"xatol": 1e-3},
-    )
-    if at_floor <= result.fun:
-        return _SIGMA2_FLOOR, at_floor
-    return math.exp(float(result.x)), float(result.fun)
-
-
-def _profile_phi(tau, value, sd, codes, n_units, c_ref, threshold) -> float:
-    """The baseline phi [m] maximizing the profile likelihood of the clearances ``S``.
-
-    phi = c_ref - margin: for each margin the per-unit lines and sigma^2 are fitted to
-    ``ln(S - phi)`` and the likelihood is transformed back to the clearance with the Jacobian
-    ``1 / (S - phi)``, so margins are compared on the same data.
-    """
-
-    def objective(margin):
-        phi = c_ref - margin
-        y, m, _ = _transform("exponential", value, sd, phi, threshold)
-        _, nll = _fit_sigma2(tau, y, m, codes, n_units)
-        return nll + float(np.sum(y))  # + sum ln(S - phi): the Jacobian of S -> ln(S - phi)
-
-    rise = threshold - c_ref
-    margins = _PHI_MARGINS * rise
-    scores = np.array([objective(mg) for mg in margins])
-    best = int(np.argmin(scores))
-    low = margins[max(best - 1, 0)]
-    high = margins[min(best + 1, len(margins) - 1)]
-    if high > low:
-        refined = minimize_scalar(
-            lambda s: objective(math.exp(s)),
-            bounds=(math.log(low), math.log(high)),
-            method="bounded",
-            options={"xatol": 1e-3},
-        )
-        if refined.fun < scores[best]:
-            return c_ref - math.exp(float(refined.x))
-    return c_ref - float(margins[best])
-
-
-def _prior(params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Mean and covariance (+ ridge) of per-unit parameters (rows: units)."""
-    mean = params.mean(axis=0)
-    cov = np.cov(params, rowvar=False, ddof=1) + _PRIOR_RIDGE * np.eye(2)
-    return mean, cov
-
-
-def _posterior(mean0, cov0, tau, y, v) -> tuple[np.ndarray, np.ndarray]:
-    """Conjugate Gaussian posterior of (a, b) for ``y = a + b tau + e``, ``e ~ N(0, v)``."""
-    precision0 = np.linalg.inv(cov0)
-    w = 1.0 / v
-    xtwx = np.array([[w.sum(), (w * tau).sum()], [(w * tau).sum(), (w * tau * tau).sum()]])
-    xtwy = np.array([(w * y).sum(), (w * tau * y).sum()])
-    precision = precision0 + xtwx
-    cov = np.linalg.inv(precision)
-    cov = 0.5 * (cov + cov.T)
-    return cov @ (precision0 @ mean0 + xtwy), cov
-
-
-def _sample_gaussian(rng, mean, cov, n) -> np.ndarray:
-    values, vectors = np.linalg.eigh(cov)
-    root = vectors * np.sqrt(np.clip(values, 0.0, None))
-    return mean + rng.standard_normal((n, 2)) @ root.T
 
 
 # --------------------------------------------------------------------------------------------
@@ -740,21 +343,21 @@ class PrognosticsModel:
         self.c_ref_ = c_ref
 
         codes = np.concatenate([np.full(len(p), i) for i, p in enumerate(parts)])
-        t, value, sd = (np.concatenate(x) for x in zip(*(_arrays(p) for p in parts)))
+        t, value, sd = (np.concatenate(x) for x in zip(*(history_arrays(p) for p in parts)))
         tau = t / self.t_scale_
         n_units = len(units)
         thr = float(self.threshold)
 
-        phi = _profile_phi(tau, value, sd, codes, n_units, c_ref, thr)
+        phi = profile_phi(tau, value, sd, codes, n_units, c_ref, thr)
         self.forms_ = {}
         for form in _FORMS:
             form_phi = phi if form == "exponential" else 0.0
-            y, m, _ = _transform(form, value, sd, form_phi, thr)
-            sigma2, _ = _fit_sigma2(tau, y, m, codes, n_units)
-            a, b, _ = _wls_by_unit(tau, y, 1.0 / (sigma2 + m), codes, n_units)
+            y, m, _ = transform(form, value, sd, form_phi, thr)
+            sigma2, _ = fit_sigma2(tau, y, m, codes, n_units)
+            a, b, _ = wls_by_unit(tau, y, 1.0 / (sigma2 + m), codes, n_units)
             params = np.column_stack([a, b])
-            mean, cov = _prior(params)
-            residual = value - _curve(form, a[codes], b[codes], tau, form_phi, thr)
+            mean, cov = prior(params)
+            residual = value - curve(form, a[codes], b[codes], tau, form_phi, thr)
             excess = np.bincount(codes, residual**2 - sd**2, n_units) / np.bincount(
                 codes, None, n_units
             )
@@ -774,13 +377,13 @@ class PrognosticsModel:
         """Leave-one-unit-out RMSE of RUL [h] of one form over every prefix of >= 2 rows."""
         state = self.forms_[form]
         thr = float(self.threshold)
-        y, m, _ = _transform(form, value, sd, state["phi"], thr)
+        y, m, _ = transform(form, value, sd, state["phi"], thr)
         w = 1.0 / (state["sigma2"] + m)
-        y_d = _y_threshold(form, state["phi"], thr)
+        y_d = y_threshold(form, state["phi"], thr)
         errors = []
         for u in range(len(self.units_)):
             keep = np.arange(len(self.units_)) != u
-            mean0, cov0 = _prior(state["params"][keep])
+            mean0, cov0 = prior(state["params"][keep])
             p0 = np.linalg.inv(cov0)
             r0 = p0 @ mean0
             rows = codes == u
@@ -834,7 +437,7 @@ class PrognosticsModel:
         self._require_fitted()
         method = self._resolve_method(method)
         clean = validate_history(history, self)
-        return self._predict_arrays(*_arrays(clean), method)
+        return self._predict_arrays(*history_arrays(clean), method)
 
     def predict_prefixes(self, history: pd.DataFrame, method=None, min_rows: int = 2) -> list:
         """Prognoses at every prefix of the history, each from the rows up to it only.
@@ -861,7 +464,7 @@ class PrognosticsModel:
             min_rows,
             "must be an integer >= 2",
         )
-        t, value, sd = _arrays(validate_history(history, self))
+        t, value, sd = history_arrays(validate_history(history, self))
         return [
             self._predict_arrays(t[:k], value[:k], sd[:k], method)
             for k in range(min_rows, len(t) + 1)
@@ -938,7 +541,7 @@ class PrognosticsModel:
         state = self.forms_[form]
         thr = float(self.threshold)
         phi = state["phi"]
-        y, m, below = _transform(form, value, sd, phi, thr)
+        y, m, below = transform(form, value, sd, phi, thr)
         warnings = []
         if below.any():
             warnings.append(
@@ -947,12 +550,12 @@ class PrognosticsModel:
                 "clipped; this unit starts tighter than the training fleet"
             )
         tau = t / self.t_scale_
-        mean, cov = _posterior(state["mean"], state["cov"], tau, y, state["sigma2"] + m)
+        mean, cov = posterior(state["mean"], state["cov"], tau, y, state["sigma2"] + m)
         rng = np.random.default_rng(self.random_state)
-        draws = _sample_gaussian(rng, mean, cov, int(self.n_samples))
+        draws = sample_gaussian(rng, mean, cov, int(self.n_samples))
         eps = rng.standard_normal(int(self.n_samples)) * math.sqrt(state["sigma2"])
         a, b = draws[:, 0], draws[:, 1]
-        y_d = _y_threshold(form, phi, thr)
+        y_d = y_threshold(form, phi, thr)
         with np.errstate(divide="ignore", invalid="ignore"):
             crossing = np.where(b > 0, (y_d - a - eps) / b, np.inf) * self.t_scale_
         rul = crossing - t[-1]
@@ -1012,7 +615,7 @@ class PrognosticsModel:
                 level = np.exp(np.minimum(params[:, 0, None] + params[:, 1, None] * now, 700.0))
                 curve = phi + level[:, :, None] * decay[:, None, :]
             else:
-                curve = _curve(
+                curve = curve(
                     form,
                     params[:, 0, None, None],
                     params[:, 1, None, None],
@@ -1040,7 +643,7 @@ class PrognosticsModel:
         bandwidth = max(1.0, 0.5 * float(np.sort(excess)[min(k, n_units) - 1]))
         w = np.exp(-excess / (2.0 * bandwidth))
         rul = np.clip(lives - aligned, 0.0, self.horizon_)
-        low_q, mid, high_q = _weighted_quantiles(rul, w, QUANTILES)
+        low_q, mid, high_q = weighted_quantiles(rul, w, QUANTILES)
         model = self._base_model_dict("similarity")
         model.update(
             {
@@ -1136,77 +739,11 @@ class PrognosticsModel:
                         raise ValueError("non-finite parameter")
                 model.forms_ = forms
         except ParameterError as err:
-            raise PRSMHealthError(f"malformed prognostics model ({_one_line(err)})") from None
+            raise PRSMHealthError(f"malformed prognostics model ({one_line(err)})") from None
         except (KeyError, TypeError, ValueError, AttributeError) as err:
-            what = f"missing {err}" if isinstance(err, KeyError) else _one_line(err)
+            what = f"missing {err}" if isinstance(err, KeyError) else one_line(err)
             raise PRSMHealthError(f"malformed prognostics model ({what})") from None
         return model
-
-
-def save_prognostics_model(path, model: PrognosticsModel) -> Path:
-    """Write a fitted model as a JSON file (atomically: temporary file, then rename).
-
-    Parameters
-    ----------
-    path : str or Path
-        Destination (conventionally ``*.json``); replaced if it exists.
-    model : PrognosticsModel
-        A fitted model.
-
-    Returns
-    -------
-    Path
-        The written file.
-
-    Raises
-    ------
-    ParameterError
-        Not a fitted :class:`PrognosticsModel`.
-    PRSMHealthError
-        An unwritable path.
-    """
-    path = Path(path)
-    require(
-        isinstance(model, PrognosticsModel) and model._is_fitted(),
-        "model",
-        type(model).__name__,
-        "must be a fitted PrognosticsModel",
-    )
-    from prsm_health.diagnostics.model_files import write_atomic
-
-    text = json.dumps(model.to_dict(), indent=1, allow_nan=False)
-    write_atomic(path, text.encode("utf-8"), "prognostics model")
-    return path
-
-
-def load_prognostics_model(path=None) -> PrognosticsModel:
-    """Read a model written by :func:`save_prognostics_model` (default: the shipped one,
-    :data:`DEFAULT_PROGNOSTICS_MODEL`).
-
-    Raises
-    ------
-    PRSMHealthError
-        A missing, unreadable, non-JSON or malformed file (one line naming the file).
-    ModelVersionError
-        A file of another format version.
-    """
-    path = DEFAULT_PROGNOSTICS_MODEL if path is None else path
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise PRSMHealthError(f"{path}: cannot read prognostics model (no such file)") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise PRSMHealthError(f"{path}: cannot read prognostics model ({_one_line(err)})") from None
-    try:
-        d = json.loads(text)
-    except ValueError as err:
-        raise PRSMHealthError(f"{path}: not a prognostics model (invalid JSON: {err})") from None
-    try:
-        return PrognosticsModel.from_dict(d)
-    except ModelVersionError as err:
-        raise ModelVersionError(f"{path}: {err}") from None
-    except PRSMHealthError as err:
-        raise PRSMHealthError(f"{path}: {err}") from None
 
 
 def prognose(history: pd.DataFrame, model: PrognosticsModel, method=None) -> Prognosis:
@@ -1233,96 +770,3 @@ def prognose(history: pd.DataFrame, model: PrognosticsModel, method=None) -> Pro
     )
     clean = validate_history(history, model)
     return model.predict(clean, method=method)
-
-
-def fleet_histories(
-    dataset,
-    bundle=None,
-    *,
-    units=None,
-    until_age: float | None = None,
-    progress: bool = False,
-    batch: int = 32,
-) -> pd.DataFrame:
-    """Diagnose the snapshots of a fleet dataset (a life recipe's) in batches: one history row
-    per snapshot.
-
-    Parameters
-    ----------
-    dataset : str, Path or :class:`~prsm_health.datasets.dataset.Dataset`
-    bundle : ModelBundle, default the shipped diagnosis model
-    units : iterable of int or None
-        The units to diagnose (default all).
-    until_age : float or None [h]
-        Only snapshots at ages ≤ this (what was known then).
-    progress : bool
-        A progress bar on stderr.
-
-    Returns
-    -------
-    DataFrame
-        ``unit_id``, :data:`HISTORY_COLUMNS`, ``design``, ``fault_class``, and the labels a
-        prognosis is scored against: ``split``, ``rul_hours``, ``failure_age_hours``,
-        ``failure_mode``, ``clearance_mean_true`` — sorted by unit and age.
-
-    Raises
-    ------
-    PRSMHealthError
-        A dataset without life labels (not made from a recipe with ``[life]``), or no
-        snapshot left after ``units`` and ``until_age``.
-    """
-    from prsm_health.datasets import Dataset
-    from prsm_health.diagnostics.diagnosis import diagnose_runs, load_bundle
-
-    dataset = dataset if isinstance(dataset, Dataset) else Dataset(dataset)
-    labels = dataset.runs
-    if "unit_id" not in labels.columns:
-        raise PRSMHealthError(
-            f"{dataset.path}: not a fleet dataset (no unit_id label): generate it from a recipe "
-            "with a [life] table (docs/prognostics.md)"
-        )
-    chosen = labels
-    if units is not None:
-        wanted = {int(u) for u in units}
-        unknown = sorted(wanted - set(labels["unit_id"].astype(int)))
-        if unknown:
-            raise PRSMHealthError(
-                f"{dataset.path}: no unit {unknown[0]} (units 0–{int(labels['unit_id'].max())})"
-            )
-        chosen = chosen[chosen["unit_id"].astype(int).isin(wanted)]
-    if until_age is not None:
-        chosen = chosen[chosen["age_hours"] <= until_age]
-    if chosen.empty:
-        raise PRSMHealthError(
-            f"{dataset.path}: no snapshot at or before {until_age:g} h for the chosen unit"
-        )
-    chosen = chosen.sort_values(["unit_id", "age_hours"])
-    bundle = bundle or load_bundle()
-    ids = [int(i) for i in chosen["run_id"]]
-    diagnoses = []
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(ids), desc="diagnosing snapshots", unit="run")
-    for start in range(0, len(ids), batch):
-        runs = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
-        diagnoses.extend(diagnose_runs(runs, bundle))
-        if bar is not None:
-            bar.update(len(runs))
-    if bar is not None:
-        bar.close()
-    out = pd.DataFrame(
-        {
-            "unit_id": chosen["unit_id"].astype(int).to_numpy(),
-            "age_hours": chosen["age_hours"].to_numpy(float),
-            "clearance": [d.clearance["estimate"] for d in diagnoses],
-            "clearance_lower": [d.clearance["lower"] for d in diagnoses],
-            "clearance_upper": [d.clearance["upper"] for d in diagnoses],
-            "design": chosen["design"].to_numpy(),
-            "fault_class": [d.fault_class for d in diagnoses],
-        }
-    )
-    for label in ("split", "rul_hours", "failure_age_hours", "failure_mode", "clearance_mean_true"):
-        out[label] = chosen[label].to_numpy()
-    return out.reset_index(drop=True)

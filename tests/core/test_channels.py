@@ -74,7 +74,7 @@ def test_formats_doc_tables_are_current():
     import sys
     from pathlib import Path
 
-    tool = Path(__file__).resolve().parents[2] / "tools" / "make_formats_tables.py"
+    tool = Path(__file__).resolve().parents[2] / "tools" / "release" / "make_formats_tables.py"
     out = subprocess.run([sys.executable, str(tool), "--check"], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
 

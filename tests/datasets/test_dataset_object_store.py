@@ -17,7 +17,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-import prsm_health.datasets.dataset as dataset_module
+import prsm_health.datasets.generation as dataset_module
 from prsm_health.apps.cli import main
 from prsm_health.core.errors import ParameterError, PRSMHealthError, StorageError
 from prsm_health.datasets import Dataset, generate

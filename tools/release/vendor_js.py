@@ -34,7 +34,7 @@ FILES = {
     "package/LICENSE": "LICENSE",
 }
 ROOT = Path(__file__).resolve().parents[2]
-TARGET = ROOT / "prsm_health" / "service" / "static" / "vendor" / "uplot"
+TARGET = ROOT / "prsm_health" / "apps" / "service" / "static" / "vendor" / "uplot"
 
 
 def _npm(*args: str, cwd: Path) -> str:

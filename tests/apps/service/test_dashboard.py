@@ -443,7 +443,7 @@ def test_pages_static_files_and_headers(bundle, tmp_path):
 
 def test_vendored_uplot_matches_its_record():
     record = json.loads(
-        (ROOT / "prsm_health/apps/service/static/vendor/uplot/VENDORED/json").read_text()
+        (ROOT / "prsm_health/apps/service/static/vendor/uplot/VENDORED.json").read_text()
     )
     assert record["name"] == "uplot" and record["license"] == "MIT"
     assert record["integrity"].startswith("sha512-")

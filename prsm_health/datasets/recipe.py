@@ -1,0 +1,652 @@
+"""Dataset recipes: what a dataset holds — design, instrumentation, duration and sample rate,
+profile and option settings, a seed, a sweep over clearance, speed, load, friction, wear, faults
+(grid, random or Latin-hypercube), repeats, the test split, fault-class thresholds and, for
+life recipes, the fleet — and the one run each index stands for (:class:`RunSpec`).
+
+Run i always gets the same parameters and seed (derived from the recipe seed and i), whatever
+the worker count or scheduler (docs/formats.md).
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+
+import numpy as np
+
+from prsm_health.actuator.design import PRESETS
+from prsm_health.actuator.design_files import load_design
+from prsm_health.actuator.faults import (
+    FaultThresholds,
+    fault_as_dict,
+    fault_from_dict,
+    scaled,
+)
+from prsm_health.core.errors import (
+    ParameterError,
+    PRSMHealthError,
+    RecipeError,
+)
+from prsm_health.core.run import Run
+from prsm_health.core.tomlfile import read_toml
+from prsm_health.simulation.instrumentation import (
+    DEFAULT_PROFILE,
+    list_profiles,
+    load_instrumentation,
+)
+from prsm_health.simulation.scenario import Scenario
+
+FORMATS = ("parquet", "mcap", "both")
+SWEEP_MODES = ("grid", "random", "lhs")
+#: Swept quantities and their units (a range is [min, max]).
+SWEPT = {
+    "clearance": "m",
+    "clearance_screw": "m",
+    "clearance_nut": "m",
+    "clearance_gear": "m",
+    "speed": "rad/s",
+    "load": "N",
+    "load_amplitude": "N",
+    "friction_scale": "-",
+    "wear_spread": "-",
+    "preload": "m",
+    "lubricant_degradation": "-",
+    "lubricant_starvation": "-",
+    "temperature": "K",
+    "severity": "-",
+}
+#: Groups whose scalar fields a sweep may also draw — domain randomisation of the operating
+#: profile, simulation options (contact damping, restitution, manufacturing scatter), drive train
+#: and sensors: ``[sweep.drive_train] coupling_stiffness = [1e3, 2e3]`` or the dotted key
+#: ``"drive_train.coupling_stiffness"``; nested fields by more dots
+#: (``options.variation.pitch_error``, ``instrumentation.nut_axial_accel.noise_density_ug``).
+#: Units are the group's (docs/formats.md); the scenario validates every drawn value.
+SWEPT_GROUPS = ("profile", "options", "drive_train", "instrumentation")
+#: Swept by name: a list of ``fault_cases`` names (drawn uniformly in random and lhs mode).
+FAULT_CASE_KEY = "fault_case"
+NO_FAULT = "none"
+DEFAULT_BATCH = 8
+#: Health fields a life recipe's units set themselves (not sweepable there).
+LIFE_SETS = (
+    "clearance",
+    "clearance_screw",
+    "clearance_nut",
+    "clearance_gear",
+    "wear_spread",
+    "preload",
+    "lubricant_degradation",
+    "lubricant_starvation",
+)
+#: Fleets of life recipes computed in this process, by recipe fingerprint.
+_FLEETS: dict[str, list] = {}
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """A parsed, validated recipe. Build with :func:`load_recipe` or :meth:`from_dict`."""
+
+    name: str
+    design: str | dict
+    duration: float
+    sample_rate: float
+    seed: int
+    sweep: dict
+    profile: dict = field(default_factory=dict)
+    instrumentation: str | dict = DEFAULT_PROFILE
+    options: dict = field(default_factory=dict)
+    drive_train: dict = field(default_factory=dict)
+    faults: FaultThresholds = field(default_factory=FaultThresholds)
+    fault_cases: dict = field(default_factory=dict)
+    test_fraction: float = 0.2
+    batch_size: int = DEFAULT_BATCH
+    dtype: str = "float32"
+    life: dict = field(default_factory=dict)
+    source: dict = field(default_factory=dict, compare=False)
+
+    @classmethod
+    def from_dict(cls, data: dict, *, base: Path | None = None) -> Recipe:
+        """Parse and validate the dict form of a recipe.
+
+        ``design`` is a preset name, kept as is, or a design TOML file (a relative path against
+        ``base``, else the working directory) or the design's dict form: both are stored as the
+        full design dict, so ``source`` (what workers rebuild the recipe from, and what the
+        manifest and the fingerprint record) holds the design itself, not a path.
+        ``instrumentation`` likewise: a built-in profile name is kept, a profile file or an
+        ``[instrumentation]`` table (``profile = …`` plus overrides) is stored complete.
+        """
+        data = dict(data)
+        if "sensors" in data:
+            raise RecipeError(
+                "recipe: the [sensors] table was replaced by instrumentation profiles: write "
+                f'instrumentation = "{DEFAULT_PROFILE}" (built-ins: {", ".join(list_profiles())}) '
+                "or an [instrumentation] table with profile = … and sensor overrides, e.g. "
+                "[instrumentation.nut_axial_accel] noise_density_ug = 40 "
+                "(docs/instrumentation.md); sample_rate stays at the top level"
+            )
+        for key in ("name", "design", "duration", "sample_rate", "seed", "sweep"):
+            if key not in data:
+                raise RecipeError(f"recipe: missing key {key!r}")
+        data["design"] = _recipe_design(data["design"], base)
+        if "instrumentation" in data:
+            data["instrumentation"] = _recipe_instrumentation(data["instrumentation"], base)
+        known = {f.name for f in fields(cls)} - {"source"}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise RecipeError(f"recipe: unknown key(s) {', '.join(unknown)}")
+        if isinstance(data["sweep"], dict):
+            data["sweep"] = _flat_sweep(data["sweep"])
+        faults = data.pop("faults", {})
+        try:
+            thresholds = FaultThresholds(**faults)
+        except TypeError as exc:
+            raise RecipeError(f"recipe [faults]: {exc}") from None
+        recipe = cls(**data, faults=thresholds, source=dict(data, faults=faults))
+        recipe._validate()
+        return recipe
+
+    def _validate(self) -> None:
+        def check(ok, key, value, allowed):
+            if not ok:
+                raise RecipeError(f"recipe: {key} = {value!r} is invalid: {allowed}")
+
+        check(
+            isinstance(self.name, str) and self.name,
+            "name",
+            self.name,
+            "must be a non-empty string",
+        )
+        check(
+            self.design in PRESETS if isinstance(self.design, str) else True,
+            "design",
+            self.design,
+            f"must be one of {', '.join(sorted(PRESETS))} or a design TOML file",
+        )
+        check(
+            isinstance(self.duration, (int, float)) and 0 < self.duration <= 60,
+            "duration",
+            self.duration,
+            "must lie in (0, 60] s",
+        )
+        check(
+            isinstance(self.sample_rate, (int, float)) and 100 <= self.sample_rate <= 1e6,
+            "sample_rate",
+            self.sample_rate,
+            "must lie in [100, 1e6] Hz",
+        )
+        check(
+            isinstance(self.seed, int) and self.seed >= 0,
+            "seed",
+            self.seed,
+            "must be an integer ≥ 0",
+        )
+        check(
+            0 <= self.test_fraction < 1, "test_fraction", self.test_fraction, "must lie in [0, 1)"
+        )
+        check(
+            isinstance(self.batch_size, int) and self.batch_size >= 1,
+            "batch_size",
+            self.batch_size,
+            "must be an integer ≥ 1",
+        )
+        check(
+            self.dtype in ("float32", "float64"), "dtype", self.dtype, "must be float32 or float64"
+        )
+        sweep = self.sweep
+        check(isinstance(sweep, dict), "sweep", sweep, "must be a table")
+        mode = sweep.get("mode", "grid")
+        check(mode in SWEEP_MODES, "sweep.mode", mode, f"must be one of {', '.join(SWEEP_MODES)}")
+        unknown = sorted(
+            set(sweep) - set(_swept_keys(sweep)) - {"mode", "repeats", "samples", FAULT_CASE_KEY}
+        )
+        check(
+            not unknown,
+            "sweep",
+            unknown,
+            f"unknown key(s); allowed: mode, repeats, samples, {FAULT_CASE_KEY}, "
+            f"{', '.join(SWEPT)}, and fields of {', '.join(SWEPT_GROUPS)} as group.field",
+        )
+        self._validate_fault_cases(check)
+        repeats = sweep.get("repeats", 1)
+        check(
+            isinstance(repeats, int) and repeats >= 1,
+            "sweep.repeats",
+            repeats,
+            "must be an integer ≥ 1",
+        )
+        for key in _swept_keys(sweep):
+            value = sweep[key]
+            unit = SWEPT.get(key, "the group's unit")
+            if mode == "grid" and isinstance(value, dict):
+                ok = set(value) == {"uniform"} and _is_range(value["uniform"])
+                check(
+                    ok,
+                    f"sweep.{key}",
+                    value,
+                    f"a drawn value must be {{uniform = [min, max]}} [{unit}]",
+                )
+            elif mode == "grid":
+                ok = (
+                    isinstance(value, list)
+                    and value
+                    and all(isinstance(v, (int, float)) for v in value)
+                )
+                check(
+                    ok,
+                    f"sweep.{key}",
+                    value,
+                    f"must be a non-empty list of numbers [{unit}], or {{uniform = [min, max]}}, in grid mode",
+                )
+            else:
+                ok = (
+                    isinstance(value, list)
+                    and len(value) == 2
+                    and all(isinstance(v, (int, float)) for v in value)
+                    and value[0] <= value[1]
+                )
+                check(
+                    ok,
+                    f"sweep.{key}",
+                    value,
+                    f"must be a range [min, max] [{unit}] in {mode} mode",
+                )
+        if mode != "grid" and not self.life:
+            samples = sweep.get("samples")
+            check(
+                isinstance(samples, int) and samples >= 1,
+                "sweep.samples",
+                samples,
+                f"must be an integer ≥ 1 in {mode} mode",
+            )
+        if self.life:
+            self._validate_life(check, mode)
+        # Build every run's scenario once (≈ 0.2 ms each), so a bad value anywhere in a sweep
+        # fails now, naming the run, not later in a worker.
+        for spec in self.runs():
+            spec.scenario()
+
+    def _validate_life(self, check, mode: str) -> None:
+        try:
+            self.fleet()  # parses [life] and simulates every unit's life (≈ 5 ms a unit)
+        except ParameterError as exc:
+            raise RecipeError(f"recipe [life]: {exc}") from None
+        check(
+            mode == "random",
+            "sweep.mode",
+            mode,
+            "must be random in a life recipe (each snapshot draws its recording conditions)",
+        )
+        set_by_life = sorted(
+            k for k in self.sweep if k in LIFE_SETS or k in (FAULT_CASE_KEY, "severity")
+        )
+        check(
+            not set_by_life,
+            "sweep",
+            set_by_life,
+            "the life simulation sets clearances, wear spread, lubricant state and faults "
+            "in a life recipe: sweep recording conditions only (speed, load, …)",
+        )
+        check(
+            "samples" not in self.sweep,
+            "sweep.samples",
+            self.sweep.get("samples"),
+            "a life recipe has units × snapshots runs; remove samples",
+        )
+
+    @property
+    def life_spec(self):
+        """The parsed ``[life]`` table (:class:`~prsm_health.physics.life.LifeSpec`), None without one."""
+        if not self.life:
+            return None
+        from prsm_health.physics.life import LifeSpec
+
+        return LifeSpec.from_dict(self.life)
+
+    def fleet(self) -> list:
+        """The units' lives of a life recipe (:func:`prsm_health.physics.life.fleet_lives`), computed
+        once per process and recipe."""
+        key = self.fingerprint
+        if key not in _FLEETS:
+            from prsm_health.physics.life import fleet_lives
+
+            _FLEETS[key] = fleet_lives(load_design(self.design), self.life_spec, self.seed)
+        return _FLEETS[key]
+
+    def _validate_fault_cases(self, check) -> None:
+        cases = self.fault_cases
+        check(isinstance(cases, dict), "fault_cases", cases, "must be a table of named cases")
+        for name, faults in cases.items():
+            check(
+                isinstance(faults, list),
+                f"fault_cases.{name}",
+                faults,
+                'must be a list of fault tables, e.g. [{ kind = "spall", location = "nut" }]',
+            )
+            for fault in faults:
+                try:
+                    fault_from_dict(fault)
+                except ParameterError as exc:
+                    raise RecipeError(f"recipe: fault_cases.{name}: {exc}") from None
+        names = self.sweep.get(FAULT_CASE_KEY)
+        if names is None:
+            return
+        known = [NO_FAULT, *cases]
+        check(
+            isinstance(names, list) and names and all(n in known for n in names),
+            f"sweep.{FAULT_CASE_KEY}",
+            names,
+            f"must be a non-empty list of case names among: {', '.join(known)}",
+        )
+
+    @property
+    def fingerprint(self) -> str:
+        """Stable hash of the recipe content (guards a dataset directory against another recipe)."""
+        return hashlib.sha256(
+            json.dumps(self.source, sort_keys=True, default=str).encode()
+        ).hexdigest()[:16]
+
+    # ------------------------------------------------------------------ runs
+    def runs(self) -> list[RunSpec]:
+        """Every run of the recipe, in run-id order (deterministic)."""
+        if self.life:
+            return self._life_runs()
+        points = self._points()
+        repeats = self.sweep.get("repeats", 1)
+        specs = []
+        n_total = len(points) * repeats
+        test = _test_set(n_total, self.test_fraction, self.seed)
+        run_id = 0
+        drawn = {k: v["uniform"] for k, v in self.sweep.items() if isinstance(v, dict)}
+        for point in points:
+            for _ in range(repeats):
+                seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
+                run_point = dict(point)
+                if drawn:
+                    # grid keys given as {uniform = [min, max]}: a fresh value for every run
+                    unit = np.random.default_rng([self.seed, run_id, 0x44524157]).random(len(drawn))
+                    for u, (k, (lo, hi)) in zip(unit, sorted(drawn.items())):
+                        run_point[k] = float(lo + u * (hi - lo))
+                specs.append(
+                    RunSpec(self, run_id, run_point, seed, "test" if run_id in test else "train")
+                )
+                run_id += 1
+        return specs
+
+    def _life_runs(self) -> list[RunSpec]:
+        # Unit-major: unit u's snapshots are runs u·n … u·n + n − 1. The unit as built (its
+        # manufacturing variation and roller wear pattern) is its seed, the same in every
+        # snapshot; each snapshot's sensors draw their own noise (sensor_seed). The test split
+        # holds out whole units.
+        spec = self.life_spec
+        test_units = _test_set(spec.units, self.test_fraction, self.seed)
+        keys = _swept_keys(self.sweep)
+        specs = []
+        for unit in self.fleet():
+            for k, age in enumerate(unit.snapshot_ages(spec.snapshots)):
+                run_id = unit.unit_id * spec.snapshots + k
+                unit_draw = np.random.default_rng([self.seed, run_id, 0x534E4150]).random(len(keys))
+                point = {
+                    key: float(self.sweep[key][0] + u * (self.sweep[key][1] - self.sweep[key][0]))
+                    for u, key in zip(unit_draw, keys)
+                }
+                point.update(unit_id=unit.unit_id, age_hours=float(age))
+                seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
+                split = "test" if unit.unit_id in test_units else "train"
+                specs.append(RunSpec(self, run_id, point, seed, split))
+        return specs
+
+    def _points(self) -> list[dict]:
+        keys = _swept_keys(self.sweep)
+        mode = self.sweep.get("mode", "grid")
+        cases = self.sweep.get(FAULT_CASE_KEY)
+        if mode == "grid":
+            keys = [k for k in keys if not isinstance(self.sweep[k], dict)]
+            if cases:
+                keys.append(FAULT_CASE_KEY)
+            values = [self.sweep[k] for k in keys]
+            return [dict(zip(keys, combo)) for combo in itertools.product(*values)]
+        n = self.sweep["samples"]
+        if mode == "random":
+            unit = np.random.default_rng([self.seed, 0x5357]).random((n, len(keys)))
+        else:
+            from scipy.stats import qmc
+
+            unit = qmc.LatinHypercube(
+                d=max(len(keys), 1), seed=np.random.default_rng([self.seed, 0x4C48])
+            ).random(n)
+        out = []
+        for row in unit:
+            point = {}
+            for j, k in enumerate(keys):
+                lo, hi = self.sweep[k]
+                point[k] = float(lo + row[j] * (hi - lo))
+            if cases:  # a categorical draw from its own stream, so the numeric draws stay put
+                pick = np.random.default_rng([self.seed, len(out), 0x46434153]).integers(len(cases))
+                point[FAULT_CASE_KEY] = cases[int(pick)]
+            out.append(point)
+        return out
+
+    def batches(self) -> list[list[int]]:
+        """Run ids grouped into the fixed batches that workers write as one shard each."""
+        ids = list(range(len(self.runs())))
+        return [ids[i : i + self.batch_size] for i in range(0, len(ids), self.batch_size)]
+
+
+def _flat_sweep(sweep: dict) -> dict:
+    """The sweep with group tables (``[sweep.drive_train]`` …) as dotted keys."""
+    out = {}
+
+    def walk(prefix: str, table: dict) -> None:
+        for key, value in table.items():
+            name = f"{prefix}.{key}"
+            if isinstance(value, dict) and "uniform" not in value:
+                walk(name, value)
+            else:
+                out[name] = value
+
+    for key, value in sweep.items():
+        if key in SWEPT_GROUPS and isinstance(value, dict):
+            walk(key, value)
+        else:
+            out[key] = value
+    return out
+
+
+def _swept_keys(sweep: dict) -> list[str]:
+    """The swept quantities of a (flat) sweep: :data:`SWEPT` order, then group fields sorted."""
+    grouped = sorted(k for k in sweep if k.split(".")[0] in SWEPT_GROUPS and "." in k)
+    return [k for k in SWEPT if k in sweep] + grouped
+
+
+def _set_path(target: dict, path: list[str], value) -> None:
+    for key in path[:-1]:
+        target = target.setdefault(key, {})
+    target[path[-1]] = value
+
+
+def _is_range(value) -> bool:
+    return (
+        isinstance(value, list)
+        and len(value) == 2
+        and all(isinstance(v, (int, float)) for v in value)
+        and value[0] <= value[1]
+    )
+
+
+def _test_set(n: int, fraction: float, seed: int) -> set[int]:
+    k = int(round(n * fraction))
+    return set(np.random.default_rng([seed, 0x54455354]).permutation(n)[:k].tolist())
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a recipe: its id, swept values, seed and split."""
+
+    recipe: Recipe
+    run_id: int
+    point: dict
+    seed: int
+    split: str
+
+    def scenario(self) -> Scenario:
+        """The :class:`~prsm_health.simulation.scenario.Scenario` of this run (validates)."""
+        r, p = self.recipe, self.point
+        unit = self.unit()
+        if unit is not None:
+            return self._life_scenario(unit)
+        health = {"clearance": p.get("clearance", 10e-6)}
+        health.update({k: p[k] for k in SWEPT if k.startswith("clearance_") and k in p})
+        health_keys = (
+            "wear_spread",
+            "friction_scale",
+            "preload",
+            "lubricant_degradation",
+            "lubricant_starvation",
+        )
+        health.update({k: p[k] for k in health_keys if k in p})
+        health["faults"] = self.faults()
+        profile = {
+            "duration": r.duration,
+            "speed": p.get("speed", 100.0),
+            "load": p.get("load", 100.0),
+        }
+        profile.update(r.profile)
+        for key in ("load_amplitude", "temperature"):
+            if key in p:
+                profile[key] = p[key]
+        return self._build(health, profile, seed=self.seed)
+
+    def _build(self, health, profile: dict, *, seed: int, sensor_seed: int | None = None):
+        r, p = self.recipe, self.point
+        groups = {
+            "profile": profile,
+            "instrumentation": copy.deepcopy(_with_sample_rate(r.instrumentation, r.sample_rate)),
+            "options": copy.deepcopy(r.options),
+            "drive_train": dict(r.drive_train),
+        }
+        for key, value in p.items():
+            group, *path = key.split(".")
+            if path:  # a domain-randomised field
+                _set_path(groups[group], path, value)
+        try:
+            return Scenario.from_dict(
+                {
+                    "design": r.design,
+                    "health": health,
+                    **groups,
+                    "seed": seed,
+                    "sensor_seed": sensor_seed,
+                }
+            )
+        except ParameterError as exc:
+            raise RecipeError(f"recipe (run {self.run_id}): {exc}") from None
+
+    def unit(self):
+        """The :class:`~prsm_health.physics.life.UnitLife` of a life recipe's snapshot, else None."""
+        if "unit_id" not in self.point:
+            return None
+        return self.recipe.fleet()[self.point["unit_id"]]
+
+    def _life_scenario(self, unit) -> Scenario:
+        # The unit's health at this age; its temperature unless the sweep draws one.
+        r, p = self.recipe, self.point
+        health = unit.health_at(p["age_hours"])
+        if "friction_scale" in p:
+            health = replace(health, friction_scale=p["friction_scale"])
+        profile = {
+            "duration": r.duration,
+            "speed": p.get("speed", 100.0),
+            "load": p.get("load", 100.0),
+            "temperature": unit.temperature,
+        }
+        profile.update(r.profile)
+        for key in ("load_amplitude", "temperature"):
+            if key in p:
+                profile[key] = p[key]
+        return self._build(health, profile, seed=unit.seed, sensor_seed=self.seed)
+
+    def faults(self) -> list[dict]:
+        """The faults of this run's case, their severities scaled by its ``severity``."""
+        name = self.point.get(FAULT_CASE_KEY, NO_FAULT)
+        factor = self.point.get("severity", 1.0)
+        try:
+            faults = [fault_from_dict(f) for f in self.recipe.fault_cases.get(name, [])]
+            return [fault_as_dict(scaled(f, factor)) for f in faults]
+        except ParameterError as exc:
+            raise RecipeError(
+                f"recipe (run {self.run_id}, fault case {name}, severity {factor:g}): {exc}"
+            ) from None
+
+    def labels(self, run: Run | None = None) -> dict:
+        """The run's labels: id, split, fault class, the scenario's labels (nominal values) and,
+        given the simulated run, its realised clearances."""
+        scenario = self.scenario()
+        out = {
+            "run_id": self.run_id,
+            "split": self.split,
+            "fault_class": self.recipe.faults.classify(scenario.health),
+            "fault_case": self.point.get(FAULT_CASE_KEY, NO_FAULT),
+            "severity": self.point.get("severity", 1.0),
+            **scenario.labels(),
+            # domain-randomised fields, under their dotted names
+            **{k: v for k, v in self.point.items() if "." in k},
+        }
+        unit = self.unit()
+        if unit is not None:
+            out.update(unit.labels(self.point["age_hours"]))
+        if run is not None:
+            out.update({k: v for k, v in run.labels.items() if "_realised_" in k})
+            out["n_samples"] = len(run)
+        return out
+
+
+def load_recipe(path: str | Path) -> Recipe:
+    """Parse and validate a TOML recipe; errors name the key."""
+    path = Path(path)
+    return Recipe.from_dict(read_toml(path, "recipe file", RecipeError), base=path.parent)
+
+
+def _recipe_design(design, base: Path | None) -> str | dict:
+    """A preset name as is; a design file or dict as the validated design's dict form."""
+    if isinstance(design, str) and design in PRESETS:
+        return design
+    try:
+        return load_design(design, base=base).to_dict()
+    except ParameterError as exc:
+        raise RecipeError(f"recipe: {exc}") from None
+    except PRSMHealthError as exc:
+        raise RecipeError(f"recipe: design: {exc}") from None
+
+
+def _recipe_instrumentation(instrumentation, base: Path | None) -> str | dict:
+    """A built-in profile name as is; a profile file or table as the profile's complete dict
+    (without its sample rate: the recipe's top-level ``sample_rate`` sets it, so a table may not
+    set it too)."""
+    if isinstance(instrumentation, str) and instrumentation in list_profiles():
+        return instrumentation
+    if isinstance(instrumentation, dict) and "sample_rate" in instrumentation:
+        raise RecipeError(
+            "recipe: instrumentation.sample_rate: the recipe's top-level sample_rate sets the "
+            "sample rate; remove it from the [instrumentation] table"
+        )
+    try:
+        complete = load_instrumentation(instrumentation, base=base).to_dict()
+    except ParameterError as exc:
+        raise RecipeError(f"recipe: {exc}") from None
+    except PRSMHealthError as exc:
+        raise RecipeError(f"recipe: instrumentation: {exc}") from None
+    del complete["sample_rate"]
+    return complete
+
+
+def _with_sample_rate(instrumentation: str | dict, sample_rate: float) -> dict:
+    """The dict form of the recipe's profile at the recipe's sample rate."""
+    if isinstance(instrumentation, str):
+        return {"profile": instrumentation, "sample_rate": sample_rate}
+    return {**instrumentation, "sample_rate": sample_rate}
+
+
+# ---------------------------------------------------------------------- storage

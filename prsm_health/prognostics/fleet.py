@@ -1,0 +1,103 @@
+"""Histories of a whole fleet: a life recipe's snapshots diagnosed in batches, one history row
+per snapshot, with the labels a prognosis is scored against."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from prsm_health.core.errors import (
+    PRSMHealthError,
+)
+
+
+def fleet_histories(
+    dataset,
+    bundle=None,
+    *,
+    units=None,
+    until_age: float | None = None,
+    progress: bool = False,
+    batch: int = 32,
+) -> pd.DataFrame:
+    """Diagnose the snapshots of a fleet dataset (a life recipe's) in batches: one history row
+    per snapshot.
+
+    Parameters
+    ----------
+    dataset : str, Path or :class:`~prsm_health.datasets.Dataset`
+    bundle : ModelBundle, default the shipped diagnosis model
+    units : iterable of int or None
+        The units to diagnose (default all).
+    until_age : float or None [h]
+        Only snapshots at ages ≤ this (what was known then).
+    progress : bool
+        A progress bar on stderr.
+
+    Returns
+    -------
+    DataFrame
+        ``unit_id``, :data:`HISTORY_COLUMNS`, ``design``, ``fault_class``, and the labels a
+        prognosis is scored against: ``split``, ``rul_hours``, ``failure_age_hours``,
+        ``failure_mode``, ``clearance_mean_true`` — sorted by unit and age.
+
+    Raises
+    ------
+    PRSMHealthError
+        A dataset without life labels (not made from a recipe with ``[life]``), or no
+        snapshot left after ``units`` and ``until_age``.
+    """
+    from prsm_health.datasets import Dataset
+    from prsm_health.diagnostics.diagnosis import diagnose_runs, load_bundle
+
+    dataset = dataset if isinstance(dataset, Dataset) else Dataset(dataset)
+    labels = dataset.runs
+    if "unit_id" not in labels.columns:
+        raise PRSMHealthError(
+            f"{dataset.path}: not a fleet dataset (no unit_id label): generate it from a recipe "
+            "with a [life] table (docs/prognostics.md)"
+        )
+    chosen = labels
+    if units is not None:
+        wanted = {int(u) for u in units}
+        unknown = sorted(wanted - set(labels["unit_id"].astype(int)))
+        if unknown:
+            raise PRSMHealthError(
+                f"{dataset.path}: no unit {unknown[0]} (units 0–{int(labels['unit_id'].max())})"
+            )
+        chosen = chosen[chosen["unit_id"].astype(int).isin(wanted)]
+    if until_age is not None:
+        chosen = chosen[chosen["age_hours"] <= until_age]
+    if chosen.empty:
+        raise PRSMHealthError(
+            f"{dataset.path}: no snapshot at or before {until_age:g} h for the chosen unit"
+        )
+    chosen = chosen.sort_values(["unit_id", "age_hours"])
+    bundle = bundle or load_bundle()
+    ids = [int(i) for i in chosen["run_id"]]
+    diagnoses = []
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(ids), desc="diagnosing snapshots", unit="run")
+    for start in range(0, len(ids), batch):
+        runs = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
+        diagnoses.extend(diagnose_runs(runs, bundle))
+        if bar is not None:
+            bar.update(len(runs))
+    if bar is not None:
+        bar.close()
+    out = pd.DataFrame(
+        {
+            "unit_id": chosen["unit_id"].astype(int).to_numpy(),
+            "age_hours": chosen["age_hours"].to_numpy(float),
+            "clearance": [d.clearance["estimate"] for d in diagnoses],
+            "clearance_lower": [d.clearance["lower"] for d in diagnoses],
+            "clearance_upper": [d.clearance["upper"] for d in diagnoses],
+            "design": chosen["design"].to_numpy(),
+            "fault_class": [d.fault_class for d in diagnoses],
+        }
+    )
+    for label in ("split", "rul_hours", "failure_age_hours", "failure_mode", "clearance_mean_true"):
+        out[label] = chosen[label].to_numpy()
+    return out.reset_index(drop=True)
