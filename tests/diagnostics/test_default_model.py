@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from prsm_health.datasets import load_recipe
+from prsm_health.diagnostics.default_model import default_recipe, point_recipe
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, diagnose, load_bundle
 
 # Simulates thirteen recordings of the reference recipe's points for the shipped model.
@@ -38,17 +38,13 @@ def test_size_and_card():
 
 def _point_run(recipe, spec, **changes):
     """The run of a recipe point with changes to its source (another design, profile, …)."""
-    from prsm_health.datasets import Recipe
-
-    source = dict(recipe.source, **changes, name="check", test_fraction=0.0)
-    source["sweep"] = {"mode": "grid", **{k: [v] for k, v in spec.point.items()}}
-    one = Recipe.from_dict(source).runs()[0]
+    one = point_recipe(recipe, spec.point, **changes).runs()[0]
     return one.scenario().simulate(), one.labels()
 
 
 @pytest.fixture(scope="module")
 def reference():
-    return load_recipe(ROOT / "datasets" / "flight-ema-reference.toml")
+    return default_recipe()
 
 
 def test_held_out_runs_of_the_reference_recipe(bundle, reference):

@@ -13,21 +13,20 @@ is downloaded). Takes about half a minute.
 from __future__ import annotations
 
 import argparse
-import socket
 import tempfile
-import threading
-import time
 from pathlib import Path
 
 import httpx
-import uvicorn
 
 from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
 from prsm_health.apps.service import create_app
+from prsm_health.apps.service.server import serve_in_thread
 from prsm_health.io.arrow import write_run_arrow
 from prsm_health.io.parquet import write_run_parquet
 
 ROOT = Path(__file__).resolve().parents[2]
+#: Headless Chromium without a sandbox, GPU or background traffic (as the browser test,
+#: tests/apps/service/test_dashboard_browser.py, launches it).
 CHROMIUM_ARGS = [
     "--headless",
     "--no-sandbox",
@@ -64,31 +63,6 @@ def recording(clearance: float, seed: int):
     ).without_truth()
 
 
-class Server:
-    """The service under uvicorn in a thread, on a socket bound to 127.0.0.1:0."""
-
-    def __init__(self, app):
-        self.sock = socket.socket()
-        self.sock.bind(("127.0.0.1", 0))
-        self.url = f"http://127.0.0.1:{self.sock.getsockname()[1]}"
-        self.server = uvicorn.Server(uvicorn.Config(app, log_level="warning"))
-        self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]})
-
-    def __enter__(self):
-        self.thread.start()
-        deadline = time.monotonic() + 60
-        while not self.server.started:
-            if not self.thread.is_alive() or time.monotonic() > deadline:
-                raise RuntimeError("the service did not start")
-            time.sleep(0.05)
-        return self
-
-    def __exit__(self, *exc):
-        self.server.should_exit = True
-        self.thread.join(timeout=30)
-        self.sock.close()
-
-
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "figures")
@@ -98,7 +72,7 @@ def main(argv=None) -> int:
 
     with tempfile.TemporaryDirectory(prefix="prsm-health-screens-") as tmp:
         app = create_app(None, Path(tmp) / "history.sqlite")
-        with Server(app) as server, httpx.Client(base_url=server.url, timeout=120) as c:
+        with serve_in_thread(app) as url, httpx.Client(base_url=url, timeout=120) as c:
             seed = 0
             for asset, snapshots in FLEET.items():
                 for hours, clearance in snapshots:
@@ -123,7 +97,7 @@ def main(argv=None) -> int:
                 args.out.mkdir(parents=True, exist_ok=True)
                 shots = {"/": "dashboard_overview.png", "/assets/press-1": "dashboard_asset.png"}
                 for path, name in shots.items():
-                    page.goto(server.url + path)
+                    page.goto(url + path)
                     page.wait_for_load_state("networkidle")
                     page.wait_for_function(
                         "() => !document.getElementById('status').textContent.startsWith('Loading')"

@@ -18,7 +18,7 @@ docs/figures/fault-<name>.png.
 
 from __future__ import annotations
 
-import sys
+import argparse
 from pathlib import Path
 
 import numpy as np
@@ -269,9 +269,15 @@ def lubrication_figure() -> Path:
     return save(fig, "lubrication")
 
 
-def main(names: list[str]) -> None:
+def main(argv: list[str] | None = None) -> None:
+    every = [*LOCALISED, "preload-loss", "lubrication"]
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("names", nargs="*", metavar="NAME", help=f"figures (default all): {every}")
+    names = parser.parse_args(argv).names or every
+    unknown = sorted(set(names) - set(every))
+    if unknown:
+        parser.error(f"unknown figure(s) {unknown}: choose from {every}")
     OUT.mkdir(parents=True, exist_ok=True)
-    names = names or [*LOCALISED, "preload-loss", "lubrication"]
     healthy: dict = {}
     for name in names:
         if name in ("preload-loss", "lubrication"):
@@ -286,4 +292,4 @@ def main(names: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    main()

@@ -1,4 +1,5 @@
-"""Serving the app on uvicorn: :func:`serve`, and the bind rules (loopback unless a token)."""
+"""Serving the app on uvicorn: :func:`serve`, :func:`serve_in_thread` (a server beside a
+script or a test), and the bind rules (loopback unless a token)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,8 @@ import os
 import signal
 import socket
 import threading
+import time
+from collections.abc import Iterator
 
 from prsm_health.core.errors import PRSMHealthError
 
@@ -122,6 +125,56 @@ def serve(
     try:
         _server_class()(config).run(sockets=[sock])
     finally:
+        sock.close()
+
+
+@contextlib.contextmanager
+def serve_in_thread(app, *, log_level: str = "warning", timeout: float = 60.0) -> Iterator[str]:
+    """Serve ``app`` on uvicorn in a background thread on a free port of 127.0.0.1.
+
+    For scripts and tests that need a real server beside them (the dashboard's screenshots,
+    end-to-end tests); :func:`serve` is the command line's blocking form. Loopback only, so no
+    token is required whatever the app's.
+
+    Parameters
+    ----------
+    app : FastAPI
+        From :func:`create_app`.
+    log_level : str
+        uvicorn log level.
+    timeout : float [s]
+        How long to wait for the server to start.
+
+    Yields
+    ------
+    str
+        The server's URL, ``http://127.0.0.1:<port>``, once it accepts connections; on exit
+        the server shuts down gracefully and the socket is closed.
+
+    Raises
+    ------
+    PRSMHealthError
+        The server did not start within ``timeout`` (e.g. the app's startup failed).
+    """
+    import uvicorn
+
+    # bound before the thread starts: the port is known, and free, before the server runs
+    sock = bind_socket("127.0.0.1", 0)
+    server = _server_class()(uvicorn.Config(app, log_level=log_level, lifespan="on"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + timeout
+        while not server.started:
+            if not thread.is_alive() or time.monotonic() > deadline:
+                raise PRSMHealthError(
+                    f"the service did not start within {timeout:g} s (see its log above)"
+                )
+            time.sleep(0.02)
+        yield f"http://127.0.0.1:{sock.getsockname()[1]}"
+    finally:
+        server.should_exit = True
+        thread.join(timeout=30)
         sock.close()
 
 

@@ -1,38 +1,30 @@
-"""A real uvicorn server on 127.0.0.1 for the service tests (imported by their modules)."""
+"""A real uvicorn server on 127.0.0.1 for the service tests (imported by their modules).
+
+The server itself is the package's :func:`prsm_health.apps.service.server.serve_in_thread`
+(also used by tools/figures/make_dashboard_screenshots.py); this adds an httpx client and
+lets a fixture hang its data on the object.
+"""
 
 from __future__ import annotations
 
-import socket
-import threading
-import time
-
 import httpx
-import uvicorn
+
+from prsm_health.apps.service.server import serve_in_thread
 
 
 class LiveServer:
-    """uvicorn in a background thread on a socket already bound to 127.0.0.1:0."""
+    """``with LiveServer(app) as live:`` — the app served in a background thread at ``live.url``."""
 
     def __init__(self, app):
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        self.sock.bind(("127.0.0.1", 0))
-        self.url = f"http://127.0.0.1:{self.sock.getsockname()[1]}"
-        self.server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
-        self.thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]})
+        self._serving = serve_in_thread(app)
+        self.url: str | None = None
 
     def __enter__(self):
-        self.thread.start()
-        deadline = time.monotonic() + 60
-        while not self.server.started:
-            if not self.thread.is_alive() or time.monotonic() > deadline:
-                raise RuntimeError("server did not start")
-            time.sleep(0.02)
+        self.url = self._serving.__enter__()
         return self
 
     def __exit__(self, *exc):
-        self.server.should_exit = True
-        self.thread.join(timeout=30)
-        self.sock.close()
+        return self._serving.__exit__(*exc)
 
     def client(self, **kwargs) -> httpx.Client:
         return httpx.Client(base_url=self.url, timeout=60, **kwargs)
