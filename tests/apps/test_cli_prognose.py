@@ -14,7 +14,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from prsm_health.apps.cli import PROGNOSIS_METHODS, _hours, main
+from prsm_health.apps.cli import main
+from prsm_health.apps.cli.output import hours
+from prsm_health.apps.cli.parser import PROGNOSIS_METHODS
 from prsm_health.datasets import Recipe, generate
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.prognostics import (
@@ -132,7 +134,7 @@ def test_human_summary(capsys, model_file, history):
     p = prognose(history["table"], load_prognostics_model(model_file))
     rul, hi = p.rul_hours, p.health_indicator
     lines = {line.split("  ")[0]: line for line in out.splitlines()}
-    interval = f"{_hours(rul['estimate'])} [{_hours(rul['lower'])}, {_hours(rul['upper'])}]"
+    interval = f"{hours(rul['estimate'])} [{hours(rul['lower'])}, {hours(rul['upper'])}]"
     assert interval in lines["RUL"]
     assert "h (median, 90 % interval)" in lines["RUL"]
     assert (
@@ -241,7 +243,7 @@ def test_fleet_unit_json_and_summary_with_the_true_rul(capsys, fleet, model_file
     assert code == 0, err
     lines = {line.split("  ")[0]: line for line in out.splitlines()}
     truth = history["rul_hours"].iloc[2]  # the label of the last snapshot used
-    assert f"  {_hours(truth)} h" in lines["true RUL"]
+    assert f"  {hours(truth)} h" in lines["true RUL"]
     assert "simulator's truth" in lines["true RUL"]
     assert "unit 1" in lines["history"] and "3 from 0 to" in lines["diagnoses"]
     assert "RUL" in lines

@@ -1,0 +1,178 @@
+"""Commands on diagnosis models: ``train``, ``evaluate``, ``diagnose``, ``replay``."""
+
+from __future__ import annotations
+
+import sys
+
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.datasets import Dataset
+from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
+from prsm_health.diagnostics.diagnosis import load_bundle
+from prsm_health.diagnostics.diagnosis import replay as replay_windows
+from prsm_health.diagnostics.evaluation import evaluate_model
+from prsm_health.diagnostics.training import train as train_model
+from prsm_health.io import read_recording
+
+from ..plots import plot_diagnosis, plot_evaluation
+from .live import play_live
+from .output import print_json, print_table, scaled, share, um
+
+# What each fault macro-F1 counts (prsm_health.diagnostics.evaluation.fault_report and
+# training._class_metrics), so that the tables of train and evaluate cannot be misread.
+F1_CANNOT_TELL_MISS = "fault macro-F1 (cannot_tell counted as a miss)"
+F1_NAMED = "fault macro-F1 (on the runs given a class)"
+F1_CLASSIFIER = "macro-F1 (the classifier alone: no cannot_tell)"
+
+
+# ----------------------------------------------------------------------------- train
+def train(args) -> int:
+    metrics = train_model(
+        args.dataset, args.out, target=args.target, cv=args.cv, progress=not args.json
+    )
+    if args.json:
+        print_json(metrics)
+        return 0
+    print_table(training_rows(metrics))
+    for text in metrics.get("warnings", []):
+        print(f"warning: {text}", file=sys.stderr)
+    return 0
+
+
+def training_rows(metrics: dict) -> list:
+    """The table of ``train``: where the model went, its cross-validated and held-out
+    metrics."""
+    rows = [("model", metrics["model"]["path"], ""), ("metrics", metrics["metrics_path"], "")]
+    for key, label in (("clearance_cv", "clearance CV"), ("clearance_test", "clearance held-out")):
+        if metrics.get(key):
+            m = metrics[key]
+            rows.append((f"{label} MAE", scaled(m.get("mae"), 1e6), "µm"))
+            rows.append(
+                (f"{label} 90 % interval coverage", share(m.get("interval_coverage"), "runs"), "")
+            )
+            rows.append(
+                (f"{label} mean interval width", scaled(m.get("mean_interval_width"), 1e6), "µm")
+            )
+    for key, label in (("fault_cv", "fault CV"), ("fault_test", "fault held-out")):
+        if metrics.get(key):
+            rows.append((f"{label} {F1_CLASSIFIER}", scaled(metrics[key].get("macro_f1")), ""))
+    return rows
+
+
+# ----------------------------------------------------------------------------- evaluate
+def evaluate(args) -> int:
+    bundle = load_bundle(args.model)
+    dataset = Dataset(args.dataset)
+    report, records = evaluate_model(bundle, dataset, split=args.split, progress=not args.json)
+    if args.plot:
+        report["figures"] = [str(p) for p in plot_evaluation(report, records, args.plot)]
+    if args.json:
+        print_json(report)
+        return 0
+    print_table(evaluation_rows(report))
+    return 0
+
+
+def evaluation_rows(report: dict) -> list:
+    """The table of ``evaluate``: the model, the dataset, and the metrics of the report."""
+    rows = [
+        ("model", f"{report['model']['name']} v{report['model']['version']}", ""),
+        ("dataset", f"{report['dataset']} ({report['split']}: {report['runs']} runs)", ""),
+    ]
+    if "clearance" in report:
+        c = report["clearance"]
+        rows += [
+            ("clearance MAE", scaled(c["mae"], 1e6), "µm"),
+            ("clearance 90 % interval coverage", share(c["coverage"], "runs"), ""),
+            ("clearance mean interval width", scaled(c["mean_width"], 1e6), "µm"),
+            ("clearance observable", share(c["observable_fraction"], "runs"), ""),
+        ]
+    if "fault" in report:
+        f = report["fault"]
+        rows += [
+            (F1_CANNOT_TELL_MISS, scaled(f["macro_f1"]), ""),
+            (F1_NAMED, scaled(f["macro_f1_told"]), ""),
+            ("cannot_tell", share(f["cannot_tell_fraction"], "runs"), ""),
+        ]
+        rows += [(f"F1({k})", v, "") for k, v in f["f1_by_class"].items()]
+    rows.append(("out of distribution", share(report["ood"]["flagged_fraction"], "runs"), ""))
+    rows += [("figure", p, "") for p in report.get("figures", [])]
+    return rows
+
+
+# ----------------------------------------------------------------------------- diagnose
+def diagnose(args) -> int:
+    bundle = load_bundle(args.model)
+    result = diagnose_recording(read_recording(args.file), bundle, window=args.window)
+    if args.plot:
+        plot_diagnosis(result, args.plot)
+    if args.json:
+        print_json(result.to_json())
+        return 0
+    print_table(diagnosis_rows(args.file, result))
+    return 0
+
+
+def diagnosis_rows(file: str, result) -> list:
+    """The table of ``diagnose``: a recording's :class:`Diagnosis` in words."""
+    c = result.clearance
+    rows = [
+        ("file", file, ""),
+        ("fault class", result.fault_class, ""),
+        ("class set", ", ".join(result.class_set), "  not ruled out (90 %)"),
+        (
+            "clearance",
+            f"{um(c['estimate'])} [{um(c['lower'])}, {um(c['upper'])}]",
+            "µm (90 % interval)",
+        ),
+    ]
+    rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
+    rows += [
+        ("clearance observable", share(result.observability.get("clearance"), "windows"), ""),
+        ("class observable", share(result.observability.get("fault"), "windows"), ""),
+        ("out-of-distribution score", result.ood_score, "> 1.5: unlike the training set"),
+        ("windows", len(result.windows), ""),
+        ("model", f"{result.model['name']} v{result.model['version']}", ""),
+    ]
+    rows += [("warning", text, "") for text in result.warnings]
+    return rows
+
+
+# ----------------------------------------------------------------------------- replay
+def replay(args) -> int:
+    if args.live and (args.out or args.json):
+        raise PRSMHealthError("--live plays the recording to Foxglove: drop --out and --json")
+    bundle = None if args.statistics_only else load_bundle(args.model)
+    window = args.window or (bundle.window if bundle else 1.0)
+    if args.live:
+        return play_live(args.file, args, bundle, window, rate=getattr(args, "rate", 1.0))
+    steps = []
+    rate = getattr(args, "rate", None)
+    for step in replay_windows(args.file, bundle, window=window, rate=rate, out=args.out):
+        steps.append(step.to_json())
+        if not args.json:
+            print(_replay_line(steps[-1]))
+    if args.json:
+        print_json({"file": args.file, "window": window, "windows": steps, "out": args.out})
+    elif not steps:
+        print("no complete window in the recording")
+    elif args.out and bundle is not None:
+        print(f"wrote {args.out} with {len(steps)} /prsm/diagnosis messages")
+    return 0
+
+
+def _replay_line(entry) -> str:
+    head = f"window {entry['index']:4d}  {entry['start']:8.3f}–{entry['end']:8.3f} s  "
+    if "diagnosis" in entry:
+        d = entry["diagnosis"]
+        c = d["clearance"]
+        return (
+            head
+            + f"{d['fault_class']:<12} clearance {um(c['estimate'])} µm "
+            + f"[{um(c['lower'])}, {um(c['upper'])}]"
+        )
+    ax = entry["statistics"].get("nut_axial_accel", {})
+    return (
+        head
+        + f"axial rms {ax.get('rms', float('nan')):.4g} m/s²  "
+        + f"peak {ax.get('peak', float('nan')):.4g} m/s²"
+    )
