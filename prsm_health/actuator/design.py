@@ -25,7 +25,13 @@ from __future__ import annotations
 import math
 from dataclasses import MISSING, dataclass, field, fields, replace
 
-from prsm_health.core.errors import ParameterError, require, require_positive, require_range
+from prsm_health.core.errors import (
+    ParameterError,
+    require,
+    require_known_keys,
+    require_positive,
+    require_range,
+)
 
 #: Relative tolerance of the concentric condition d_n = d_s + 2·d_r (paper 03 eq. 1). Real
 #: designs shift the roller pitch diameter by a few tenths of a percent to tune the contact
@@ -519,12 +525,7 @@ def _expected(annotation: str) -> tuple[str, bool]:
 def _from_dict(kind: type, data, where: str):
     if not isinstance(data, dict):
         raise ParameterError(where, data, f"must be a table of {kind.__name__} fields")
-    allowed = [f.name for f in fields(kind)]
-    unknown = sorted(set(data) - set(allowed))
-    if unknown:
-        raise ParameterError(
-            f"{where}.{unknown[0]}", data[unknown[0]], f"unknown key; allowed: {', '.join(allowed)}"
-        )
+    require_known_keys(where, data, [f.name for f in fields(kind)])
     values = {}
     for f in fields(kind):
         name = f"{where}.{f.name}"

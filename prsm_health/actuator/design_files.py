@@ -5,10 +5,17 @@ in SI units (m, kg, kg·m², Pa, rad); the nested dataclasses are tables: ``[mas
 ``[gear]`` (standard variant only), ``[screw_material]``, ``[roller_material]``,
 ``[nut_material]``. Optional fields (``None`` in Python) are left out. ``name`` defaults to the
 file's stem. See docs/formats.md → Design files.
+
+Design identity: a design travels with its data (a dataset's manifest, a run's scenario, a
+model's metadata) as its dict form; :func:`design_fingerprint` names it in a label and
+:func:`same_design` compares two. The name is for people; the fingerprint decides.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
+from collections.abc import Mapping
 from pathlib import Path
 
 from prsm_health.core.errors import ParameterError
@@ -170,4 +177,117 @@ def design_rows(design: PRSMDesign) -> list[tuple[str, object, str]]:
     return rows
 
 
-__all__ = ["FIELDS", "design_rows", "design_to_toml", "field_info", "load_design"]
+# ---------------------------------------------------------------------- identity
+#: Fields that describe a design to people, not the mechanism: left out of its identity.
+IDENTITY_IGNORES = ("name", "reference")
+#: Hex digits of :func:`design_fingerprint` (64 bits: no collision among any realistic number
+#: of designs, short enough for a label column).
+FINGERPRINT_LENGTH = 16
+
+
+def canonical_design(design: str | Path | dict | PRSMDesign) -> dict:
+    """The design's identity as a plain dict: its dict form without :data:`IDENTITY_IGNORES`.
+
+    Rebuilt through :meth:`PRSMDesign.from_dict`, so an integer given for a float field reads
+    as the float (``pitch = 2`` and ``pitch = 2.0`` are one design), and -0.0 as 0.0.
+
+    Parameters
+    ----------
+    design : PRSMDesign, preset name, design TOML file or dict form
+        Anything :func:`load_design` reads.
+    """
+    data = PRSMDesign.from_dict(load_design(design).to_dict()).to_dict()
+    for key in IDENTITY_IGNORES:
+        data.pop(key, None)
+    return _plain_zero(data)
+
+
+def _plain_zero(values: dict) -> dict:
+    # -0.0 == 0.0 but json writes "-0.0": one design, one text
+    return {
+        k: _plain_zero(v) if isinstance(v, dict) else (v + 0.0 if isinstance(v, float) else v)
+        for k, v in values.items()
+    }
+
+
+def design_fingerprint(design: str | Path | dict | PRSMDesign) -> str:
+    """Short hex SHA-256 of the design's identity (:func:`canonical_design` as sorted JSON).
+
+    Two designs have one fingerprint exactly when :func:`same_design` holds. Floats are hashed
+    as written by :func:`repr` (the shortest text that reads back to the same float64), so a
+    design keeps its fingerprint through every form it travels in — TOML, JSON, dict, Parquet.
+
+    Parameters
+    ----------
+    design : PRSMDesign, preset name, design TOML file or dict form
+
+    Returns
+    -------
+    str
+        :data:`FINGERPRINT_LENGTH` lowercase hex digits.
+    """
+    text = json.dumps(canonical_design(design), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:FINGERPRINT_LENGTH]
+
+
+def same_design(a: str | Path | dict | PRSMDesign, b: str | Path | dict | PRSMDesign) -> bool:
+    """Whether two designs are the same mechanism: equal :func:`canonical_design` dicts.
+
+    Names and references are ignored (``==`` on :class:`PRSMDesign` compares the name too).
+    Floats compare exactly, not within a tolerance: every form a design travels in round-trips
+    float64 exactly, so a design read back is bit-equal to itself, and an exact rule is the one
+    a fingerprint (a hash, which cannot be tolerant) agrees with — two designs are the same
+    exactly when their fingerprints are.
+    """
+    return canonical_design(a) == canonical_design(b)
+
+
+def design_of(source, labels: Mapping | None = None) -> PRSMDesign | None:
+    """The design of a run: its scenario's design, else a preset named in its labels, else None.
+
+    Parameters
+    ----------
+    source : Run or dict
+        A :class:`~prsm_health.core.run.Run` (its ``scenario`` and ``labels`` are read) or a
+        run's scenario dict. A simulated run's scenario holds ``design`` (a preset name or the
+        full dict form); a dataset's run holds it too, and under ``recipe``.
+    labels : dict, optional
+        The run's labels, when ``source`` is a scenario dict.
+
+    Returns
+    -------
+    PRSMDesign or None
+        None when the run carries no design and its labels name no preset (an imported rig, a
+        design known only by name): the caller decides what that means.
+    """
+    if hasattr(source, "scenario"):
+        source, labels = source.scenario, source.labels if labels is None else labels
+    scenario = source if isinstance(source, Mapping) else {}
+    recipe = scenario.get("recipe")
+    for ref in (
+        scenario.get("design"),
+        recipe.get("design") if isinstance(recipe, Mapping) else None,
+    ):
+        if isinstance(ref, Mapping):
+            return PRSMDesign.from_dict(dict(ref))
+        if isinstance(ref, PRSMDesign):
+            return ref
+        if isinstance(ref, str) and ref in PRESETS:
+            return preset(ref)
+    name = (labels or {}).get("design")
+    if isinstance(name, str) and name in PRESETS:
+        return preset(name)
+    return None
+
+
+__all__ = [
+    "FIELDS",
+    "canonical_design",
+    "design_fingerprint",
+    "design_of",
+    "design_rows",
+    "design_to_toml",
+    "field_info",
+    "load_design",
+    "same_design",
+]

@@ -238,7 +238,7 @@ def plot_evaluation(report: dict, records, directory: str | Path) -> list[Path]:
         ax.set_ylabel("true")
         f = report["fault"]
         ax.set_title(
-            f"macro-F1 {f['macro_f1']:.2f} (given a class: {_fraction_text(f['macro_f1_told'])})"
+            f"macro-F1 {f['macro_f1_all']:.2f} (given a class: {_fraction_text(f['macro_f1_named'])})"
         )
         written.append(_save(fig, out / "confusion.png"))
     return written

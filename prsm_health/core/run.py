@@ -5,7 +5,8 @@ Channel names and units follow the signal-channel contract (:mod:`prsm_health.co
 simulator's truth signals (empty for a recording from hardware); the two never mix. A run as a
 table (:meth:`Run.to_frame`, the single-run Parquet file of :mod:`prsm_health.io.parquet`) has
 the columns ``time``, the measured channels, then ``truth_<name>`` for each truth signal.
-:meth:`Run.validate` is the one place that decides whether a recording can be processed.
+:meth:`Run.validate` is the one place that decides whether a recording can be processed,
+:meth:`Run.windows` the one place recordings are cut into windows.
 """
 
 from __future__ import annotations
@@ -20,6 +21,9 @@ from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
 #: Fewest samples a recording or window needs: below it the spectra have too few bins for the
 #: indicators (a 256-point Welch segment).
 MIN_SAMPLES = 256
+#: A tail of this many samples or fewer (a recording that ends one sample past its last
+#: window) is not worth a note about what was not diagnosed.
+_TAIL_WORTH_A_NOTE = 5
 
 
 @dataclass
@@ -164,6 +168,67 @@ class Run:
             truth={k: v[sl] for k, v in self.truth.items()},
         )
 
+    def windows(
+        self, length: float, *, hop: float | None = None, min_tail: float | None = None
+    ) -> tuple[list[Run], list[str]]:
+        """The run cut into windows of ``length`` seconds (views), and notes on what is not in
+        one: the one place windows are cut (features, diagnosis, service).
+
+        Window ``k`` holds the samples ``[k·step, k·step + n)`` (:func:`window_span`), ``n``
+        and ``step`` being ``length`` and ``hop`` in samples.
+
+        Parameters
+        ----------
+        length : float [s]
+            Window length; at least :data:`MIN_SAMPLES` samples.
+        hop : float or None [s]
+            Hop between window starts; default ``length`` (contiguous windows).
+        min_tail : float or None
+            None: complete windows only (a run shorter than one window gives none), no notes.
+            A fraction of a window: a run shorter than one window is one short window; the
+            samples after the last complete window are a last, shorter window when they are
+            at least ``min_tail`` of a window (and :data:`MIN_SAMPLES`), else left out; the
+            notes say which.
+
+        Raises
+        ------
+        PRSMHealthError
+            A window or hop shorter than the indicators' minimum or than one sample.
+        """
+        rate = float(self.sample_rate)
+        n = int(round(length * rate)) if np.isfinite(length) else 0
+        step = n if hop is None else (int(round(hop * rate)) if np.isfinite(hop) else 0)
+        if n < MIN_SAMPLES:
+            raise PRSMHealthError(
+                f"window length {length:g} s gives {n} samples, need at least {MIN_SAMPLES}"
+                f"{ms_hint(rate)}"
+            )
+        if step < 1:
+            raise PRSMHealthError(f"hop {hop:g} s is shorter than one sample at {rate:g} Hz")
+        total = len(self)
+        if min_tail is not None and total < n:
+            return [self], [
+                f"recording ({self.duration:.2g} s) is shorter than the window ({length:g} s): "
+                "diagnosed as one short window"
+            ]
+        count = complete_windows(total, n, step)
+        parts = [self.slice(*window_span(k, n, step)) for k in range(count)]
+        if min_tail is None:
+            return parts, []
+        end = window_span(count - 1, n, step)[1]
+        tail = total - end
+        notes = []
+        if tail >= max(MIN_SAMPLES, min_tail * n):
+            parts.append(self.slice(end, total))
+            notes.append(f"last window is {tail / rate:.2g} s, shorter than {length:g} s")
+        elif tail > max(_TAIL_WORTH_A_NOTE, 0.01 * n):  # the closing sample or so: no news
+            fraction = "half a window" if min_tail == 0.5 else f"{min_tail:g} of a window"
+            notes.append(
+                f"last {tail / rate:.2g} s not diagnosed: shorter than {fraction} "
+                f"({min_tail * length:.2g} s)"
+            )
+        return parts, notes
+
     def columns(self) -> dict[str, np.ndarray]:
         """The run as file columns (contract): ``time``, the measured channels, then
         ``truth_<name>`` for each truth signal, in contract order."""
@@ -177,6 +242,23 @@ class Run:
         import pandas as pd
 
         return pd.DataFrame(self.columns())
+
+
+def window_span(
+    index: int, length: int, step: int | None = None, origin: int = 0
+) -> tuple[int, int]:
+    """``[start, end)`` of window ``index`` when windows of ``length`` start every ``step``
+    (default ``length``) from ``origin``: the boundary arithmetic of every windowing, in any
+    integer unit (samples for :meth:`Run.windows`, nanoseconds of log time for the MCAP
+    replay)."""
+    start = origin + index * (length if step is None else step)
+    return start, start + length
+
+
+def complete_windows(total: int, length: int, step: int | None = None) -> int:
+    """How many windows of :func:`window_span` fit completely in ``total`` units from 0."""
+    step = length if step is None else step
+    return 0 if total < length else (total - length) // step + 1
 
 
 def lookup_channel(time: np.ndarray, channels: dict[str, np.ndarray], name: str) -> np.ndarray:

@@ -324,6 +324,8 @@ def _finalise(store: DatasetStore, recipe: Recipe, formats: str) -> None:
     manifest = {
         "name": recipe.name,
         "recipe": recipe.source,
+        # which design the runs are of, at a glance (the design itself is the recipe's)
+        "design": {"name": recipe.prsm_design.name, "fingerprint": recipe.design_fingerprint},
         "package": {"name": "prsm_health", "version": __version__},
         "sample_rate": recipe.sample_rate,
         "duration": recipe.duration,

@@ -7,16 +7,26 @@ a generated dataset.
 
 * **MAP.toml** — ``[columns]`` maps contract channel names (:mod:`prsm_health.core.channels`, plus
   ``time`` and the alias ``motor_current``) to the files' column names; ``[units]`` gives each
-  mapped file column's unit (:data:`UNITS`), converted to SI; ``sample_rate`` [Hz] instead of a
-  time column; optional ``design`` (a preset or design name; absent for a rig that is not a
-  PRSM: design-dependent indicators are then NaN), ``lead`` [m per revolution of
-  ``screw_angle``] for such a rig (lost motion needs it), ``torque_constant`` [N·m/A] to turn a
-  ``motor_current`` into ``drive_torque``.
+  mapped file column's unit (:data:`prsm_health.io.column_map.UNITS`), converted to SI;
+  ``sample_rate`` [Hz] instead of a time column; optional ``design`` (a preset, a design TOML
+  file relative to the map, or an inline ``[design]`` table; absent for a rig that is not a
+  PRSM: design-dependent indicators are then NaN),
+  ``lead`` [m per revolution of ``screw_angle``] for such a rig (lost motion needs it),
+  ``torque_constant`` [N·m/A] to turn a ``motor_current`` into ``drive_torque``.
 * **LABELS.csv** — a ``recording`` column (the file's name) and label columns: ``fault_class``,
   ``clearance`` [m] (both sides), any other; ``split`` (train/test) optional, else a
   deterministic stratified split.
 * MCAP recordings in this project's layout carry contract channels in SI already; the map's
   columns and units apply to table files (CSV, Parquet).
+
+The map is :class:`prsm_health.io.ColumnMap` and every file is read by
+:func:`prsm_health.io.read_with_warnings` — the reader ``prsm-health diagnose`` and the service
+use — so a recording and its map read the same on import and at diagnosis (derived channels
+included). What is import's own: time from 0, labels from the labels table, one sample rate.
+The design travels as a generated dataset's does: the manifest's ``recipe.design`` (a preset
+name or the full dict form), its ``design`` entry (name and fingerprint) and every run's
+``design`` and ``design_fingerprint`` labels, so :attr:`Dataset.design` and the indicators find
+it.
 
 Everything is checked before anything is written, and the dataset is assembled in a temporary
 sibling directory renamed at the end: a failed import leaves nothing behind.
@@ -28,7 +38,6 @@ import json
 import math
 import os
 import shutil
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -38,221 +47,23 @@ from prsm_health.core.channels import UNITS as CHANNEL_UNITS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps
 from prsm_health.core.run import MIN_SAMPLES, Run
-from prsm_health.core.tomlfile import read_toml
+from prsm_health.io import ColumnMap, load_column_map, read_with_warnings
+from prsm_health.io.column_map import MIN_RATE as COLUMN_MAP_MIN_RATE
 
-#: Lowest sample rate an import accepts [Hz].
-MIN_RATE = 10.0
-#: Quantity of each contract channel (and of ``time``, ``motor_current``).
-QUANTITY = {
-    "time": "time",
-    "screw_angle": "angle",
-    "screw_speed": "angular speed",
-    "nut_position": "length",
-    "nut_axial_accel": "acceleration",
-    "nut_tangential_accel": "acceleration",
-    "nut_radial_x_accel": "acceleration",
-    "nut_radial_y_accel": "acceleration",
-    "drive_torque": "torque",
-    "axial_load": "force",
-    "motor_current": "current",
-}
-_G = 9.80665
-#: Unit spelling → (quantity, factor to SI). Declared once; docs/import.md prints it.
-UNITS: dict[str, tuple[str, float]] = {
-    "s": ("time", 1.0),
-    "ms": ("time", 1e-3),
-    "us": ("time", 1e-6),
-    "m": ("length", 1.0),
-    "mm": ("length", 1e-3),
-    "um": ("length", 1e-6),
-    "µm": ("length", 1e-6),
-    "in": ("length", 0.0254),
-    "rad": ("angle", 1.0),
-    "deg": ("angle", math.pi / 180),
-    "rev": ("angle", 2 * math.pi),
-    "rad/s": ("angular speed", 1.0),
-    "deg/s": ("angular speed", math.pi / 180),
-    "rpm": ("angular speed", 2 * math.pi / 60),
-    "N*m": ("torque", 1.0),
-    "N·m": ("torque", 1.0),
-    "Nm": ("torque", 1.0),
-    "N*mm": ("torque", 1e-3),
-    "N·mm": ("torque", 1e-3),
-    "Nmm": ("torque", 1e-3),
-    "A": ("current", 1.0),
-    "mA": ("current", 1e-3),
-    "N": ("force", 1.0),
-    "kN": ("force", 1e3),
-    "kgf": ("force", _G),
-    "lbf": ("force", 4.4482216152605),
-    "m/s^2": ("acceleration", 1.0),
-    "m/s²": ("acceleration", 1.0),
-    "mm/s^2": ("acceleration", 1e-3),
-    "mm/s²": ("acceleration", 1e-3),
-    "g": ("acceleration", _G),
-}
-MAP_KEYS = ("columns", "units", "sample_rate", "design", "lead", "torque_constant")
-TABLE_SUFFIXES = (".csv", ".parquet")
+#: Lowest sample rate an import accepts [Hz] (a map's ``sample_rate`` is held to it too).
+MIN_RATE = COLUMN_MAP_MIN_RATE
 
 
-@dataclass(frozen=True)
-class ImportMap:
-    """A parsed, checked MAP.toml."""
-
-    columns: dict[str, str]
-    units: dict[str, str] = field(default_factory=dict)
-    sample_rate: float | None = None
-    design: str | None = None
-    lead: float | None = None
-    torque_constant: float | None = None
-    source: dict = field(default_factory=dict)
-
-
-def load_map(path: str | Path) -> ImportMap:
-    """Parse and check a MAP.toml; errors name the file and the key."""
-    path = Path(path)
-    data = read_toml(path, "column map")
-    unknown = sorted(set(data) - set(MAP_KEYS))
-    if unknown:
-        raise PRSMHealthError(
-            f"{path}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(MAP_KEYS)}"
-        )
-    columns = data.get("columns")
-    if not isinstance(columns, dict) or not columns:
-        raise PRSMHealthError(
-            f"{path}: [columns] must map channel names to your files' column names"
-        )
-    for name, column in columns.items():
-        if name not in QUANTITY:
-            raise PRSMHealthError(
-                f"{path}: [columns] {name!r} is not a channel; use time, motor_current or one of "
-                f"{', '.join(CHANNEL_NAMES)}"
-            )
-        if not isinstance(column, str) or not column:
-            raise PRSMHealthError(f"{path}: [columns] {name} = {column!r} must be a column name")
-    units = data.get("units", {})
-    if not isinstance(units, dict):
-        raise PRSMHealthError(f"{path}: [units] must map column names to units")
-    for name, column in columns.items():
-        unit = units.get(column, "s" if name == "time" else None)
-        if unit is None:
-            raise PRSMHealthError(f"{path}: [units] gives no unit for column {column!r} ({name})")
-        if unit not in UNITS:
-            raise PRSMHealthError(
-                f"{path}: unit {unit!r} of column {column!r} is not understood; accepted: "
-                f"{', '.join(UNITS)}"
-            )
-        if UNITS[unit][0] != QUANTITY[name]:
-            accepted = [u for u, (q, _) in UNITS.items() if q == QUANTITY[name]]
-            raise PRSMHealthError(
-                f"{path}: column {column!r} ({name}) is a {QUANTITY[name]}, but its unit {unit!r} "
-                f"is a {UNITS[unit][0]}; use one of {', '.join(accepted)}"
-            )
-    stray = sorted(set(units) - set(columns.values()))
-    if stray:
-        raise PRSMHealthError(
-            f"{path}: [units] names column(s) {', '.join(stray)} that [columns] does not map"
-        )
-    rate = data.get("sample_rate")
-    if ("time" in columns) == (rate is not None):
-        raise PRSMHealthError(
-            f"{path}: give either a time column ([columns] time = …) or sample_rate [Hz], not both or neither"
-        )
-    if rate is not None and not (isinstance(rate, (int, float)) and rate >= MIN_RATE):
-        raise PRSMHealthError(f"{path}: sample_rate = {rate!r} must be a number ≥ {MIN_RATE:g} Hz")
-    for key in ("lead", "torque_constant"):
-        value = data.get(key)
-        if value is not None and not (isinstance(value, (int, float)) and value > 0):
-            raise PRSMHealthError(f"{path}: {key} = {value!r} must be a positive number")
-    if "motor_current" in columns:
-        if data.get("torque_constant") is None:
-            raise PRSMHealthError(
-                f"{path}: motor_current needs torque_constant [N·m/A] to become drive_torque"
-            )
-        if "drive_torque" in columns:
-            raise PRSMHealthError(f"{path}: map motor_current or drive_torque, not both")
-    design = data.get("design")
-    if design is not None:
-        from prsm_health.actuator.design import PRESETS
-
-        if design not in PRESETS:
-            raise PRSMHealthError(
-                f"{path}: design = {design!r} must be a preset ({', '.join(sorted(PRESETS))}); "
-                "leave it out for a rig that is not one of them (design-dependent indicators NaN)"
-            )
-    return ImportMap(
-        columns=dict(columns),
-        units=dict(units),
-        sample_rate=None if rate is None else float(rate),
-        design=design,
-        lead=data.get("lead"),
-        torque_constant=data.get("torque_constant"),
-        source=data,
-    )
-
-
-def read_table(path: Path, spec: ImportMap) -> Run:
-    """One CSV or Parquet recording through the map, in SI."""
-    import pandas as pd
-
-    try:
-        frame = pd.read_csv(path) if path.suffix.lower() == ".csv" else pd.read_parquet(path)
-    except Exception as exc:  # truncated or not a table
-        raise PRSMHealthError(
-            f"{path}: unreadable or truncated ({type(exc).__name__}: {exc})"
-        ) from None
-    missing = [c for c in spec.columns.values() if c not in frame.columns]
-    if missing:
-        raise PRSMHealthError(
-            f"{path}: no column(s) {', '.join(map(repr, missing))} (the map's [columns]); the file "
-            f"has {', '.join(map(str, list(frame.columns)[:10]))}"
-        )
-    values = {}
-    for name, column in spec.columns.items():
-        unit = spec.units.get(column, "s")
-        try:
-            x = frame[column].to_numpy(float) * UNITS[unit][1]
-        except (TypeError, ValueError):
-            raise PRSMHealthError(f"{path}: column {column!r} is not numeric") from None
-        if not np.all(np.isfinite(x)):
-            raise PRSMHealthError(f"{path}: column {column!r} has empty or non-finite values")
-        values[name] = x
-    n = len(frame)
-    if "time" in values:
-        time = values.pop("time")
-        steps = np.diff(time)
-        if n < 2 or not np.all(steps > 0):
-            raise PRSMHealthError(f"{path}: time must increase strictly")
-        rate = 1.0 / float(np.median(steps))
-        if np.max(np.abs(steps - 1 / rate)) > 0.01 / rate:
-            raise PRSMHealthError(f"{path}: time is not uniformly sampled (steps vary by > 1 %)")
-        time = time - time[0]
-    else:
-        rate = spec.sample_rate
-        time = np.arange(n) / rate
-    if "motor_current" in values:
-        values["drive_torque"] = values.pop("motor_current") * spec.torque_constant
-    return Run(time, values, rate)
-
-
-def _read(path: Path, spec: ImportMap) -> tuple[Run, list[str]]:
-    if not path.exists():
-        raise PRSMHealthError(f"{path}: no such file")
-    suffix = path.suffix.lower()
-    if suffix in TABLE_SUFFIXES:
-        run = read_table(path, spec)
-    elif suffix == ".mcap":
-        from prsm_health.io.mcap import read_mcap
-
-        run = read_mcap(path)
-        run = Run(run.time - run.time[0], dict(run.channels), run.sample_rate)
-    else:
-        raise PRSMHealthError(f"{path}: unsupported file type {suffix!r} (.csv, .parquet, .mcap)")
-    derived = []
-    if "screw_speed" not in run.channels and "screw_angle" in run.channels:
-        # the drive speed from the angle, as a drive's own estimate would (docs/import.md)
-        run.channels["screw_speed"] = np.gradient(run.channels["screw_angle"], run.time)
-        derived.append("screw_speed")
+def _read(path: Path, spec: ColumnMap) -> tuple[Run, tuple[str, ...]]:
+    """One recording as the dataset stores it (time from 0, channels only) and the channels
+    the reader derived; through :func:`prsm_health.io.read_with_warnings`, the reader
+    ``diagnose`` and the service use, so a file reads the same everywhere."""
+    recording = read_with_warnings(path, column_map=spec)
+    recording.warn(stacklevel=3)
+    run = recording.run
+    # An MCAP recording keeps its own clock, labels and truth; the dataset stores its signals
+    # from 0 and the labels table's labels (a mapped table starts at 0 already).
+    run = Run(run.time - run.time[0], dict(run.channels), run.sample_rate)
     if run.sample_rate < MIN_RATE:
         raise PRSMHealthError(
             f"{path}: sample rate {run.sample_rate:.3g} Hz is below {MIN_RATE:g} Hz"
@@ -262,7 +73,7 @@ def _read(path: Path, spec: ImportMap) -> tuple[Run, list[str]]:
             f"{path}: {len(run)} samples; the indicators need at least {MIN_SAMPLES} "
             f"({MIN_SAMPLES / run.sample_rate:.3g} s at {run.sample_rate:g} Hz)"
         )
-    return run.validate(what=str(path)), derived
+    return run.validate(what=str(path)), recording.derived
 
 
 def _labels(path: Path, names: list[str]):
@@ -350,7 +161,7 @@ def import_recordings(
         raise PRSMHealthError(f"{out}: directory {out.parent} does not exist")
     if not recordings:
         raise PRSMHealthError("no recordings given")
-    spec = load_map(map_path)
+    spec = load_column_map(map_path)
     paths = [Path(p) for p in recordings]
     names = [p.name for p in paths]
     if len(set(names)) < len(names):
@@ -391,8 +202,11 @@ def import_recordings(
                 "split": split_of[path.name],
                 "recording": path.name,
                 "source": str(path),
-                "design": spec.design,
+                # None for a rig that is not a PRSM; else the map's design name, fingerprint
+                "design": None,
+                "design_fingerprint": None,
                 "lead": spec.lead,
+                **spec.labels(),
                 **row,
                 "n_samples": len(run),
             }
@@ -416,16 +230,23 @@ def import_recordings(
         frame = pd.DataFrame(rows)
         pq.write_table(pa.Table.from_pandas(frame, preserve_index=False), tmp / "runs.parquet")
         classes = sorted(set(frame["fault_class"].astype(str))) if "fault_class" in frame else []
+        design = spec.labels()
         manifest = {
             "name": name or out.name,
             "recipe": {
                 "name": name or out.name,
                 "imported": True,
+                # a preset name or the design's full dict form, as a generated dataset's recipe
                 "design": spec.design,
                 "instrumentation": None,
                 "map": spec.source,
                 "labels": str(labels),
             },
+            "design": (
+                {"name": design["design"], "fingerprint": design["design_fingerprint"]}
+                if spec.design is not None
+                else None
+            ),
             "package": {"name": "prsm_health", "version": __version__},
             "sample_rate": runs[0].sample_rate,
             "duration": min(r.duration for r in runs),

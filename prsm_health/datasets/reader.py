@@ -9,6 +9,8 @@ import json
 from collections.abc import Iterable
 from pathlib import Path
 
+from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.design_files import load_design
 from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_PREFIX
 from prsm_health.core.errors import (
     PRSMHealthError,
@@ -45,6 +47,19 @@ class Dataset:
             raise
         except Exception as exc:  # damaged files
             raise PRSMHealthError(f"{self.path}: unreadable dataset ({exc})") from None
+
+    @property
+    def design(self) -> PRSMDesign | None:
+        """The design the dataset's runs are of: the preset a recipe named, or the full design
+        it was generated with (a design file's, stored in the manifest); None for an imported
+        rig that is not a PRSM. Its fingerprint is every run's ``design_fingerprint`` label."""
+        ref = self.manifest.get("recipe", {}).get("design")
+        if ref is None:
+            return None
+        try:
+            return load_design(ref)
+        except PRSMHealthError as exc:  # a manifest edited by hand, or of another version
+            raise PRSMHealthError(f"{self.path}: manifest.json recipe design: {exc}") from None
 
     @property
     def sample_rate(self) -> float:
@@ -96,7 +111,8 @@ class Dataset:
             channels,
             self.sample_rate,
             labels,
-            {"recipe": self.manifest["recipe"]},
+            # the design as a simulated run's scenario holds it (a preset name or the dict)
+            {"recipe": self.manifest["recipe"], "design": self.manifest["recipe"].get("design")},
             truth=signals,
         )
 

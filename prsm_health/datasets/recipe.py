@@ -14,12 +14,13 @@ import hashlib
 import itertools
 import json
 from dataclasses import dataclass, field, fields, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 
-from prsm_health.actuator.design import PRESETS
-from prsm_health.actuator.design_files import load_design
+from prsm_health.actuator.design import PRESETS, PRSMDesign
+from prsm_health.actuator.design_files import design_fingerprint, load_design
 from prsm_health.actuator.faults import (
     FaultThresholds,
     fault_as_dict,
@@ -30,6 +31,7 @@ from prsm_health.core.errors import (
     ParameterError,
     PRSMHealthError,
     RecipeError,
+    require_known_keys,
 )
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml
@@ -127,16 +129,17 @@ class Recipe:
                 "[instrumentation.nut_axial_accel] noise_density_ug = 40 "
                 "(docs/instrumentation.md); sample_rate stays at the top level"
             )
-        for key in ("name", "design", "duration", "sample_rate", "seed", "sweep"):
-            if key not in data:
-                raise RecipeError(f"recipe: missing key {key!r}")
+        # unknown keys first: a typo ('sead') is named as such, not as 'seed' missing
+        require_known_keys(
+            "recipe",
+            data,
+            [f.name for f in fields(cls) if f.name != "source"],
+            required=("name", "design", "duration", "sample_rate", "seed", "sweep"),
+            error=RecipeError,
+        )
         data["design"] = _recipe_design(data["design"], base)
         if "instrumentation" in data:
             data["instrumentation"] = _recipe_instrumentation(data["instrumentation"], base)
-        known = {f.name for f in fields(cls)} - {"source"}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise RecipeError(f"recipe: unknown key(s) {', '.join(unknown)}")
         if isinstance(data["sweep"], dict):
             data["sweep"] = _flat_sweep(data["sweep"])
         faults = data.pop("faults", {})
@@ -296,6 +299,17 @@ class Recipe:
             "a life recipe has units × snapshots runs; remove samples",
         )
 
+    @cached_property
+    def prsm_design(self) -> PRSMDesign:
+        """The recipe's design (``design`` holds a preset name or the full dict form)."""
+        return load_design(self.design)
+
+    @cached_property
+    def design_fingerprint(self) -> str:
+        """:func:`~prsm_health.actuator.design_files.design_fingerprint` of the design: every
+        run's ``design_fingerprint`` label."""
+        return design_fingerprint(self.prsm_design)
+
     @property
     def life_spec(self):
         """The parsed ``[life]`` table (:class:`~prsm_health.physics.life.LifeSpec`), None without one."""
@@ -312,7 +326,7 @@ class Recipe:
         if key not in _FLEETS:
             from prsm_health.physics.life import fleet_lives
 
-            _FLEETS[key] = fleet_lives(load_design(self.design), self.life_spec, self.seed)
+            _FLEETS[key] = fleet_lives(self.prsm_design, self.life_spec, self.seed)
         return _FLEETS[key]
 
     def _validate_fault_cases(self, check) -> None:
@@ -591,6 +605,8 @@ class RunSpec:
             "fault_case": self.point.get(FAULT_CASE_KEY, NO_FAULT),
             "severity": self.point.get("severity", 1.0),
             **scenario.labels(),
+            # the design's name is for people; this says which design the run is of
+            "design_fingerprint": self.recipe.design_fingerprint,
             # domain-randomised fields, under their dotted names
             **{k: v for k, v in self.point.items() if "." in k},
         }

@@ -606,13 +606,13 @@ counts `cannot_tell` as a miss.
 
 | set | clearance MAE | 90 % coverage | mean width | fault macro-F1 (models alone: argmax; through the diagnosis: class sets) |
 |---|---|---|---|---|
-| 3-fold CV on train (grouped by operating point; models alone) | {_um(cv["mae"])} | {_f(cv["interval_coverage"])} | {_um(cv["mean_interval_width"])} | {_f(fcv["macro_f1"])} |
-| held-out split ({ct["n"]} runs; models alone) | {_um(ct["mae"])} | {_f(ct["interval_coverage"])} | {_um(ct["mean_interval_width"])} | {_f(ft["macro_f1"])} |
-| off-grid ({ogc["n"]} runs: a fresh hypercube, recipe seed + 1, run seeds never used in training; through the diagnosis) | {_um(ogc["mae"])} | {_f(ogc["coverage"])} | {_um(ogc["mean_width"])} | {_f(ogf["macro_f1"])} |
+| 3-fold CV on train (grouped by operating point; models alone) | {_um(cv["mae"])} | {_f(cv["interval_coverage"])} | {_um(cv["mean_interval_width"])} | {_f(fcv["macro_f1_classifier"])} |
+| held-out split ({ct["n"]} runs; models alone) | {_um(ct["mae"])} | {_f(ct["interval_coverage"])} | {_um(ct["mean_interval_width"])} | {_f(ft["macro_f1_classifier"])} |
+| off-grid ({ogc["n"]} runs: a fresh hypercube, recipe seed + 1, run seeds never used in training; through the diagnosis) | {_um(ogc["mae"])} | {_f(ogc["coverage"])} | {_um(ogc["mean_width"])} | {_f(ogf["macro_f1_all"])} |
 
 Off-grid: clearance observable in {_f(ogc["observable_fraction"], 2)} of the runs; out of
 distribution {_f(og["ood"]["flagged_fraction"], 3)}; `cannot_tell` {_f(ogf["cannot_tell_fraction"], 3)};
-macro-F1 of the runs given a class {_f(ogf["macro_f1_told"])}.
+macro-F1 of the runs given a class {_f(ogf["macro_f1_named"])}.
 
 Figures of the off-grid set: [predicted vs true clearance](figures/clearance.png),
 [class calibration](figures/calibration.png) (the probabilities are cautious: the share correct
@@ -623,8 +623,8 @@ lies above the top probability), [confusion matrix](figures/confusion.png).
 {metrics["default_severity"]["per_class"]} runs per class, on otherwise healthy units (clearance
 < 12 µm, lubricant degradation < 0.4) except where the class is the clearance or the lubricant,
 everything else drawn from the reference ranges, fresh seeds: fault macro-F1
-**{_f(metrics["default_severity"]["fault"]["macro_f1"])}** (`cannot_tell` counted as a miss;
-{_f(metrics["default_severity"]["fault"]["macro_f1_told"])} over the runs given a class,
+**{_f(metrics["default_severity"]["fault"]["macro_f1_all"])}** (`cannot_tell` counted as a miss;
+{_f(metrics["default_severity"]["fault"]["macro_f1_named"])} over the runs given a class,
 `cannot_tell` {_f(metrics["default_severity"]["fault"]["cannot_tell_fraction"], 3)}); clearance MAE
 {_um(metrics["default_severity"]["clearance"]["mae"])}, coverage
 {_f(metrics["default_severity"]["clearance"]["coverage"])}.
@@ -717,7 +717,7 @@ Fault class (drop of accuracy):
   probability (the previous card, 2026-11-24) scored 0.34, and gave a wrong class to 25–29 of
   the 30 runs of healthy, preload loss, spall and tooth damage (14 of lubrication), at
   probabilities of 0.25–0.3; naming only classes that reach 0.5 scores
-  {_f(dsf["macro_f1"])} with {_f(dsf["confident_wrong_fraction"], 3)} confident wrong answers.
+  {_f(dsf["macro_f1_all"])} with {_f(dsf["confident_wrong_fraction"], 3)} confident wrong answers.
   No indicator we tried (time-synchronous averages, envelope lines at the defect frequencies,
   spectral kurtosis, plain-spectrum lines at the defect frequencies) changed that (ablation
   table, docs/faults.md). What would: a load cell, a tangential accelerometer, longer windows

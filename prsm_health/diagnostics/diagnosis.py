@@ -16,11 +16,14 @@ because the model never learnt to do without it; a channel the model was trained
 harmless (its indicators were NaN in training, the model never uses them). Bundles saved before
 the channel list was recorded are not checked.
 
-``Diagnosis.to_json()`` is the Diagnosis contract (docs/formats.md)::
+``Diagnosis.to_json()`` is the Diagnosis contract (docs/formats.md), declared once with its
+typed parts in :mod:`prsm_health.diagnostics.contract`::
 
     {"clearance": {"estimate": m, "lower": m, "upper": m}, "fault_class": str,
-     "class_probabilities": {class: p}, "indicators": {name: value},
-     "model": {name, version, design}, "warnings": [str], "window"|"windows": …}
+     "class_probabilities": {class: p}, "class_set": [class], "observability": {target: …},
+     "ood_score": float, "indicators": {name: value}, "indicator_groups": {group: str},
+     "model": {name, version, design, instrumentation}, "warnings": [str],
+     "window"|"windows": …}
 """
 
 from __future__ import annotations
@@ -33,17 +36,25 @@ from pathlib import Path
 import numpy as np
 
 from prsm_health.actuator.design import PRSMDesign
-from prsm_health.actuator.design_files import load_design
+from prsm_health.actuator.design_files import design_fingerprint, load_design
 from prsm_health.core.channels import MEASURED_TOPICS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import finite_or_none
-from prsm_health.core.run import MIN_SAMPLES, Run
+from prsm_health.core.run import Run
 from prsm_health.signals.features import (
     FEATURES,
     NO_DESIGN,
     extract_features_batch,
     indicator_groups,
-    windows,
+)
+
+from .contract import (
+    CANNOT_TELL,
+    ClearanceInterval,
+    Diagnosis,
+    ModelReference,
+    Observability,
+    WindowSpan,
 )
 
 #: Where the shipped default model lives (repository layout: models/ next to the package).
@@ -52,9 +63,6 @@ DEFAULT_MODEL = Path(__file__).resolve().parents[2] / "models" / "default.skops"
 #: least this fraction of a window (indicators over less are biased: fewer reversals, wider
 #: spectral bins), and reported as dropped otherwise.
 MIN_TAIL_FRACTION = 0.5
-#: The class of a window whose class the model cannot see (clearance hidden, channels missing,
-#: indicators unlike the training set).
-CANNOT_TELL = "cannot_tell"
 #: Out-of-distribution score above which a window is unlike the training set. The score is 1 at
 #: the 99th percentile of the training windows' own scores; 1.5 leaves room for the held-out
 #: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
@@ -65,6 +73,12 @@ OOD_LIMIT = 1.5
 NAME_PROBABILITY = 0.5
 #: How the class-set part of a fault-class warning begins.
 _SET_NOTE = "not ruled out at "
+#: How the warning of windows unlike the training set begins.
+_OOD_NOTE = "indicators unlike the training windows"
+#: A clearance interval at least this share of the trained range wide says nothing: the
+#: clearance is not observable in that window (the shipped model's held-out intervals are
+#: 10 µm wide on average, a quarter of its 40 µm range: models/default.metrics.json).
+WHOLE_RANGE_SHARE = 0.9
 #: Words for the operating indicators in warnings.
 REGIME_WORDS = {
     "speed_mean": "speed",
@@ -93,6 +107,34 @@ class ModelBundle:
     @property
     def design_name(self) -> str:
         return self.design.name if self.design is not None else NO_DESIGN
+
+    @property
+    def design_fingerprint(self) -> str | None:
+        """The identity of the design the model was trained on (None: a rig without one)."""
+        return None if self.design is None else design_fingerprint(self.design)
+
+    def refuses(self, labels: dict) -> str | None:
+        """Why this model cannot diagnose a recording with these labels — another design —
+        or None. The design itself decides (its fingerprint) where the recording carries it;
+        a recording known only by its design's name is compared by name; one that names no
+        design, or a model trained on a rig without one, is taken as it comes."""
+        if self.design is None:
+            return None
+        fingerprint, name = labels.get("design_fingerprint"), labels.get("design")
+        if fingerprint is not None:
+            same = fingerprint == self.design_fingerprint
+        elif isinstance(name, str) and name != NO_DESIGN:
+            same = name == self.design.name
+        else:
+            return None
+        if same:
+            return None
+        shown = name if fingerprint is None else f"{name} ({fingerprint})"
+        return (
+            f"recording of design {shown!r}, model {self.name!r} was trained on design "
+            f"{self.design.name!r} ({self.design_fingerprint}): its indicators mean something "
+            "else; diagnose it with a model trained for its design (prsm-health train)"
+        )
 
     def indicators(self, run: Run) -> dict:
         """The indicators of one window, as this model was trained to read them."""
@@ -125,8 +167,14 @@ class ModelBundle:
         return None if channels is None else tuple(channels)
 
     def reference(self) -> dict:
+        """The ``model`` entry of a diagnosis, as JSON (:meth:`model_reference`)."""
+        return self.model_reference().to_json()
+
+    def model_reference(self) -> ModelReference:
         """The ``model`` entry of a diagnosis."""
-        return {"name": self.name, "version": self.version, "design": self.design_name}
+        return ModelReference(
+            self.name, self.version, self.design_name, self.metadata.get("instrumentation")
+        )
 
     def missing_channels(self, channels) -> list[str]:
         """The channels the model was trained with that a recording lacks."""
@@ -158,77 +206,6 @@ def load_bundle(
         metadata,
         model.get("guard"),
     )
-
-
-@dataclass
-class Diagnosis:
-    """One diagnosis, of a window or of a whole recording (then with ``windows``).
-
-    Attributes
-    ----------
-    clearance : dict
-        ``estimate``, ``lower``, ``upper`` [m] (90 % interval); None where not computable.
-    fault_class : str or None
-        The most probable class, when the window shows the fault (``observability``) and its
-        probability reaches :data:`NAME_PROBABILITY`; else ``cannot_tell``.
-    class_probabilities : dict of class → probability
-    class_set : list of str
-        The classes the evidence cannot rule out (the model's conformal class set, 90 % by
-        default: :meth:`prsm_health.diagnostics.estimators.FaultClassifier.predict_set`); every class where
-        the fault is not observable.
-    indicators : dict of name → value (None where not computable)
-    model : dict
-        ``name``, ``version``, ``design`` of the model bundle.
-    window : dict or None
-        ``index``, ``start``, ``end`` [s] of a window diagnosis.
-    windows : list of Diagnosis
-        Per-window diagnoses of a recording diagnosis.
-    warnings : list of str
-        Sentences a person can act on: why a target is not observable, a missing channel, a
-        recording outside the trained range, a dropped tail.
-    observability : dict
-        ``clearance`` and ``fault``: whether the window lets the model see them (bool), or the
-        fraction of windows that did for a recording.
-    ood_score : float or None
-        Out-of-distribution score of the indicators (:class:`DistributionGuard`: 1 = the
-        training windows' 99th percentile; above :data:`OOD_LIMIT` the window is unlike the
-        training set); a recording's is the median of its windows'.
-    indicator_groups : dict
-        Indicator group → ``"computed"`` or why not (missing channels, window).
-    """
-
-    clearance: dict
-    fault_class: str | None
-    class_probabilities: dict
-    indicators: dict
-    model: dict
-    window: dict | None = None
-    windows: list[Diagnosis] = field(default_factory=list)
-    warnings: list[str] = field(default_factory=list)
-    observability: dict = field(default_factory=dict)
-    ood_score: float | None = None
-    indicator_groups: dict = field(default_factory=dict)
-    class_set: list[str] = field(default_factory=list)
-
-    def to_json(self) -> dict:
-        """The Diagnosis contract as plain JSON values."""
-        out = {
-            "clearance": dict(self.clearance),
-            "fault_class": self.fault_class,
-            "class_probabilities": dict(self.class_probabilities),
-            "class_set": list(self.class_set),
-            "observability": dict(self.observability),
-            "ood_score": self.ood_score,
-            "indicators": dict(self.indicators),
-            "indicator_groups": dict(self.indicator_groups),
-            "model": dict(self.model),
-            "warnings": list(self.warnings),
-        }
-        if self.window is not None:
-            out["window"] = dict(self.window)
-        if self.windows:
-            out["windows"] = [w.to_json() for w in self.windows]
-        return out
 
 
 def _matrix(rows: list[dict], names: list[str]):
@@ -272,8 +249,13 @@ def diagnose_indicators(
         return _predict(rows, x, bundle, channels, design)
 
 
-def _window_gates(row: dict, channels, bundle: ModelBundle, ood: float, design) -> tuple:
-    """(clearance observable, fault observable, warnings) of one window."""
+def _window_gates(
+    row: dict, channels, bundle: ModelBundle, ood: float, design, interval_share: float
+) -> tuple:
+    """(clearance observable, fault observable, warnings) of one window.
+
+    ``interval_share``: the share of the trained range the regression's clearance interval
+    covers (NaN without a clearance model or a recorded range)."""
     notes = []
     missing = bundle.missing_channels(channels)
     if missing:
@@ -285,8 +267,13 @@ def _window_gates(row: dict, channels, bundle: ModelBundle, ood: float, design) 
     reverses = reversal is not None and np.isfinite(reversal) and reversal > 0
     gate = bundle.metadata.get("observability_feature")
     gate_ok = gate not in bundle.feature_names or np.isfinite(row.get(gate, np.nan))
-    clearance_ok = bool(reverses and gate_ok and not missing)
-    if bundle.clearance is not None and not clearance_ok:
+    ood_high = bool(np.isfinite(ood) and ood > OOD_LIMIT)
+    shown = bool(reverses and gate_ok and not missing)
+    # An interval as wide as the trained range says nothing about the clearance: the window
+    # does not show it, whatever the gates above say (observability must not claim it does).
+    wide = bool(np.isfinite(interval_share) and interval_share >= WHOLE_RANGE_SHARE)
+    clearance_ok = shown and not ood_high and not wide
+    if bundle.clearance is not None and not shown:
         if not reverses:
             notes.append(
                 "no load or motion reversal in this window: clearance is not observable (the "
@@ -296,6 +283,12 @@ def _window_gates(row: dict, channels, bundle: ModelBundle, ood: float, design) 
             notes.append("clearance is not observable without the missing channel(s)")
         else:
             notes.append(f"indicator {gate} not computable: clearance is not observable")
+    elif bundle.clearance is not None and wide and not ood_high:
+        notes.append(
+            f"the clearance interval covers {100 * WHOLE_RANGE_SHARE:.0f} % or more of the "
+            "trained range: clearance is not observable in this window (its indicators do not "
+            "narrow it); the interval is the whole trained range"
+        )
     for name, (lo, hi) in bundle.regime.items():
         value = row.get(name)
         if value is not None and np.isfinite(value):
@@ -310,45 +303,90 @@ def _window_gates(row: dict, channels, bundle: ModelBundle, ood: float, design) 
             f"recording of design {design!r}, model trained on {bundle.design_name!r}: its "
             "indicators mean something else"
         )
-    ood_high = np.isfinite(ood) and ood > OOD_LIMIT
     if ood_high:
-        notes.append(
-            f"indicators unlike the training windows (out-of-distribution score {ood:.2g} > "
-            f"{OOD_LIMIT:g}): another design, instrumentation or operating regime? No class, "
-            "and the clearance interval is the whole trained range"
-        )
-    fault_ok = bool(clearance_ok and not ood_high and not missing)
+        notes.append(_ood_note([ood]))
+    fault_ok = clearance_ok  # the wear classes differ by clearance
     if bundle.fault is not None and not fault_ok:
         notes.append(
-            "fault class: cannot tell — wear classes differ by clearance, which this window "
+            "fault class: cannot tell"
+            if ood_high
+            else "fault class: cannot tell — wear classes differ by clearance, which this window "
             "does not show"
-            if not clearance_ok
-            else "fault class: cannot tell"
         )
     return clearance_ok, fault_ok, notes
 
 
+def _ood_note(scores: list[float]) -> str:
+    """The warning of windows unlike the training set, with their scores (each above
+    :data:`OOD_LIMIT`), rounded."""
+    low, high = _above_limit(min(scores)), _above_limit(max(scores))
+    shown = low if low == high else f"{low} … {high}"
+    return (
+        f"{_OOD_NOTE} (out-of-distribution score {shown} > {OOD_LIMIT:g}): another design, "
+        "instrumentation or operating regime? No class, and the clearance interval is the "
+        "whole trained range"
+    )
+
+
+def _above_limit(score: float) -> str:
+    """``score`` (> :data:`OOD_LIMIT`) rounded to the fewest digits (two at least) that still
+    read above the limit: 1.52 is "1.52", never "1.5"."""
+    for digits in (2, 3, 4, 5):
+        text = f"{score:.{digits}g}"
+        if float(text) > OOD_LIMIT:
+            return text
+    return f"{score:.6g}"
+
+
+def ood_verdict(diagnosis: Diagnosis) -> str:
+    """The OOD score of a diagnosis in words, true for a window and for a recording (whose
+    score is the median of its windows', some of which may lie above the limit while the
+    median does not): e.g. "0.61 ≤ 1.5: like the training set", "9.4 > 1.5: unlike the
+    training set", "0.61 ≤ 1.5 (median of 5 windows; 1 above: unlike the training set)"."""
+    score = diagnosis.ood_score
+    if score is None:
+        return "not computed (the model has no out-of-distribution guard)"
+    windows = [w.ood_score for w in diagnosis.windows if w.ood_score is not None]
+    above = sum(s > OOD_LIMIT for s in windows)
+    if score > OOD_LIMIT:
+        text = f"{_above_limit(score)} > {OOD_LIMIT:g}: unlike the training set"
+    else:
+        text = f"{score:.2g} ≤ {OOD_LIMIT:g}: like the training set"
+    if len(windows) > 1 and 0 < above < len(windows):
+        text += f" (median of {len(windows)} windows; {above} above {OOD_LIMIT:g})"
+    return text
+
+
 def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
     n = len(rows)
-    estimate = lower = upper = np.full(n, np.nan)
+    estimate = lower = upper = share = np.full(n, np.nan)
     guard = bundle.guard
     ood = np.asarray(guard.score(x), float) if guard is not None else np.full(n, np.nan)
-    gates = [_window_gates(r, c, bundle, o, design) for r, c, o in zip(rows, channels, ood)]
+    span = bundle.metadata.get("clearance_range")
     if bundle.clearance is not None:
         estimate = np.asarray(bundle.clearance.predict(x), float)
         lower, upper = (np.asarray(a, float) for a in bundle.clearance.predict_interval(x))
+        if span and span[1] > span[0]:
+            # the part of the trained range the interval covers (a wide interval that reaches
+            # past one end still tells the clearance lies near that end)
+            covered = np.minimum(upper, span[1]) - np.maximum(lower, span[0])
+            share = np.clip(covered, 0.0, None) / (span[1] - span[0])
+    gates = [
+        _window_gates(r, c, bundle, o, design, s) for r, c, o, s in zip(rows, channels, ood, share)
+    ]
+    if bundle.clearance is not None and span:
         # Where the clearance is not observable (no reversal: steady load keeps each roller on
-        # one flank, docs/validation.md) or the window is unlike the training set, the interval
-        # is the whole range the model was trained on, whatever the regression says.
-        span = bundle.metadata.get("clearance_range")
-        if span:
-            hidden = np.array([not g[0] or o > OOD_LIMIT for g, o in zip(gates, ood)])
-            lower = np.where(hidden, span[0], lower)
-            upper = np.where(hidden, span[1], upper)
+        # one flank, docs/validation.md; the window unlike the training set; an interval that
+        # says nothing) the interval is the whole range the model was trained on, whatever the
+        # regression says.
+        hidden = np.array([not g[0] for g in gates])
+        lower = np.where(hidden, span[0], lower)
+        upper = np.where(hidden, span[1], upper)
     classes, proba = [], np.zeros((n, 0))
     if bundle.fault is not None:
         classes = [str(c) for c in bundle.fault.classes_]
         proba = np.asarray(bundle.fault.predict_proba(x), float)
+    model = bundle.model_reference()
     out = []
     for i, row in enumerate(rows):
         clearance_ok, fault_ok, notes = gates[i]
@@ -356,18 +394,18 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
         fault_class, class_set = _fault_answer(probabilities, fault_ok, bundle, notes)
         out.append(
             Diagnosis(
-                clearance={
-                    "estimate": finite_or_none(estimate[i]),
-                    "lower": finite_or_none(lower[i]),
-                    "upper": finite_or_none(upper[i]),
-                },
+                clearance=ClearanceInterval(
+                    finite_or_none(estimate[i]),
+                    finite_or_none(lower[i]),
+                    finite_or_none(upper[i]),
+                ),
                 fault_class=fault_class,
                 class_probabilities=probabilities,
                 class_set=class_set,
                 indicators={k: finite_or_none(v) for k, v in row.items()},
-                model=bundle.reference(),
+                model=model,
                 warnings=notes,
-                observability={"clearance": clearance_ok, "fault": fault_ok},
+                observability=Observability(clearance_ok, fault_ok),
                 ood_score=finite_or_none(ood[i]),
                 indicator_groups=indicator_groups(row, channels[i]),
             )
@@ -439,10 +477,16 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
     counts: dict[str, int] = {}
     for d in diagnoses:
         for note in d.warnings:
+            if note.startswith(_OOD_NOTE):  # one note with the range of the windows' scores
+                note = _OOD_NOTE
             if _SET_NOTE not in note:  # restated below for the mean probabilities
                 counts[note] = counts.get(note, 0) + 1
+    flagged = [
+        d.ood_score for d in diagnoses if d.ood_score is not None and d.ood_score > OOD_LIMIT
+    ]
     notes = [
-        note if k == len(diagnoses) else f"{note} (in {k} of {len(diagnoses)} windows)"
+        (_ood_note(flagged) if note == _OOD_NOTE else note)
+        + ("" if k == len(diagnoses) else f" (in {k} of {len(diagnoses)} windows)")
         for note, k in counts.items()
     ]
     fault_class, class_set = _fault_answer(probs, bool(told), bundle, notes)
@@ -454,20 +498,22 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         for g, r in diagnoses[0].indicator_groups.items()
     }
     return Diagnosis(
-        clearance={
-            k: median([d.clearance[k] for d in seen]) for k in ("estimate", "lower", "upper")
-        },
+        clearance=ClearanceInterval(
+            *(median([d.clearance[k] for d in seen]) for k in ("estimate", "lower", "upper"))
+        ),
         fault_class=fault_class,
         class_probabilities=probs,
         class_set=class_set,
         indicators={n: median([d.indicators[n] for d in diagnoses]) for n in names},
-        model=bundle.reference(),
+        model=bundle.model_reference(),
         windows=list(diagnoses),
         warnings=notes,
-        observability={
-            k: float(np.mean([bool(d.observability.get(k)) for d in diagnoses]))
-            for k in ("clearance", "fault")
-        },
+        observability=Observability(
+            **{
+                target: float(np.mean([bool(d.observability[target]) for d in diagnoses]))
+                for target in Observability.TARGETS
+            }
+        ),
         ood_score=median([d.ood_score for d in diagnoses]),
         indicator_groups=groups,
     )
@@ -484,30 +530,17 @@ def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
 
     A recording shorter than one window (but ≥ the indicators' minimum) is one window; a tail
     of at least :data:`MIN_TAIL_FRACTION` of a window is a last, shorter window; a shorter tail
-    is dropped with a warning.
+    is dropped with a warning (:meth:`Run.windows <prsm_health.core.run.Run.windows>` cuts).
     """
-    n = int(round(length * run.sample_rate))
-    if len(run) < n:
-        return [run], [
-            f"recording ({run.duration:.3g} s) is shorter than the model's window ({length:g} s): "
-            "diagnosed as one short window"
-        ]
-    parts = list(windows(run, length))
-    tail = len(run) - n * len(parts)
-    notes = []
-    if tail >= max(MIN_SAMPLES, MIN_TAIL_FRACTION * n):
-        parts.append(run.slice(len(run) - tail, len(run)))
-        notes.append(f"last window is {tail / run.sample_rate:.3g} s, shorter than {length:g} s")
-    elif tail > 0:
-        notes.append(
-            f"last {tail / run.sample_rate:.3g} s not diagnosed: shorter than half a window "
-            f"({length:g} s)"
-        )
-    return parts, notes
+    return run.windows(length, min_tail=MIN_TAIL_FRACTION)
 
 
 def diagnose(
-    run: Run, bundle: ModelBundle | None = None, *, window: float | None = None
+    run: Run,
+    bundle: ModelBundle | None = None,
+    *,
+    window: float | None = None,
+    windows: tuple[list[Run], list[str]] | None = None,
 ) -> Diagnosis:
     """Diagnose a recording: a :class:`Diagnosis` of the whole, with one per window.
 
@@ -517,18 +550,35 @@ def diagnose(
     bundle : ModelBundle, default the shipped model
     window : float or None [s]
         Window length; default the model's training window (see :func:`split_windows`).
+    windows : (windows, notes) or None
+        ``run`` already cut by :func:`split_windows`, for a caller that needs the windows too
+        (it then cuts once); ``window`` is ignored.
     """
-    return diagnose_runs([run], bundle, window=window)[0]
+    split = None if windows is None else [windows]
+    return diagnose_runs([run], bundle, window=window, split=split)[0]
 
 
 def diagnose_runs(
-    runs: list[Run], bundle: ModelBundle | None = None, *, window: float | None = None
+    runs: list[Run],
+    bundle: ModelBundle | None = None,
+    *,
+    window: float | None = None,
+    split: list[tuple[list[Run], list[str]]] | None = None,
 ) -> list[Diagnosis]:
     """Diagnose several recordings in one batch (every window's indicators in one call):
-    one :class:`Diagnosis` per run, each as :func:`diagnose` gives it."""
+    one :class:`Diagnosis` per run, each as :func:`diagnose` gives it; ``split``: each run
+    already cut by :func:`split_windows` (``window`` then ignored)."""
     bundle = bundle or load_bundle()
+    for run in runs:
+        reason = bundle.refuses(run.labels)
+        if reason is not None:
+            raise PRSMHealthError(reason)
     runs = [run.without_truth().validate() for run in runs]
-    split = [split_windows(run, window or bundle.window) for run in runs]
+    if split is None:
+        split = [split_windows(run, window or bundle.window) for run in runs]
+    elif len(split) != len(runs):
+        raise ValueError(f"{len(split)} window sets for {len(runs)} runs")
+    split = [([part.without_truth() for part in parts], notes) for parts, notes in split]
     rows = bundle.indicators_batch([part for parts, _ in split for part in parts])
     channels = [tuple(run.channels) for run, (parts, _) in zip(runs, split) for _ in parts]
     designs = [run.labels.get("design") for run, (parts, _) in zip(runs, split) for _ in parts]
@@ -545,7 +595,7 @@ def diagnose_runs(
         mine = per_window[start : start + len(parts)]
         start += len(parts)
         for k, (part, d) in enumerate(zip(parts, mine)):
-            d.window = {"index": k, "start": float(part.time[0]), "end": float(part.time[-1])}
+            d.window = WindowSpan(k, float(part.time[0]), float(part.time[-1]))
         result = aggregate(mine, bundle)
         result.warnings.extend(notes)
         results.append(result)

@@ -10,6 +10,7 @@ also get interval coverage and width.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
 from typing import Any
 
@@ -28,15 +29,17 @@ from sklearn.metrics import (
 from sklearn.model_selection import GroupKFold, KFold, StratifiedGroupKFold, StratifiedKFold
 from sklearn.utils import check_random_state
 
-from prsm_health.core.errors import require
+from prsm_health.core.errors import PRSMHealthError, require
 
 __all__ = [
+    "SparseFeatureError",
     "clearance_report",
     "cross_validated_metrics",
     "evaluate_model",
     "fault_report",
     "permutation_importance_table",
     "sensitivity_table",
+    "sparse_feature_errors",
 ]
 
 
@@ -186,6 +189,66 @@ def _take(X, idx):
     return X.iloc[idx] if isinstance(X, (pd.DataFrame, pd.Series)) else X[idx]
 
 
+#: What scikit-learn's histogram binning (HistGradientBoosting*, 1.9) raises when one fit gets a
+#: column without a single finite value — a fold of sparse data. The only error translated.
+_NO_FINITE_VALUE = "window shape cannot be larger than input array shape"
+
+
+class SparseFeatureError(PRSMHealthError):
+    """A model fit got a feature without a finite value: the data are too sparse for the folds."""
+
+
+def _sparse_feature_message(X, context: str, minimum: int | None, words: tuple) -> str:
+    """One line naming the sparsest features of ``X`` (finite in some rows, not all) and what
+    a fit needs; ``minimum`` is the finite rows a feature needs for every fit to see one."""
+    feature, rows = words
+    frame = X if isinstance(X, pd.DataFrame) else pd.DataFrame(np.asarray(X, float))
+    n = len(frame)
+    counts = np.isfinite(frame.to_numpy(float)).sum(axis=0)
+    partial = sorted((int(c), str(name)) for name, c in zip(frame.columns, counts) if 0 < c < n)
+    named = ", ".join(f"{name} finite in {c} of {n} {rows}" for c, name in partial[:3])
+    need = (
+        f"needs each {feature} finite in ≥ {minimum} of the {n} {rows} (or in none)"
+        if minimum is not None
+        else f"needs a finite value of each {feature} in every fit"
+    )
+    return (
+        f"{context} {need}, and a fit got none of a sparse one"
+        + (f" ({named})" if named else "")
+        + f": add {rows} where these are measured, leave out the {rows} that lack them, or use "
+        "fewer folds"
+    )
+
+
+@contextlib.contextmanager
+def sparse_feature_errors(
+    X, context: str, minimum: int | None = None, *, words: tuple = ("feature", "rows")
+):
+    """Turn a fit's failure on a feature without a finite value (sparse data split into folds)
+    into a one-line :class:`SparseFeatureError` naming the sparsest features of ``X``.
+
+    Parameters
+    ----------
+    X : DataFrame or array of shape (n_samples, n_features)
+        The rows the fits draw their folds from.
+    context : str
+        The start of the message (e.g. ``"--cv 3"``).
+    minimum : int, optional
+        Finite rows a feature needs for every fit to be sure to see one.
+    words : (str, str)
+        What a feature and the rows are called in the message (``("indicator", "training
+        runs")``).
+    """
+    try:
+        yield
+    except SparseFeatureError:  # an inner guard's: this one knows the wider context
+        raise SparseFeatureError(_sparse_feature_message(X, context, minimum, words)) from None
+    except ValueError as exc:
+        if _NO_FINITE_VALUE not in str(exc):
+            raise
+        raise SparseFeatureError(_sparse_feature_message(X, context, minimum, words)) from None
+
+
 def cross_validated_metrics(
     estimator_factory: Callable[[], Any] | BaseEstimator,
     X,
@@ -224,6 +287,11 @@ def cross_validated_metrics(
         the interval), ``nominal_coverage`` (``1 - alpha``), ``mean_interval_width``
         [units of y]. Plain regression: ``mae``, ``rmse``. Classification: ``accuracy``,
         ``macro_f1``, ``log_loss`` [nat], ``classes``.
+
+    Raises
+    ------
+    SparseFeatureError
+        A fold's training part has no finite value of a feature (data too sparse for ``cv``).
     """
     make = (
         estimator_factory
@@ -259,7 +327,8 @@ def cross_validated_metrics(
         oof_lo, oof_hi = np.zeros(n), np.zeros(n)
     folds = []
     for train, test in splits:
-        est = make().fit(_take(X, train), y[train])
+        with sparse_feature_errors(X, f"{len(splits)}-fold cross-validation"):
+            est = make().fit(_take(X, train), y[train])
         X_test, y_test = _take(X, test), y[test]
         if classification:
             cols = np.searchsorted(classes, est.classes_)
@@ -322,9 +391,11 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
 
     The runs go through :func:`prsm_health.diagnostics.diagnosis.diagnose_indicators`, as a recording
     would: observability gates, the OOD score, ``cannot_tell``. Clearance metrics are computed
-    over all runs and over those whose clearance the diagnosis called observable; fault
-    metrics count ``cannot_tell`` as not correct (``macro_f1``) and also over the runs given a
-    class (``macro_f1_told``).
+    over all runs and over those whose clearance the diagnosis called observable. Fault metrics
+    are ``macro_f1_all`` (every run; ``cannot_tell`` counted as a miss) and ``macro_f1_named``
+    (only the runs the diagnosis named a class for). Neither is the ``macro_f1_classifier`` of
+    ``prsm-health train`` — the classifier alone on every run, no gates, never ``cannot_tell``
+    — so on one split the three differ.
 
     Parameters
     ----------
@@ -346,6 +417,12 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
     require(split in ("test", "train", "all"), "split", split, "must be test, train or all")
     runs = dataset.runs if split == "all" else dataset.runs[dataset.runs["split"] == split]
     require(len(runs) > 0, "split", split, f"has no runs in {dataset.path}")
+    # a model of another design reads these indicators wrongly: refused before any work
+    identity = [c for c in ("design", "design_fingerprint") if c in runs]
+    for labels in runs[identity].drop_duplicates().to_dict("records") if identity else []:
+        reason = bundle.refuses({k: v for k, v in labels.items() if isinstance(v, str)})
+        if reason is not None:
+            raise PRSMHealthError(f"{dataset.path}: {reason}")
     table = dataset_features(dataset, runs["run_id"], progress=progress)
     rows = [{k: row[k] for k in bundle.feature_names} | _extra(row) for _, row in table.iterrows()]
     designs = table["design"] if "design" in table else [None] * len(table)
@@ -422,11 +499,12 @@ def clearance_report(records: pd.DataFrame) -> dict:
 
 
 def fault_report(records: pd.DataFrame) -> dict:
-    """Macro-F1 (``cannot_tell`` counted as a miss), macro-F1 of the runs given a class,
-    per-class F1, the confusion matrix (rows: true, columns: predicted incl. ``cannot_tell``),
-    the share of confident wrong answers (a class named, wrong, top probability > 0.6), and the
-    class sets: how often they hold the true class, their mean size, and per true class the
-    share of runs whose set holds each class."""
+    """Fault metrics of diagnosed runs: ``macro_f1_all`` (every run, ``cannot_tell`` counted as
+    a miss), ``macro_f1_named`` (the runs the diagnosis named a class for; None when none),
+    per-class F1 (``cannot_tell`` a miss), the confusion matrix (rows: true, columns:
+    predicted incl. ``cannot_tell``), the share of confident wrong answers (a class named,
+    wrong, top probability > 0.6), and the class sets: how often they hold the true class,
+    their mean size, and per true class the share of runs whose set holds each class."""
     from sklearn.metrics import confusion_matrix
 
     from .diagnosis import CANNOT_TELL
@@ -441,8 +519,8 @@ def fault_report(records: pd.DataFrame) -> dict:
     per_class = f1_score(y, pred, labels=classes, average=None, zero_division=0)
     return {
         "n": len(y),
-        "macro_f1": float(f1_score(y, pred, labels=classes, average="macro", zero_division=0)),
-        "macro_f1_told": (
+        "macro_f1_all": float(f1_score(y, pred, labels=classes, average="macro", zero_division=0)),
+        "macro_f1_named": (
             float(f1_score(y[told], pred[told], labels=classes, average="macro", zero_division=0))
             if told.any()
             else None

@@ -15,6 +15,7 @@ is no better than a constant answer is reported in ``metrics["warnings"]``.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import math
 import re
@@ -53,12 +54,21 @@ FAULT_PARAMS = dict(min_samples_leaf=5, max_iter=40, learning_rate=0.15, calibra
 
 
 def clearance_target(table) -> np.ndarray:
-    """Thread clearance [m]: mean of the screw- and nut-side half-clearances."""
-    return 0.5 * (table["clearance_screw"].to_numpy(float) + table["clearance_nut"].to_numpy(float))
+    """Thread clearance [m]: mean of the screw- and nut-side half-clearances (NaN where a run
+    has no clearance label)."""
+    import pandas as pd
+
+    def side(name):  # an empty label column is object-typed (None): read it as NaN
+        return pd.to_numeric(table[name], errors="coerce").to_numpy(float)
+
+    return 0.5 * (side("clearance_screw") + side("clearance_nut"))
 
 
 def operating_point(table) -> np.ndarray:
-    """Group id of runs that share every swept value (repeats differ only by seed)."""
+    """Group id of runs that share every swept value (repeats differ only by seed).
+
+    A runs table with none of the swept columns filled in (a rig's recordings labelled with
+    faults only) makes each run its own group: recordings are independent."""
     keys = [
         "clearance_screw",
         "clearance_nut",
@@ -69,8 +79,11 @@ def operating_point(table) -> np.ndarray:
         "wear_spread",
         "load_amplitude",
     ]
-    keys = [k for k in keys if k in table]
-    return table[keys].astype(str).agg("|".join, axis=1).to_numpy()
+    keys = [k for k in keys if k in table and table[k].notna().any()]
+    if not keys:
+        return np.arange(len(table)).astype(str)
+    # element-wise str: a missing label (None/NaN) becomes its text rather than staying missing
+    return table[keys].map(str).agg("|".join, axis=1).to_numpy()
 
 
 # --------------------------------------------------------------------------------------------
@@ -118,9 +131,10 @@ def training_problems(labels, *, target: str = "both", cv: int = 5) -> list[str]
     ----------
     labels : pandas.DataFrame
         The dataset's runs table (``Dataset(path).runs``, i.e. ``runs.parquet``): one row per
-        run with at least ``split`` ("train"/"test"), ``fault_class`` and ``clearance_screw``,
-        ``clearance_nut``; the other swept columns (``screw_speed``, ``axial_load``,
-        ``friction_scale`` …) define the operating points that cross-validation groups by.
+        run with at least ``split`` ("train"/"test") and the labels of ``target``:
+        ``fault_class`` (fault), ``clearance_screw`` and ``clearance_nut`` [m] (clearance); the
+        other swept columns (``screw_speed``, ``axial_load``, ``friction_scale`` …) define the
+        operating points that cross-validation groups by (none: each run is its own).
     target : {"clearance", "fault", "both"}, default "both"
         What will be trained.
     cv : int, default 5
@@ -140,14 +154,38 @@ def training_problems(labels, *, target: str = "both", cv: int = 5) -> list[str]
         An unknown ``target``.
     """
     require(target in TARGETS, "target", target, f"must be one of {', '.join(TARGETS)}")
-    missing = [
-        c for c in ("split", "fault_class", "clearance_screw", "clearance_nut") if c not in labels
-    ]
-    if missing:
+    if "split" not in labels:
         return [
-            f"the runs table has no {', '.join(missing)} column(s), so it is not from "
-            "prsm-health generate: regenerate the dataset"
+            "the runs table has no split column, so it is not from prsm-health generate or "
+            "import: regenerate or re-import the dataset"
         ]
+    # each target needs its own labels only: a rig labelled with faults alone trains --target fault
+    if target in ("fault", "both") and "fault_class" not in labels:
+        return [
+            f"--target {target} needs fault labels, and the runs table has no fault_class "
+            "column: add a fault_class column to the labels table, or use --target clearance"
+        ]
+    if target in ("clearance", "both"):
+        absent = [c for c in ("clearance_screw", "clearance_nut") if c not in labels]
+        labelled = (
+            np.isfinite(clearance_target(labels)) if not absent else np.zeros(len(labels), bool)
+        )
+        if not labelled.any():
+            where = (
+                f"no {', '.join(absent)} column(s)"
+                if absent
+                else "empty clearance_screw, clearance_nut columns"
+            )
+            return [
+                f"--target {target} needs clearance labels, and this dataset has none ({where}):"
+                " use --target fault, or give each recording a clearance [m] in the labels table"
+            ]
+        if not labelled.all():
+            return [
+                f"--target {target} needs a clearance label for every run, and "
+                f"{int((~labelled).sum())} of {len(labels)} runs have none: label them, or use "
+                "--target fault"
+            ]
     problems = []
     if not (isinstance(cv, (int, np.integer)) and not isinstance(cv, bool) and cv >= 2):
         problems.append(
@@ -222,6 +260,41 @@ def training_problems(labels, *, target: str = "both", cv: int = 5) -> list[str]
     return problems
 
 
+def fit_minimum(labels, *, cv: int, target: str = "both") -> int:
+    """Training runs an indicator must be finite in for every fit of ``train`` to see a value of
+    it (an indicator finite in none is left out; in fewer than this, one fit may get none).
+
+    The smallest fit is a CV fold's training part, ``m = n - ceil(n / cv)`` of the ``n``
+    training runs, less what an estimator holds out inside it: the fault classifier one of its
+    ``FAULT_PARAMS["calibration_cv"]`` calibration folds (fewer folds when a class has fewer
+    runs), the clearance estimator its calibration runs and one of the 5 folds of its residual
+    model (:class:`~prsm_health.diagnostics.estimators.ClearanceEstimator`). An indicator
+    finite in ``n - smallest + 1`` runs keeps one in every fit, wherever the folds fall.
+
+    Parameters
+    ----------
+    labels : pandas.DataFrame
+        The runs table (``split``; ``fault_class`` for the fault target).
+    cv : int
+        Cross-validation folds.
+    target : {"clearance", "fault", "both"}
+    """
+    train = labels[labels["split"] == "train"]
+    n = len(train)
+    outer = n - math.ceil(n / cv)
+    fits = [outer]
+    if target in ("fault", "both") and "fault_class" in train and n:
+        fewest = int(train["fault_class"].astype(str).value_counts().min())
+        # FaultClassifier.fit: min(calibration_cv, the fewest runs of a class) folds
+        folds = min(FAULT_PARAMS["calibration_cv"], max(2, fewest - math.ceil(fewest / cv)))
+        fits.append(outer - math.ceil(outer / folds))
+    if target in ("clearance", "both") and outer >= 2:
+        fit = outer - _n_calibration(outer, CLEARANCE_PARAMS["calibration_fraction"])
+        folds = min(5, fit)  # ClearanceEstimator.fit: its residual model's out-of-fold folds
+        fits.append(fit - math.ceil(fit / folds) if folds >= 2 else fit)
+    return n - max(min(fits), 0) + 1
+
+
 # --------------------------------------------------------------------------------------------
 # Metrics and their warnings
 # --------------------------------------------------------------------------------------------
@@ -244,14 +317,20 @@ def _interval_metrics(estimator, x, y) -> dict:
 
 
 def _class_metrics(classifier, x, y) -> dict:
-    """Held-out fault metrics; None (not 0) for every metric when there are no runs."""
+    """Held-out fault metrics of the classifier alone; None (not 0) for every metric when there
+    are no runs.
+
+    ``macro_f1_classifier``: the classifier's answer for every run — no observability gates, no
+    OOD score, never ``cannot_tell`` — so it is not the ``macro_f1_all`` (``cannot_tell``
+    counted as a miss) nor the ``macro_f1_named`` (runs given a class) of ``prsm-health
+    evaluate``, which go through the diagnosis (:func:`~.evaluation.fault_report`)."""
     from sklearn.metrics import accuracy_score, confusion_matrix, f1_score
 
     labels = list(classifier.classes_)
     if len(y) == 0:
         return {
             "n": 0,
-            "macro_f1": None,
+            "macro_f1_classifier": None,
             "accuracy": None,
             "classes": [str(c) for c in labels],
             "confusion_matrix": None,
@@ -259,11 +338,20 @@ def _class_metrics(classifier, x, y) -> dict:
     pred = classifier.predict(x)
     return {
         "n": int(len(y)),
-        "macro_f1": float(f1_score(y, pred, average="macro", zero_division=0)),
+        "macro_f1_classifier": float(f1_score(y, pred, average="macro", zero_division=0)),
         "accuracy": float(accuracy_score(y, pred)),
         "classes": [str(c) for c in labels],
         "confusion_matrix": confusion_matrix(y, pred, labels=labels).tolist(),
     }
+
+
+def _classifier_alone(cv_metrics: dict) -> dict:
+    """Cross-validated fault metrics with their macro-F1 named as the classifier's alone
+    (``macro_f1_classifier``, as :func:`_class_metrics`), in the folds too."""
+    for part in (cv_metrics, *cv_metrics.get("folds", ())):
+        if "macro_f1" in part:
+            part["macro_f1_classifier"] = part.pop("macro_f1")
+    return cv_metrics
 
 
 def _best_constant_f1(y_true, candidates) -> tuple[float, str]:
@@ -393,13 +481,19 @@ def train(
         ``fault_test`` (per target), importances, ``model``, ``metrics_path`` and
         ``warnings``: sentences on what the metrics do not show (e.g. a held-out split of 0
         runs, whose metrics are None, never 0) or a model no better than a constant answer.
+        The fault macro-F1 is ``macro_f1_classifier``: the classifier alone, which names a
+        class for every run (no gates, never ``cannot_tell``); ``prsm-health evaluate`` reports
+        ``macro_f1_all`` and ``macro_f1_named`` through the diagnosis instead.
 
     Raises
     ------
     PRSMHealthError
         ``out`` without the ``.skops`` suffix or in a missing directory; an unreadable
-        dataset; a dataset too small to train on (the sentences of
-        :func:`training_problems`, on one line). All raised before any fitting.
+        dataset; a dataset too small to train on or without the target's labels (the
+        sentences of :func:`training_problems`, on one line). All raised before any fitting.
+    SparseFeatureError
+        An indicator finite in so few training runs that a fit got none of its values (one
+        line naming it and :func:`fit_minimum`).
     """
     out = Path(out)
     if out.suffix != MODEL_SUFFIX:
@@ -427,7 +521,11 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     from prsm_health.datasets import Dataset
 
     from .estimators import ClearanceEstimator, DistributionGuard, FaultClassifier
-    from .evaluation import cross_validated_metrics, permutation_importance_table
+    from .evaluation import (
+        cross_validated_metrics,
+        permutation_importance_table,
+        sparse_feature_errors,
+    )
     from .model_files import save_model
 
     require(target in TARGETS, "target", target, f"must be one of {', '.join(TARGETS)}")
@@ -451,6 +549,15 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     test_rows = table[table["split"] == "test"]
     x_train, x_test = train_rows[features], test_rows[features]
     groups = operating_point(train_rows)
+    # an indicator finite in a few runs only can be absent from one fit's runs: one line, no
+    # traceback, naming it and how many runs it needs
+    sparse = functools.partial(
+        sparse_feature_errors,
+        x_train,
+        f"{dataset_dir}: cannot train: --cv {cv}",
+        fit_minimum(train_rows, cv=cv, target=target),
+        words=("indicator", "training runs"),
+    )
     notes: list[str] = []
     metrics: dict = {
         "dataset": str(dataset_dir),
@@ -468,11 +575,11 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         def make():
             return ClearanceEstimator(**CLEARANCE_PARAMS, random_state=random_state)
 
-        with _collect_warnings("clearance CV", notes):
+        with _collect_warnings("clearance CV", notes), sparse():
             metrics["clearance_cv"] = cross_validated_metrics(
                 make, x_train, y, groups=groups, cv=cv
             )
-        with _collect_warnings("clearance model", notes):
+        with _collect_warnings("clearance model", notes), sparse():
             # reported below, in terms of training runs
             warnings.filterwarnings("ignore", "ClearanceEstimator: .* calibration samples")
             estimator = make().fit(x_train, y)
@@ -512,15 +619,18 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         def make_classifier():
             return FaultClassifier(**FAULT_PARAMS, random_state=random_state)
 
-        with _collect_warnings("fault CV", notes):
-            metrics["fault_cv"] = cross_validated_metrics(
-                make_classifier, x_train, labels, groups=groups, cv=cv
+        with _collect_warnings("fault CV", notes), sparse():
+            metrics["fault_cv"] = _classifier_alone(
+                cross_validated_metrics(make_classifier, x_train, labels, groups=groups, cv=cv)
             )
-        with _collect_warnings("fault model", notes):
+        with _collect_warnings("fault model", notes), sparse():
             classifier = make_classifier().fit(x_train, labels)
         bundle["fault"] = classifier
         notes += fault_warnings(
-            "cross-validated", metrics["fault_cv"]["macro_f1"], labels, classifier.classes_
+            "cross-validated",
+            metrics["fault_cv"]["macro_f1_classifier"],
+            labels,
+            classifier.classes_,
         )
         y_test = test_rows["fault_class"].astype(str).to_numpy()
         with _collect_warnings("fault held-out", notes):
@@ -536,7 +646,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
                 )
                 metrics["fault_importance"] = _importance_records(importance)
         notes += fault_warnings(
-            "held-out", metrics["fault_test"]["macro_f1"], y_test, classifier.classes_
+            "held-out", metrics["fault_test"]["macro_f1_classifier"], y_test, classifier.classes_
         )
     metrics["warnings"] = notes
 

@@ -4,88 +4,72 @@
 - :mod:`prsm_health.io.arrow` — one run as an Arrow IPC stream (the Parquet file's columns);
 - :mod:`prsm_health.io.csv` — a CSV table with contract channel names (a rig's export);
 - :mod:`prsm_health.io.mcap` — MCAP recordings (writer, tolerant reader, replay);
+- :mod:`prsm_health.io.column_map` — column maps (MAP.toml): a rig's column names and units;
+- :mod:`prsm_health.io.derived` — channels derived from others (screw speed from the angle);
 - :mod:`prsm_health.datasets.dataset` — generated datasets (a directory of Parquet files).
 
-:func:`read_recording` picks the reader from the file suffix; :func:`read_recording_bytes`
-reads a recording held in memory (a request body).
+One reader (:mod:`prsm_health.io.reader`) serves every path: :func:`read_recording` picks the
+format from the file suffix, :func:`read_recording_bytes` reads a recording held in memory (a
+request body), both through a column map when given one and with the derivable channels
+added; :func:`read_with_warnings` returns the reader's warnings as sentences too.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from prsm_health.core.errors import PRSMHealthError
+from .column_map import ColumnMap, load_column_map
+from .reader import BYTE_FORMATS, Recording, read_with_warnings
 
 SUFFIXES = (".mcap", ".parquet", ".csv")
-#: Formats :func:`read_recording_bytes` reads.
-BYTE_FORMATS = ("arrow", "parquet", "mcap")
+
+__all__ = [
+    "BYTE_FORMATS",
+    "SUFFIXES",
+    "ColumnMap",
+    "Recording",
+    "load_column_map",
+    "read_recording",
+    "read_recording_bytes",
+    "read_with_warnings",
+]
 
 
-def read_recording(path: str | Path):
-    """A recording as a :class:`~prsm_health.core.run.Run`: ``.mcap``, ``.parquet`` or ``.csv``."""
-    path = Path(path)
-    if not path.exists():
-        raise PRSMHealthError(f"{path}: no such file")
-    suffix = path.suffix.lower()
-    if suffix == ".mcap":
-        from .mcap import read_mcap
+def read_recording(path: str | Path, *, column_map: ColumnMap | str | Path | None = None):
+    """A recording as a :class:`~prsm_health.core.run.Run`: ``.mcap``, ``.parquet`` or ``.csv``.
 
-        return read_mcap(path)
-    if suffix == ".parquet":
-        from .parquet import read_run_parquet
+    Parameters
+    ----------
+    path : str or Path
+    column_map : ColumnMap, path of a MAP.toml, or None
+        How a CSV or Parquet file names and scales its columns (docs/import.md). None: the
+        contract's column names, SI units.
 
-        return read_run_parquet(path)
-    if suffix == ".csv":
-        from .csv import read_csv
-
-        return read_csv(path)
-    raise PRSMHealthError(f"{path}: unsupported file type {suffix!r} (use {', '.join(SUFFIXES)})")
+    The reader's warnings (a truncated recording, …) are raised as Python warnings; see
+    :func:`read_with_warnings` to have them as sentences. Derivable channels the recording
+    lacks are added (``screw_speed`` from ``screw_angle``).
+    """
+    recording = read_with_warnings(path, column_map=column_map)
+    recording.warn(stacklevel=2)
+    return recording.run
 
 
-def read_recording_bytes(data: bytes, fmt: str, name: str = "recording"):
+def read_recording_bytes(
+    data: bytes,
+    fmt: str,
+    name: str = "recording",
+    *,
+    column_map: ColumnMap | str | Path | None = None,
+):
     """A recording held in memory as a :class:`~prsm_health.core.run.Run`: ``fmt`` is ``"arrow"``
-    (Arrow IPC stream), ``"parquet"`` or ``"mcap"``; ``name`` names it in messages and
-    warnings.
+    (Arrow IPC stream), ``"parquet"``, ``"mcap"`` or ``"csv"``; ``name`` names it in messages
+    and warnings; ``column_map`` as for :func:`read_recording`.
 
     Decodes everything: check what the bytes declare first when they come from someone else
     (:func:`prsm_health.io.arrow.arrow_stream_sizes`, the Parquet footer, the MCAP chunk
     headers). An MCAP recording is read through a private temporary file (the MCAP reader
     scans files); its path never appears in a message.
     """
-    if fmt == "arrow":
-        from .arrow import read_run_arrow
-
-        return read_run_arrow(data, name)
-    if fmt == "parquet":
-        from .parquet import read_run_parquet
-
-        return read_run_parquet(data, name=name)
-    if fmt == "mcap":
-        return _read_mcap_bytes(data, name)
-    raise PRSMHealthError(f"{name}: unsupported format {fmt!r} (use {', '.join(BYTE_FORMATS)})")
-
-
-def _read_mcap_bytes(data: bytes, name: str):
-    import tempfile
-    import warnings
-
-    from prsm_health.core.errors import TruncatedRecordingWarning
-
-    from .mcap import read_mcap
-
-    with tempfile.TemporaryDirectory(prefix="prsm-health-mcap-") as tmp:
-        path = Path(tmp) / "recording.mcap"
-        path.write_bytes(data)
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", TruncatedRecordingWarning)
-            try:
-                run = read_mcap(path)
-            except PRSMHealthError as exc:
-                raise PRSMHealthError(str(exc).replace(str(path), name)) from None
-    for w in caught:
-        text = str(w.message).replace(str(path), name)
-        if issubclass(w.category, TruncatedRecordingWarning):
-            warnings.warn(text, TruncatedRecordingWarning, stacklevel=2)
-        else:
-            warnings.warn_explicit(text, w.category, w.filename, w.lineno)
-    return run
+    recording = read_with_warnings(data, fmt=fmt, name=name, column_map=column_map)
+    recording.warn(stacklevel=2)
+    return recording.run

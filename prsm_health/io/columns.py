@@ -16,19 +16,68 @@ from prsm_health.core.jsonable import dumps
 
 
 def run_table(run):
-    """``run`` as a pyarrow Table (``time``, channels, ``truth_<name>``) whose schema metadata
-    carries the units, sample rate, labels and scenario (what the Parquet and Arrow writers
-    store)."""
+    """``run`` as a pyarrow Table (``time``, channels, ``truth_<name>``) whose schema carries
+    the units and sample rate (:func:`with_units`), the labels and the scenario (what the
+    Parquet and Arrow writers store)."""
     import pyarrow as pa
 
-    table = pa.Table.from_pandas(run.to_frame(), preserve_index=False)
+    table = with_units(pa.Table.from_pandas(run.to_frame(), preserve_index=False), run.sample_rate)
     meta = {
-        b"prsm_health.units": json.dumps({k: UNITS[k] for k in table.column_names}).encode(),
-        b"prsm_health.sample_rate": repr(float(run.sample_rate)).encode(),
         b"prsm_health.labels": dumps(run.labels).encode(),
         b"prsm_health.scenario": dumps(run.scenario).encode(),
     }
-    return table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+    return table.replace_schema_metadata({**table.schema.metadata, **meta})
+
+
+def units_schema(schema, sample_rate: float):
+    """``schema`` with the unit of every contract column (``time``, channels, ``truth_*``;
+    other columns such as ``run_id`` have none) and the sample rate [Hz] where each reader
+    looks for them — one place for every file of signals the package writes:
+
+    - ``prsm_health.units`` (JSON: column → unit) and ``prsm_health.sample_rate`` in the schema
+      metadata (the contract, docs/formats.md; polars ``read_parquet_metadata``, duckdb
+      ``parquet_kv_metadata``);
+    - the field metadata ``unit`` of each column (pyarrow ``schema.field(name).metadata``);
+    - pandas ``DataFrame.attrs``: ``{"units": {column: unit}, "sample_rate": Hz}`` after
+      ``pandas.read_parquet`` (pandas ≥ 2.1 restores ``attrs`` from the "pandas" metadata).
+    """
+    import pyarrow as pa
+
+    units = {name: UNITS[name] for name in schema.names if name in UNITS}
+    fields = [
+        f.with_metadata({**(f.metadata or {}), b"unit": units[f.name].encode()})
+        if f.name in units
+        else f
+        for f in schema
+    ]
+    meta = dict(schema.metadata or {})
+    if b"pandas" in meta:
+        pandas_meta = json.loads(meta[b"pandas"])
+    else:  # a table built from arrays: the pandas metadata of its (empty) frame
+        empty = schema.empty_table().to_pandas()
+        pandas_meta = json.loads(
+            pa.Schema.from_pandas(empty, preserve_index=False).metadata[b"pandas"]
+        )
+    pandas_meta["attributes"] = {
+        **pandas_meta.get("attributes", {}),
+        "units": units,
+        "sample_rate": float(sample_rate),
+    }
+    meta.update(
+        {
+            b"pandas": json.dumps(pandas_meta).encode(),
+            b"prsm_health.units": json.dumps(units).encode(),
+            b"prsm_health.sample_rate": repr(float(sample_rate)).encode(),
+        }
+    )
+    return pa.schema(fields, metadata=meta)
+
+
+def with_units(table, sample_rate: float):
+    """``table`` with :func:`units_schema` (the data are not copied)."""
+    import pyarrow as pa
+
+    return pa.Table.from_arrays(table.columns, schema=units_schema(table.schema, sample_rate))
 
 
 def contract_channels(path: Path, columns: Iterable[str], column: Callable) -> dict:

@@ -1,6 +1,6 @@
 """One run as a single Parquet file: ``time``, the measured channels, then ``truth_<name>`` for
 each truth signal as columns, with the units, sample rate, labels and scenario in the schema
-metadata (docs/formats.md), so pandas, pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.datasets.dataset`.
+metadata (docs/formats.md), so pandas, pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.datasets`.
 """
 
 from __future__ import annotations

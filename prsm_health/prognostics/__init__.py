@@ -5,11 +5,13 @@
 - :mod:`.rul` — :class:`PrognosticsModel` (degradation model, similarity baseline) → :class:`Prognosis`
 - :mod:`.model_files` — JSON model files
 - :mod:`.fleet` — a fleet dataset's snapshots diagnosed into histories
+- :mod:`.fitting` — a model fitted for a fleet of any design, scored on its held-out units
 - :mod:`.metrics` — RMSE, α–λ accuracy, prognostic horizon, coverage (Saxena et al. 2010)
 
 Import from here, not from the modules: their split is this package's business.
 """
 
+from .fitting import FitReport, diagnosed_threshold, fit_prognostics_model
 from .fleet import fleet_histories
 from .history import HISTORY_COLUMNS, HistoryError, read_history, validate_history
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
@@ -18,12 +20,15 @@ from .rul import HORIZON_FACTOR, METHODS, PrognosticsModel, prognose
 
 __all__ = [
     "DEFAULT_PROGNOSTICS_MODEL",
+    "FitReport",
     "HISTORY_COLUMNS",
     "HORIZON_FACTOR",
     "METHODS",
     "HistoryError",
     "Prognosis",
     "PrognosticsModel",
+    "diagnosed_threshold",
+    "fit_prognostics_model",
     "fleet_histories",
     "load_prognostics_model",
     "prognose",

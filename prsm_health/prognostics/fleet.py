@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pandas as pd
 
+from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.core.errors import (
     PRSMHealthError,
 )
@@ -36,7 +37,9 @@ def fleet_histories(
     Returns
     -------
     DataFrame
-        ``unit_id``, :data:`HISTORY_COLUMNS`, ``design``, ``fault_class``, and the labels a
+        ``unit_id``, :data:`HISTORY_COLUMNS`, ``design`` (its name), ``design_fingerprint``
+        (which design: :func:`~prsm_health.actuator.design_files.design_fingerprint`),
+        ``fault_class``, and the labels a
         prognosis is scored against: ``split``, ``rul_hours``, ``failure_age_hours``,
         ``failure_mode``, ``clearance_mean_true`` — sorted by unit and age.
 
@@ -95,9 +98,19 @@ def fleet_histories(
             "clearance_lower": [d.clearance["lower"] for d in diagnoses],
             "clearance_upper": [d.clearance["upper"] for d in diagnoses],
             "design": chosen["design"].to_numpy(),
+            "design_fingerprint": _fingerprints(dataset, chosen),
             "fault_class": [d.fault_class for d in diagnoses],
         }
     )
     for label in ("split", "rul_hours", "failure_age_hours", "failure_mode", "clearance_mean_true"):
         out[label] = chosen[label].to_numpy()
     return out.reset_index(drop=True)
+
+
+def _fingerprints(dataset, chosen: pd.DataFrame):
+    """The runs' ``design_fingerprint`` labels; for a dataset generated before runs carried
+    them, its design's (every run of a recipe is of the recipe's design)."""
+    if "design_fingerprint" in chosen.columns:
+        return chosen["design_fingerprint"].to_numpy()
+    design = dataset.design
+    return None if design is None else design_fingerprint(design)

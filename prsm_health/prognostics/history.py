@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from prsm_health.actuator.design import PRESETS
+from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.core.errors import (
     ParameterError,
     PRSMHealthError,
@@ -19,7 +21,7 @@ Z90 = 1.6448536269514722
 #: Required columns of a history: age [h], clearance estimate and its 90 % interval [m].
 HISTORY_COLUMNS = ("age_hours", "clearance", "clearance_lower", "clearance_upper")
 #: Optional columns a history may carry (checked when present).
-OPTIONAL_COLUMNS = ("design", "fault_class", "unit_id")
+OPTIONAL_COLUMNS = ("design", "design_fingerprint", "fault_class", "unit_id")
 
 
 class HistoryError(ParameterError):
@@ -63,7 +65,7 @@ def read_history(path) -> pd.DataFrame:
     path : str or Path
         ``*.csv`` or ``*.parquet`` / ``*.pq`` file with the columns :data:`HISTORY_COLUMNS`
         (``age_hours`` [h], ``clearance``, ``clearance_lower``, ``clearance_upper`` [m]) and
-        optionally ``design``, ``fault_class``, ``unit_id``.
+        optionally ``design``, ``design_fingerprint``, ``fault_class``, ``unit_id``.
 
     Returns
     -------
@@ -108,9 +110,11 @@ def validate_history(history: pd.DataFrame, model=None) -> pd.DataFrame:
     history : pandas.DataFrame
         Diagnoses of one unit: :data:`HISTORY_COLUMNS` (``age_hours`` [h] strictly increasing
         from row to row, ``clearance``, ``clearance_lower`` <= ``clearance_upper`` [m], all
-        finite), optionally ``design`` (one design), ``unit_id`` (one unit), ``fault_class``.
+        finite), optionally ``design`` (one design name), ``design_fingerprint`` (one
+        fingerprint), ``unit_id`` (one unit), ``fault_class``.
     model : PrognosticsModel, optional
-        When given, a ``design`` column must name ``model.design``.
+        When given, the history must be of the model's design: its ``design_fingerprint``
+        equal to the model's where both have one, else its ``design`` name to the model's.
 
     Returns
     -------
@@ -185,21 +189,7 @@ def validate_history(history: pd.DataFrame, model=None) -> pd.DataFrame:
             field="history.clearance_lower",
             value=float(lower[i]),
         )
-    if "design" in out.columns:
-        designs = sorted({str(d) for d in out["design"].dropna()})
-        if len(designs) > 1:
-            raise HistoryError(
-                f"history mixes designs {', '.join(repr(d) for d in designs)}; "
-                "a prognosis is of one unit of one design",
-                field="history.design",
-                value=designs,
-            )
-        if designs and model is not None and designs[0] != str(model.design):
-            raise HistoryError(
-                f"history is of design {designs[0]!r}, the prognostics model of {model.design!r}",
-                field="history.design",
-                value=designs[0],
-            )
+    _check_design(out, model)
     if "unit_id" in out.columns:
         units = out["unit_id"].dropna().unique()
         if len(units) > 1:
@@ -211,6 +201,54 @@ def validate_history(history: pd.DataFrame, model=None) -> pd.DataFrame:
                 value=len(units),
             )
     return out
+
+
+def model_design(name: str, fingerprint: str | None) -> tuple[str, str | None]:
+    """A model's design as (name, fingerprint): a model file from before fingerprints names
+    only its design; a preset name then stands for that preset's fingerprint."""
+    if fingerprint is None and name in PRESETS:
+        fingerprint = design_fingerprint(name)
+    return name, fingerprint
+
+
+def _one_design(history: pd.DataFrame, column: str) -> str | None:
+    """The one value of a design column (None: absent or empty); several raise."""
+    if column not in history.columns:
+        return None
+    values = sorted({str(v) for v in history[column].dropna()})
+    if len(values) > 1:
+        raise HistoryError(
+            f"history mixes designs ({column} {', '.join(repr(v) for v in values)}); "
+            "a prognosis is of one unit of one design",
+            field=f"history.{column}",
+            value=values,
+        )
+    return values[0] if values else None
+
+
+def _check_design(history: pd.DataFrame, model) -> None:
+    """One design in the history, and the model's: by fingerprint where the history and the
+    model both have one (the name is for people and may be reused), else by name."""
+    name = _one_design(history, "design")
+    fingerprint = _one_design(history, "design_fingerprint")
+    if model is None:
+        return
+    model_name, model_fingerprint = model.design_id
+    if fingerprint is not None and model_fingerprint is not None:
+        if fingerprint != model_fingerprint:
+            shown = f"{name!r} " if name is not None else ""
+            raise HistoryError(
+                f"history is of design {shown}(fingerprint {fingerprint}), the prognostics "
+                f"model of {model_name!r} (fingerprint {model_fingerprint}): another design",
+                field="history.design_fingerprint",
+                value=fingerprint,
+            )
+    elif name is not None and name != model_name:
+        raise HistoryError(
+            f"history is of design {name!r}, the prognostics model of {model_name!r}",
+            field="history.design",
+            value=name,
+        )
 
 
 def history_arrays(history: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

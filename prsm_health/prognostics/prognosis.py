@@ -22,7 +22,8 @@ class Prognosis:
         "upper", "current"}``: the history the RUL was predicted from and the failure
         threshold [m]; ``current`` is the latest clearance estimate [m].
     model : dict
-        ``{"name", "version", "design", "units_trained", …}``: ``name`` is
+        ``{"name", "version", "design", "design_fingerprint", "units_trained", …}``
+        (``design_fingerprint`` None for a design known by name only): ``name`` is
         ``"degradation-exponential"``, ``"degradation-linear"`` or ``"similarity"``; the
         degradation models add the posterior of ``(ln theta, beta)`` (or ``(theta, beta)``) in
         physical units [ln m, 1/h] / [m, m/h], ``sigma2``, ``horizon_hours``; the similarity

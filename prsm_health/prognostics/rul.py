@@ -70,7 +70,7 @@ from .degradation import (
     wls_by_unit,
     y_threshold,
 )
-from .history import Z90, HistoryError, history_arrays, one_line, validate_history
+from .history import Z90, HistoryError, history_arrays, model_design, one_line, validate_history
 from .prognosis import Prognosis
 
 #: Methods :meth:`PrognosticsModel.predict` accepts. ``"degradation"`` uses the form chosen at
@@ -175,7 +175,13 @@ class PrognosticsModel:
     threshold : float, default 30e-6
         Clearance at which a unit fails [m], > 0.
     design : str, default "paper01"
-        Design the model is for; histories with a ``design`` column must match it.
+        Name of the design the model is for (any design, not only a preset).
+    design_fingerprint : str or None, default None
+        :func:`~prsm_health.actuator.design_files.design_fingerprint` of that design; None
+        for a preset named by ``design`` (its fingerprint) or a design known by name only.
+        A history must be of the model's design: its ``design_fingerprint`` column equal to
+        this where both exist, else its ``design`` column equal to the name
+        (:func:`~prsm_health.prognostics.validate_history`).
     n_samples : int, default 4000
         Posterior samples per degradation prediction, >= 100.
     random_state : int or None, default 0
@@ -214,10 +220,12 @@ class PrognosticsModel:
         design="paper01",
         n_samples=4000,
         random_state=0,
+        design_fingerprint=None,
     ):
         self.method = method
         self.threshold = threshold
         self.design = design
+        self.design_fingerprint = design_fingerprint
         self.n_samples = n_samples
         self.random_state = random_state
 
@@ -233,6 +241,13 @@ class PrognosticsModel:
             "design",
             self.design,
             "must be a non-empty design name",
+        )
+        require(
+            self.design_fingerprint is None
+            or (isinstance(self.design_fingerprint, str) and self.design_fingerprint != ""),
+            "design_fingerprint",
+            self.design_fingerprint,
+            "must be None or a design fingerprint (hex text)",
         )
         require(
             isinstance(self.n_samples, (int, np.integer))
@@ -253,6 +268,12 @@ class PrognosticsModel:
             self.random_state,
             "must be None or an integer >= 0",
         )
+
+    @property
+    def design_id(self) -> tuple[str, str | None]:
+        """(name, fingerprint) of the model's design; a preset's fingerprint when only a
+        preset name was given (model files from before fingerprints)."""
+        return model_design(self.design, self.design_fingerprint)
 
     def _is_fitted(self) -> bool:
         return hasattr(self, "forms_")
@@ -508,6 +529,7 @@ class PrognosticsModel:
             "name": name,
             "version": _package_version(),
             "design": self.design,
+            "design_fingerprint": self.design_id[1],
             "units_trained": len(self.units_),
             "threshold": float(self.threshold),
             "horizon_hours": self.horizon_,
@@ -613,9 +635,9 @@ class PrognosticsModel:
             now = aligned / self.t_scale_
             if form == "exponential":
                 level = np.exp(np.minimum(params[:, 0, None] + params[:, 1, None] * now, 700.0))
-                curve = phi + level[:, :, None] * decay[:, None, :]
-            else:
-                curve = curve(
+                fitted = phi + level[:, :, None] * decay[:, None, :]
+            else:  # not named `curve`: that would hide the module's function in this scope
+                fitted = curve(
                     form,
                     params[:, 0, None, None],
                     params[:, 1, None, None],
@@ -623,7 +645,7 @@ class PrognosticsModel:
                     phi,
                     thr,
                 )
-            return np.einsum("un,ugn->ug", weights, (value[None, None, :] - curve) ** 2)
+            return np.einsum("un,ugn->ug", weights, (value[None, None, :] - fitted) ** 2)
 
         grid = (
             bottom[:, None] + (top - bottom)[:, None] * np.linspace(0.0, 1.0, _ALIGN_GRID)[None, :]
@@ -669,6 +691,7 @@ class PrognosticsModel:
                 "method": self.method,
                 "threshold": self.threshold,
                 "design": self.design,
+                "design_fingerprint": self.design_fingerprint,
                 "n_samples": self.n_samples,
                 "random_state": self.random_state,
             },

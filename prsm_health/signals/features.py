@@ -40,10 +40,11 @@ from functools import lru_cache
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
-from prsm_health.actuator.design import PRSMDesign, preset
+from prsm_health.actuator.design import DEFAULT_PRESET, PRSMDesign, preset
+from prsm_health.actuator.design_files import design_of, load_design
 from prsm_health.core.channels import CHANNEL_NAMES, VIBRATION
 from prsm_health.core.errors import PRSMHealthError
-from prsm_health.core.run import MIN_SAMPLES, Run, ms_hint
+from prsm_health.core.run import Run
 from prsm_health.physics.kinematics import defect_frequencies, speed_ratios
 
 from .envelope_analysis import defect_lines_batch
@@ -296,7 +297,7 @@ def _truth_request(run: Run, truth) -> tuple[str, ...]:
 
 def extract_features(
     run: Run,
-    design: PRSMDesign | str | None = None,
+    design: PRSMDesign | str | dict | None = None,
     *,
     truth: tuple[str, ...] = (),
     lead: float | None = None,
@@ -308,10 +309,12 @@ def extract_features(
     run : Run
         Measured channels at ``run.sample_rate``; missing channels give NaN indicators.
         ``run.truth`` is not read unless named in ``truth``.
-    design : PRSMDesign, preset name, :data:`NO_DESIGN` or None
-        Default: the run's ``labels["design"]``, else paper01. :data:`NO_DESIGN` (or a run
-        labelled ``design = None``, an imported rig that is not a PRSM): the indicators that
-        need the design's kinematics (mesh, gear, envelope, axial baseline) are NaN.
+    design : PRSMDesign, preset name, design TOML file, dict form, :data:`NO_DESIGN` or None
+        Default (None): the run's own design (:func:`run_design`: its scenario's, else a
+        preset its labels name, else paper01 for a run with no design label).
+        :data:`NO_DESIGN` (or a run labelled ``design = None``, an imported rig that is not a
+        PRSM): the indicators that need the design's kinematics (mesh, gear, envelope, axial
+        baseline) are NaN.
     lead : float or None [m per revolution of screw_angle]
         Without a design, the lead lost motion needs (default the run's ``labels["lead"]``).
     truth : tuple of str
@@ -328,14 +331,18 @@ def extract_features(
     RecordingError
         The measured channels (or the truth signals asked for) cannot be processed.
     PRSMHealthError
-        No nut acceleration and no nut position; an unknown or absent truth signal asked for.
+        No nut acceleration and no nut position; an unknown or absent truth signal asked for;
+        a run labelled with a design that is not a preset and carries no design, no
+        ``design`` given.
+    ParameterError
+        A ``design`` that is not a preset, a design file or a valid dict form.
     """
     return extract_features_batch([run], design, truth=truth, lead=lead)[0]
 
 
 def extract_features_batch(
     runs: list[Run],
-    design: PRSMDesign | str | None = None,
+    design: PRSMDesign | str | dict | None = None,
     *,
     truth: tuple[str, ...] = (),
     lead: float | None = None,
@@ -347,24 +354,79 @@ def extract_features_batch(
     channels in one call (the Welch spectra, kurtograms and envelopes then transform them row
     by row, where a row's frames stay in the cache).
     """
-    prepared = [_prepare(run, design, truth, lead) for run in runs]
+    given = _given_design(design)
+    # windows of one recording share its scenario and labels: resolve its design once
+    designs: dict[tuple[int, int], PRSMDesign | None] = {}
+    prepared = [_prepare(run, given, truth, lead, designs) for run in runs]
     groups: dict[tuple, list[int]] = {}
-    for i, (run, run_design, run_lead) in enumerate(prepared):
-        key = (len(run), run.sample_rate, tuple(sorted(run.channels)), run_design, run_lead)
+    for i, (run, window_design, run_lead) in enumerate(prepared):
+        key = (len(run), run.sample_rate, tuple(sorted(run.channels)), window_design, run_lead)
         groups.setdefault(key, []).append(i)
     rows: list = [None] * len(runs)
     for index in groups.values():
         for start in range(0, len(index), BATCH_WINDOWS):
             chunk = index[start : start + BATCH_WINDOWS]
-            _, run_design, run_lead = prepared[chunk[0]]
-            found = _extract([prepared[i][0] for i in chunk], run_design, run_lead)
+            _, window_design, run_lead = prepared[chunk[0]]
+            found = _extract([prepared[i][0] for i in chunk], window_design, run_lead)
             for i, row in zip(chunk, found):
                 rows[i] = row
     return rows
 
 
-def _prepare(run: Run, design, truth, lead) -> tuple[Run, PRSMDesign | None, float | None]:
-    """(the window with only what is read, checked; its design; the lead without a design)."""
+#: :func:`_prepare` takes the design from the run.
+_FROM_RUN = object()
+
+
+def _given_design(design) -> PRSMDesign | None | object:
+    """The ``design`` argument resolved once: :data:`_FROM_RUN` (None given), None
+    (:data:`NO_DESIGN`) or the design (a preset name, a design file, a dict or a design)."""
+    if design is None:
+        return _FROM_RUN
+    if isinstance(design, str) and design == NO_DESIGN:
+        return None
+    return load_design(design)
+
+
+def run_design(run: Run) -> PRSMDesign | None:
+    """The design a run's indicators are computed for, from the run alone.
+
+    Its scenario's design (a simulated run's, a dataset run's), else a preset its labels name
+    (:func:`~prsm_health.actuator.design_files.design_of`); None for a run labelled
+    ``design = None`` or :data:`NO_DESIGN` (a rig that is not a PRSM); paper01 for a run
+    with no design label at all.
+
+    Raises
+    ------
+    PRSMHealthError
+        The labels name a design that is not a preset and the run carries no design.
+    """
+    found = design_of(run)
+    if found is not None:
+        return found
+    if "design" not in run.labels:
+        return preset(DEFAULT_PRESET)
+    name = run.labels["design"]
+    if not isinstance(name, str) or name == NO_DESIGN:  # None, or NaN read back from a table
+        return None
+    raise PRSMHealthError(
+        f"run labelled design {name!r} carries no design and it is not a preset: "
+        "pass design=<PRSMDesign or design file>"
+    )
+
+
+def _prepare(
+    run: Run, design, truth, lead, designs: dict | None = None
+) -> tuple[Run, PRSMDesign | None, float | None]:
+    """(the window with only what is read, checked; its design; the lead without a design).
+
+    ``design``: what :func:`_given_design` made of the argument; ``designs`` memoises
+    :func:`run_design` by the identity of the run's scenario and labels."""
+    if design is _FROM_RUN:
+        # ids are unique here: every run of the batch is alive while it is prepared
+        key, memo = (id(run.scenario), id(run.labels)), {} if designs is None else designs
+        if key not in memo:
+            memo[key] = run_design(run)
+        design = memo[key]
     truth = _truth_request(run, truth)
     # Only what is read: the measured channels and the truth signals asked for.
     run = Run(
@@ -380,12 +442,7 @@ def _prepare(run: Run, design, truth, lead) -> tuple[Run, PRSMDesign | None, flo
             f"({', '.join(CHANNEL_NAMES)})"
         )
     if design is None:
-        design = run.labels.get("design", "paper01")
-    if design is None or design == NO_DESIGN:
-        design = None
         lead = lead if lead is not None else run.labels.get("lead")
-    elif isinstance(design, str):
-        design = preset(design)
     return run, design, lead
 
 
@@ -681,26 +738,26 @@ def _rattle_rate(torque: np.ndarray, rate: float) -> float:
 
 
 def windows(run: Run, length: float, hop: float | None = None):
-    """Split a run into windows of ``length`` seconds (hop defaults to length), as Runs."""
-    n = int(round(length * run.sample_rate))
-    step = int(round((hop or length) * run.sample_rate))
-    if n < MIN_SAMPLES:
-        raise PRSMHealthError(
-            f"window length {length:g} s gives {n} samples, need at least {MIN_SAMPLES}"
-            f"{ms_hint(run.sample_rate)}"
-        )
-    for start in range(0, len(run) - n + 1, step):
-        yield run.slice(start, start + n)
+    """Split a run into complete windows of ``length`` seconds (hop defaults to length), as
+    Runs: :meth:`Run.windows <prsm_health.core.run.Run.windows>`, the one place windows are
+    cut."""
+    yield from run.windows(length, hop=hop)[0]
 
 
 def dataset_features(dataset, run_ids=None, progress: bool = False, truth: tuple[str, ...] = ()):
-    """Indicators of every run of a :class:`~prsm_health.datasets.dataset.Dataset` as a DataFrame.
+    """Indicators of every run of a :class:`~prsm_health.datasets.Dataset` as a DataFrame.
 
     Columns: :data:`FEATURES` (then the indicators of the truth signals named in ``truth``, see
     :func:`extract_features`) plus the run labels (run_id, split, fault_class, clearances, …).
+    The indicators are computed for the dataset's own design (``dataset.design``: a preset or
+    the full design it was generated with); a dataset without one (an imported rig that is
+    not a PRSM) leaves it to each run's labels.
     """
     import pandas as pd
 
+    # resolved once, and what makes a dataset of one's own design work: its runs are
+    # labelled with the design's name, which is not a preset
+    design = getattr(dataset, "design", None)
     rows = []
     ids = list(dataset.runs["run_id"] if run_ids is None else run_ids)
     iterator = ids
@@ -710,7 +767,7 @@ def dataset_features(dataset, run_ids=None, progress: bool = False, truth: tuple
         iterator = tqdm(ids, unit="run", desc="features")
     for run_id in iterator:
         run = dataset.run(int(run_id), truth=bool(truth))
-        row = extract_features(run, truth=truth)
+        row = extract_features(run, design, truth=truth)
         row.update(run.labels)
         rows.append(row)
     return pd.DataFrame(rows)

@@ -43,7 +43,13 @@ from typing import ClassVar
 import numpy as np
 from scipy import signal
 
-from prsm_health.core.errors import ParameterError, require, require_known_keys, require_range
+from prsm_health.core.errors import (
+    ParameterError,
+    UnknownKeyError,
+    require,
+    require_known_keys,
+    require_range,
+)
 from prsm_health.core.tomlfile import read_toml, toml_value
 
 from .decimation import decimate
@@ -239,11 +245,7 @@ class _Sensor:
             elif key in known:
                 values[key] = value
             else:
-                raise ParameterError(
-                    f"{where}.{key}",
-                    value,
-                    f"unknown key; allowed: {', '.join(cls.allowed_keys())}, fitted",
-                )
+                raise UnknownKeyError(where, key, value, [*cls.allowed_keys(), "fitted"])
         try:
             return cls(**values)
         except ParameterError as exc:

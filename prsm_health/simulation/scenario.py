@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS, PRSMDesign, preset
-from prsm_health.actuator.design_files import design_toml_tables, load_design
+from prsm_health.actuator.design_files import design_fingerprint, design_toml_tables, load_design
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.actuator.faults import fault_as_dict
 from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
@@ -139,14 +139,9 @@ class Scenario:
                 f"{', '.join(list_profiles())}) or an [instrumentation] table with profile = … "
                 "and overrides (docs/instrumentation.md)",
             )
-        unknown = sorted(set(data) - {"design", "instrumentation", "seed", "sensor_seed", *_GROUPS})
-        if unknown:
-            raise ParameterError(
-                "scenario",
-                ", ".join(unknown),
-                "unknown key(s); allowed: design, instrumentation, seed, sensor_seed, "
-                f"{', '.join(_GROUPS)}",
-            )
+        require_known_keys(
+            "scenario", data, ["design", "instrumentation", "seed", "sensor_seed", *_GROUPS]
+        )
         groups = {name: _group(name, kind, data.get(name, {})) for name, kind in _GROUPS.items()}
         design = load_design(data.get("design", DEFAULT_PRESET), base=base)
         instrumentation = load_instrumentation(
@@ -225,6 +220,9 @@ class Scenario:
         h, p = self.health, self.profile
         return {
             "design": self.design.name,
+            # the name is for people; the fingerprint says which design the run is of (as a
+            # dataset run's label does)
+            "design_fingerprint": design_fingerprint(self.design),
             "clearance_screw": h.clearance_screw,
             "clearance_nut": h.clearance_nut,
             "clearance_gear": h.clearance_gear,

@@ -39,7 +39,10 @@ def test_every_field_has_a_unit_and_meaning():
 
 def test_from_dict_errors_name_the_field():
     data = preset().to_dict()
-    with pytest.raises(ParameterError, match=r"design\.gear\.modul .*allowed: ring_teeth"):
+    with pytest.raises(
+        ParameterError,
+        match=r"unknown key 'modul' in \[design\.gear\] \(did you mean 'module'\?\).*allowed: ring_teeth",
+    ):
         PRSMDesign.from_dict({**data, "gear": {**data["gear"], "modul": 1e-3}})
     with pytest.raises(ParameterError, match=r"design\.pitch .*expected a number"):
         PRSMDesign.from_dict({**data, "pitch": "2 mm"})
@@ -75,21 +78,25 @@ def test_template_then_check(tmp_path, capsys):
 
 
 @pytest.mark.parametrize(
-    "old, new, field",
+    "old, new, message",
     [
-        ("module = 0.0005", "modul = 0.0005", "design.gear.modul"),
-        ("pitch = 0.002", 'pitch = "0.002"', "design.pitch"),
-        ("nut_diameter = 0.0325", "nut_diameter = 0.04", "design.nut_diameter"),
+        (
+            "module = 0.0005",
+            "modul = 0.0005",
+            "unknown key 'modul' in [design.gear] (did you mean 'module'?)",
+        ),
+        ("pitch = 0.002", 'pitch = "0.002"', "design.pitch = "),
+        ("nut_diameter = 0.0325", "nut_diameter = 0.04", "design.nut_diameter = "),
     ],
 )
-def test_check_refuses_a_bad_file_in_one_line(old, new, field, tmp_path, capsys):
+def test_check_refuses_a_bad_file_in_one_line(old, new, message, tmp_path, capsys):
     text = design_to_toml(preset("paper01"))
     assert old in text
     path = tmp_path / "bad.toml"
     path.write_text(text.replace(old, new, 1))
     code, out, err = _check(path, capsys)
     assert code == 2 and out == ""
-    assert len(err.splitlines()) == 1 and err.startswith(f"error: {field} = ")
+    assert len(err.splitlines()) == 1 and err.startswith(f"error: {message}")
 
 
 def test_show_table_and_json(capsys):

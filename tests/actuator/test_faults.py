@@ -88,7 +88,7 @@ def test_severity_scaling_names_the_field_out_of_range():
         ({"kind": "crack"}, "faults.kind"),
         ({"kind": "spall", "location": "ring_gear"}, "faults.location"),
         ({"kind": "spall", "depth": -1e-6}, "faults.depth"),
-        ({"kind": "spall", "size": 1.0}, "faults.size"),
+        ({"kind": "spall", "size": 1.0}, r"unknown key 'size' in \[faults\]"),
         ({"kind": "preload_loss", "fraction": 2.0}, "faults.fraction"),
         ({"kind": "tooth_crack", "location": "nut"}, "faults.location"),
         ({"kind": "tooth_pit", "depth": -1e-6}, "faults.depth"),

@@ -55,8 +55,8 @@ REPORT = {
     "runs": 10,
     "clearance": {"mae": 2e-6, "coverage": 0.9, "mean_width": 8e-6, "observable_fraction": 0.8},
     "fault": {
-        "macro_f1": 0.5,
-        "macro_f1_told": 0.75,
+        "macro_f1_all": 0.5,
+        "macro_f1_named": 0.75,
         "cannot_tell_fraction": 0.3,
         "f1_by_class": {"healthy": 0.6, "wear": 0.4},
     },
@@ -79,8 +79,8 @@ def test_train_says_its_macro_f1_is_the_classifiers_alone(capsys):
     metrics = {
         "model": {"path": "m.skops"},
         "metrics_path": "m.metrics.json",
-        "fault_cv": {"macro_f1": 0.6},
-        "fault_test": {"macro_f1": None},  # no held-out runs
+        "fault_cv": {"macro_f1_classifier": 0.6},
+        "fault_test": {"macro_f1_classifier": None},  # no held-out runs
         "clearance_test": {"mae": 2e-6, "interval_coverage": 0.85, "mean_interval_width": 8e-6},
     }
     lines = table(training_rows(metrics), capsys)

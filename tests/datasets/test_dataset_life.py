@@ -127,7 +127,7 @@ def test_life_recipes_draw_their_recording_conditions(sweep, key):
     "life, field",
     [
         ({"units": 0}, "life.units"),
-        ({"units": 2, "colour": "red"}, "life.colour"),
+        ({"units": 2, "colour": "red"}, "unknown key 'colour' in [life]"),
         ({"units": 2, "duty": {"shares": [0.5, 0.5, 0.5]}}, "life.duty.shares"),
         ({"units": 2, "max_age": 10.0}, "life.max_age"),
     ],

@@ -19,7 +19,14 @@ from prsm_health.apps.cli import main
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, FaultThresholds, Recipe, generate
 from prsm_health.diagnostics import training
-from prsm_health.diagnostics.training import calibration_minimums, train, training_problems
+from prsm_health.diagnostics.evaluation import SparseFeatureError
+from prsm_health.diagnostics.training import (
+    calibration_minimums,
+    fit_minimum,
+    operating_point,
+    train,
+    training_problems,
+)
 from prsm_health.signals.features import FEATURES
 
 TINY = dict(
@@ -224,10 +231,115 @@ def test_no_metric_from_zero_runs():
     classes = training._class_metrics(Never(), empty, np.array([]))
     assert interval["n"] == 0 and classes["n"] == 0
     assert all(interval[k] is None for k in ("mae", "rmse", "interval_coverage"))
-    assert classes["macro_f1"] is None and classes["accuracy"] is None
+    assert classes["macro_f1_classifier"] is None and classes["accuracy"] is None
     assert training.clearance_warnings("held-out", None, [], [1e-5, 2e-5]) == [
         "held-out split has 0 runs: no held-out clearance metrics"
     ]
     assert training.fault_warnings("held-out", None, [], ["healthy", "wear"]) == [
         "held-out split has 0 runs: no held-out fault metrics"
     ]
+
+
+# ------------------------------------------------------------------------------------------
+# A rig's dataset: fault labels alone, empty clearance labels, sparse indicators
+# ------------------------------------------------------------------------------------------
+
+
+def fault_only(table):
+    """A rig's runs table labelled with faults alone: no clearance, nothing swept."""
+    return table[["run_id", "split", "fault_class", "design"]]
+
+
+def test_fault_labels_alone_are_enough_for_the_fault_target():
+    table = fault_only(labels_table(60, 20))
+    assert training_problems(table, target="fault", cv=5) == []
+    for target in ("clearance", "both"):
+        (problem,) = training_problems(table, target=target, cv=5)
+        assert problem.startswith(f"--target {target} needs clearance labels, and this dataset")
+        assert "no clearance_screw, clearance_nut column(s)" in problem
+        assert "use --target fault" in problem
+
+
+def test_empty_clearance_labels_are_no_labels_not_a_type_error():
+    # an imported rig's runs table with clearance columns left empty: object-typed None
+    table = fault_only(labels_table(60, 20)).assign(clearance_screw=None, clearance_nut=None)
+    assert table["clearance_screw"].dtype == object
+    assert training_problems(table, target="fault", cv=5) == []
+    (problem,) = training_problems(table, target="both", cv=5)
+    assert "needs clearance labels" in problem and "empty clearance_screw" in problem
+    partly = labels_table(60, 20)
+    partly.loc[:4, "clearance_nut"] = np.nan
+    (problem,) = training_problems(partly, target="clearance", cv=5)
+    assert "5 of 80 runs have none" in problem
+
+
+def test_runs_without_swept_columns_are_each_their_own_operating_point():
+    assert len(set(operating_point(fault_only(labels_table(6, 0))))) == 6
+    empty = labels_table(6, 0)[["split", "clearance_screw", "screw_speed"]].assign(
+        clearance_screw=None, screw_speed=None
+    )
+    assert len(set(operating_point(empty))) == 6
+
+
+def test_fit_minimum_is_the_runs_the_smallest_fit_could_miss():
+    table = labels_table(16, 4, classes=["a", "b", "c", "d"] * 5)
+    minimum = fit_minimum(table, cv=3, target="fault")
+    # 16 runs, 3 folds: 10 in a fold's fit; the classifier calibrates on 2 folds of it: 5
+    assert minimum == 12
+    assert fit_minimum(table, cv=3, target="clearance") <= 16
+    assert fit_minimum(labels_table(800, 200), cv=5, target="both") < 800
+
+
+def _features_of(table, sparse, finite_rows, seed=0):
+    """Indicators for a runs table: random, but ``sparse`` finite in ``finite_rows`` train runs."""
+    rng = np.random.default_rng(seed)
+
+    def features(dataset, progress=False):
+        runs = dataset.runs.reset_index(drop=True)
+        values = pd.DataFrame(
+            rng.normal(size=(len(runs), len(FEATURES))), index=runs.index, columns=list(FEATURES)
+        )
+        train_rows = np.flatnonzero(runs["split"].to_numpy() == "train")
+        values.loc[train_rows[finite_rows:], sparse] = np.nan
+        return pd.concat([values, runs], axis=1)
+
+    return features
+
+
+def _dataset(tiny, path, table):
+    path.mkdir()
+    shutil.copy(tiny / "manifest.json", path / "manifest.json")
+    table.to_parquet(path / "runs.parquet")
+    return path
+
+
+def test_fault_labels_alone_train_a_fault_model(tiny, tmp_path, monkeypatch):
+    table = fault_only(labels_table(24, 8, classes=["healthy", "wear"] * 16))
+    ds_dir = _dataset(tiny, tmp_path / "faults", table)
+    monkeypatch.setattr(training, "dataset_features", _features_of(table, "lost_motion", 24))
+    monkeypatch.setitem(training.FAULT_PARAMS, "max_iter", 3)
+    metrics = train(ds_dir, tmp_path / "m.skops", target="fault", cv=2, progress=False)
+    assert "clearance_cv" not in metrics and metrics["fault_test"]["n"] == 8
+    # the classifier alone: every run named, so it is neither of evaluate's two macro-F1s
+    assert "macro_f1_classifier" in metrics["fault_test"] and "macro_f1" not in metrics["fault_cv"]
+    assert all("macro_f1_classifier" in fold for fold in metrics["fault_cv"]["folds"])
+    with pytest.raises(PRSMHealthError, match="needs clearance labels"):
+        train(ds_dir, tmp_path / "c.skops", target="clearance", cv=2, progress=False)
+
+
+def test_a_too_sparse_indicator_is_one_line_never_a_traceback(tiny, tmp_path, monkeypatch):
+    # lost_motion finite in 1 of 16 training runs (a rig whose recordings rarely reverse): the
+    # CV fold that holds that run out fits on none of its values
+    table = labels_table(16, 4, classes=["healthy", "wear"] * 10)
+    ds_dir = _dataset(tiny, tmp_path / "sparse", table)
+    monkeypatch.setattr(training, "dataset_features", _features_of(table, "lost_motion", 1))
+    monkeypatch.setitem(training.FAULT_PARAMS, "max_iter", 3)
+    try:
+        train(ds_dir, tmp_path / "m.skops", target="fault", cv=3, progress=False)
+    except SparseFeatureError as err:  # the boosted trees cannot bin a column without values
+        message = str(err)
+        assert "\n" not in message and message.startswith(f"{ds_dir}: cannot train: --cv 3")
+        assert "lost_motion finite in 1 of 16 training runs" in message
+        assert f"finite in ≥ {fit_minimum(table, cv=3, target='fault')} of the 16" in message
+    else:  # an estimator that copes with such a column in a fit trains instead
+        assert (tmp_path / "m.skops").exists()

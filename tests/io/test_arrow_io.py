@@ -118,5 +118,7 @@ def test_parquet_and_mcap_bytes(run, tmp_path):
     assert 0 < len(cut) < len(run)
     notes = [str(w.message) for w in caught if w.category is TruncatedRecordingWarning]
     assert len(notes) == 1 and notes[0].startswith("upload: the file ends at byte")
-    with pytest.raises(PRSMHealthError, match="unsupported format 'csv'"):
-        read_recording_bytes(data, "csv")
+    with pytest.raises(PRSMHealthError, match="unsupported format 'xlsx'"):
+        read_recording_bytes(data, "xlsx")
+    with pytest.raises(PRSMHealthError, match="^upload: not a readable CSV file"):
+        read_recording_bytes(data, "csv", "upload")  # MCAP bytes are no CSV

@@ -49,6 +49,31 @@ def test_independent_readers(tmp_path, run):
     assert float(meta[b"prsm_health.sample_rate"]) == run.sample_rate
 
 
+def test_units_where_every_reader_sees_them(tmp_path, run):
+    path = write_run_parquet(run, tmp_path / "run.parquet")
+    contract = {name: UNITS[name] for name in pd.read_parquet(path).columns}
+    # pandas: DataFrame.attrs, restored by read_parquet
+    attrs = pd.read_parquet(path).attrs
+    assert attrs["units"] == contract and attrs["sample_rate"] == run.sample_rate
+    # Arrow: the unit of each field, beside the contract's schema-level JSON
+    schema = pq.read_schema(path)
+    assert schema.field("nut_axial_accel").metadata[b"unit"] == b"m/s^2"
+    assert {f.name: f.metadata[b"unit"].decode() for f in schema} == contract
+    assert json.loads(schema.metadata[b"prsm_health.units"]) == contract
+    # polars and duckdb read the columns and the file's key-value metadata
+    polars = pytest.importorskip("polars")
+    assert polars.read_parquet(path).columns == list(contract)
+    kv = polars.read_parquet_metadata(path)
+    assert json.loads(kv["prsm_health.units"]) == contract
+    duckdb = pytest.importorskip("duckdb")
+    rows = duckdb.sql(
+        f"select value from parquet_kv_metadata('{path}') where key = 'prsm_health.units'"
+    ).fetchall()
+    assert json.loads(rows[0][0]) == contract
+    count = duckdb.sql(f"select count(*) from read_parquet('{path}')").fetchall()[0][0]
+    assert count == len(run)
+
+
 def test_simulated_truth_is_the_physics_without_sensor_errors(run):
     # The ideal profile adds no sensor error, so each reading equals the true value it reads:
     # the motor side for angle and torque. With the default drive train the linkage force

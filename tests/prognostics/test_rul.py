@@ -207,6 +207,18 @@ def test_form_selection_follows_the_generating_model(fleet_model):
     assert abs(phi - PHI0) < 0.05 * (THRESHOLD - PHI0), phi
 
 
+def test_similarity_aligns_on_the_linear_form_too():
+    # a model whose chosen form is linear aligns the history on its units' straight lines
+    # (regression: that branch once shadowed the curve function and raised UnboundLocalError)
+    histories, lives, _ = linear_fleet(seed=3)
+    model = PrognosticsModel().fit(histories, lives)
+    assert model.form_ == "linear"
+    unit = histories[histories["unit_id"] == 0].drop(columns="unit_id").iloc[:10]
+    p = model.predict(unit, method="similarity")
+    assert p.model["form"] == "linear" and p.model["nearest_unit"] == 0  # itself, in-sample
+    assert 0 <= p.rul_hours["lower"] <= p.rul_hours["estimate"] <= p.rul_hours["upper"]
+
+
 # --------------------------------------------------------------------------------------------
 # Analytic checks
 # --------------------------------------------------------------------------------------------

@@ -72,7 +72,7 @@ def test_scenario_simulate_equals_simulate():
 @pytest.mark.parametrize(
     "data, field",
     [
-        ({"heath": {}}, "scenario"),
+        ({"heath": {}}, "scenario.heath"),
         ({"health": {"clearence": 1e-6}}, "health.clearence"),
         ({"profile": {"speed": -1.0}}, "profile.speed"),
         ({"options": {"variation": {"pitch": 1e-6}}}, "options.variation.pitch"),

@@ -7,15 +7,17 @@
    complete (resumable), timed.
 2. Diagnoses every snapshot with the shipped diagnosis model (batched), as the histories a
    user's fleet would give (cached beside the dataset as ``<dataset>-diagnoses.parquet``).
-3. Fits :class:`prsm_health.prognostics.rul.PrognosticsModel` on the training units. Its failure
-   threshold is in the units of the health indicator, the *diagnosed* clearance: the diagnosed
-   clearance at failure, learnt from the training units (median over them of a straight-line
-   fit to their last diagnoses, evaluated at their failure age) — the recipe's limit is on the
-   true clearance, which the diagnosis reads with its own bias.
+3. Fits the model with :func:`prsm_health.prognostics.fit_prognostics_model` (what
+   ``prsm-health train FLEET --target rul`` runs) on the cached histories: a
+   :class:`~prsm_health.prognostics.PrognosticsModel` of the fleet's design (name and
+   fingerprint) fitted on the training units. Its failure threshold is in the units of the
+   health indicator, the *diagnosed* clearance: the diagnosed clearance at failure, learnt from
+   the training units (:func:`prsm_health.prognostics.diagnosed_threshold`) — the recipe's
+   limit is on the true clearance, which the diagnosis reads with its own bias.
 4. Scores both methods (degradation model, similarity baseline) on the held-out units, every
-   history prefix: RMSE, α–λ accuracy (α = 0.2) after half of life, 90 % interval coverage,
-   prognostic horizon (prsm_health.prognostics.metrics), with a sensitivity table by unit
-   life and failure mode.
+   history prefix (the same call): RMSE, α–λ accuracy (α = 0.2) after half of life, 90 %
+   interval coverage, prognostic horizon (prsm_health.prognostics.metrics), with a sensitivity
+   table by unit life and failure mode.
 5. Writes models/prognostics.json, models/PROGNOSTICS_CARD.md and models/figures/prognostics_*.png.
    ``--evaluate-only`` re-scores the shipped model without fitting.
 """
@@ -33,6 +35,7 @@ from prsm_health.datasets import Dataset, generate, load_recipe
 from prsm_health.prognostics import (
     DEFAULT_PROGNOSTICS_MODEL,
     PrognosticsModel,
+    fit_prognostics_model,
     fleet_histories,
     load_prognostics_model,
     save_prognostics_model,
@@ -49,20 +52,6 @@ ALPHA = 0.2
 #: dynamics): 60 units each, 40 to fit, 20 to score.
 USAGE_LEVELS = (0.0, 0.15, 0.3)
 NOISE_LEVELS = (0.0, 1e-6, 2e-6)  # m, 1σ of a diagnosis' error (the shipped one: ≈ 2 µm)
-#: Diagnoses of a unit's last share of life used to read the indicator at failure.
-LAST_SHARE = 0.25
-
-
-def diagnosed_threshold(train: pd.DataFrame) -> float:
-    """The diagnosed clearance at failure [m]: median over the training units of a straight
-    line through their diagnoses in the last LAST_SHARE of life, evaluated at failure."""
-    values = []
-    for _, unit in train.groupby("unit_id"):
-        failure = float(unit["failure_age_hours"].iloc[0])
-        late = unit[unit["age_hours"] >= (1 - LAST_SHARE) * failure]
-        slope, intercept = np.polyfit(late["age_hours"], late["clearance"], 1)
-        values.append(intercept + slope * failure)
-    return float(np.median(values))
 
 
 def main() -> None:
@@ -89,27 +78,23 @@ def main() -> None:
         histories = fleet_histories(dataset, progress=True)
         print(f"diagnosed {len(histories)} snapshots in {time.perf_counter() - t0:.1f} s")
         histories.to_parquet(cache)
-    failure = histories.groupby("unit_id")["failure_age_hours"].first().to_dict()
-    train = histories[histories["split"] == "train"]
-    test = histories[histories["split"] == "test"]
-
-    if args.evaluate_only:
-        model = load_prognostics_model(DEFAULT_PROGNOSTICS_MODEL)
-    else:
-        threshold = diagnosed_threshold(train)
-        print(
-            f"diagnosed clearance at failure {threshold * 1e6:.2f} µm "
-            f"(true limit {recipe.life_spec.failure_clearance * 1e6:g} µm)"
-        )
-        model = PrognosticsModel(threshold=threshold, design=recipe.design)
-        model.fit(train, {u: failure[u] for u in train["unit_id"].unique()})
-        save_prognostics_model(DEFAULT_PROGNOSTICS_MODEL, model)
-
     t0 = time.perf_counter()
-    predictions, summary = evaluate_units(
-        test, {u: failure[u] for u in test["unit_id"].unique()}, model, alpha=ALPHA
-    )
-    print(f"scored {len(predictions)} predictions in {time.perf_counter() - t0:.1f} s")
+    if args.evaluate_only:
+        # the shipped model re-scored as it is: no fit
+        model = load_prognostics_model(DEFAULT_PROGNOSTICS_MODEL)
+        test = histories[histories["split"] == "test"]
+        failure = test.groupby("unit_id")["failure_age_hours"].first().to_dict()
+        predictions, summary = evaluate_units(test, failure, model, alpha=ALPHA)
+    else:
+        model, fit = fit_prognostics_model(dataset, histories=histories, alpha=ALPHA)
+        print(
+            f"diagnosed clearance at failure {fit.threshold * 1e6:.2f} µm "
+            f"(true limit {fit.true_failure_clearance * 1e6:g} µm)"
+        )
+        save_prognostics_model(DEFAULT_PROGNOSTICS_MODEL, model)
+        predictions, summary = fit.predictions, fit.summary
+    done = "scored" if args.evaluate_only else "fitted and scored"
+    print(f"{done} {len(predictions)} predictions in {time.perf_counter() - t0:.1f} s")
     for method, s in summary.items():
         print(
             f"{method:12s} α–λ {s['alpha_lambda']:.3f}  coverage after half {s['coverage_after']:.3f}"

@@ -16,6 +16,8 @@ from prsm_health.io import read_recording
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
 from .output import print_json, print_table, scaled, share, um
+from .parser import DEFAULT_CV
+from .prognose import check_train_options, train_prognostics
 
 # What each fault macro-F1 counts (prsm_health.diagnostics.evaluation.fault_report and
 # training._class_metrics), so that the tables of train and evaluate cannot be misread.
@@ -26,9 +28,11 @@ F1_CLASSIFIER = "macro-F1 (the classifier alone: no cannot_tell)"
 
 # ----------------------------------------------------------------------------- train
 def train(args) -> int:
-    metrics = train_model(
-        args.dataset, args.out, target=args.target, cv=args.cv, progress=not args.json
-    )
+    check_train_options(args)
+    if args.target == "rul":
+        return train_prognostics(args)
+    cv = DEFAULT_CV if args.cv is None else args.cv
+    metrics = train_model(args.dataset, args.out, target=args.target, cv=cv, progress=not args.json)
     if args.json:
         print_json(metrics)
         return 0
@@ -54,7 +58,9 @@ def training_rows(metrics: dict) -> list:
             )
     for key, label in (("fault_cv", "fault CV"), ("fault_test", "fault held-out")):
         if metrics.get(key):
-            rows.append((f"{label} {F1_CLASSIFIER}", scaled(metrics[key].get("macro_f1")), ""))
+            rows.append(
+                (f"{label} {F1_CLASSIFIER}", scaled(metrics[key].get("macro_f1_classifier")), "")
+            )
     return rows
 
 
@@ -89,8 +95,8 @@ def evaluation_rows(report: dict) -> list:
     if "fault" in report:
         f = report["fault"]
         rows += [
-            (F1_CANNOT_TELL_MISS, scaled(f["macro_f1"]), ""),
-            (F1_NAMED, scaled(f["macro_f1_told"]), ""),
+            (F1_CANNOT_TELL_MISS, scaled(f["macro_f1_all"]), ""),
+            (F1_NAMED, scaled(f["macro_f1_named"]), ""),
             ("cannot_tell", share(f["cannot_tell_fraction"], "runs"), ""),
         ]
         rows += [(f"F1({k})", v, "") for k, v in f["f1_by_class"].items()]
@@ -102,7 +108,8 @@ def evaluation_rows(report: dict) -> list:
 # ----------------------------------------------------------------------------- diagnose
 def diagnose(args) -> int:
     bundle = load_bundle(args.model)
-    result = diagnose_recording(read_recording(args.file), bundle, window=args.window)
+    run = read_recording(args.file, column_map=args.map)
+    result = diagnose_recording(run, bundle, window=args.window)
     if args.plot:
         plot_diagnosis(result, args.plot)
     if args.json:

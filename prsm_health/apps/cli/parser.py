@@ -40,6 +40,12 @@ DEFAULT_PROFILE = "flight-ema"
 #: ``--live`` defaults and message budget (prsm_health.apps.live, which imports foxglove).
 LIVE_HOST, LIVE_PORT, LIVE_MESSAGE_BUDGET = "127.0.0.1", 8765, 20_000
 
+#: ``train --target``: the diagnosis models' targets (prsm_health.diagnostics.training), and
+#: ``rul``, a prognostics model of a fleet dataset.
+TRAIN_TARGETS = ("clearance", "fault", "both", "rul")
+#: ``train --cv`` when not given.
+DEFAULT_CV = 5
+
 DESIGN_HELP = "preset name (paper01…paper05) or design TOML file"
 PROFILE_HELP = (
     "instrumentation profile: a built-in name (prsm-health instrumentation list) or a TOML file"
@@ -414,18 +420,47 @@ def _add_data(command) -> None:
 
 # ----------------------------------------------------------------------------- models
 def _add_models(command) -> None:
-    t = command("train", "train the clearance estimator and fault classifier on a dataset")
+    t = command(
+        "train",
+        "train the clearance estimator and fault classifier on a dataset, or a prognostics "
+        "model on a fleet dataset (--target rul)",
+    )
     t.add_argument("dataset", help="dataset directory or URL (prsm-health generate)")
     t.add_argument(
-        "--out", required=True, help="model file, must end in .skops; metrics JSON beside it"
+        "--out",
+        required=True,
+        help="model file: .skops (metrics JSON beside it), or .json for --target rul",
     )
     t.add_argument(
         "--target",
-        choices=("clearance", "fault", "both"),
+        choices=TRAIN_TARGETS,
         default="both",
-        help="what to train: the clearance estimator, the fault classifier or both",
+        help="what to train: the clearance estimator, the fault classifier, both, or the "
+        "remaining-useful-life model of a fleet dataset (a [life] recipe's)",
     )
-    t.add_argument("--cv", type=int, default=5, help="cross-validation folds on the train split")
+    t.add_argument(
+        "--cv",
+        type=int,
+        default=None,
+        default_text=str(DEFAULT_CV),
+        help="cross-validation folds on the train split (not with --target rul)",
+    )
+    t.add_argument(
+        "--model",
+        default=None,
+        metavar="BUNDLE",
+        default_text=SHIPPED_MODEL,
+        help="--target rul: the diagnosis model (.skops) that reads the fleet's snapshots into "
+        "histories; it must be of the fleet's design",
+    )
+    t.add_argument(
+        "--threshold",
+        type=finite_float,
+        default=None,
+        metavar="M",
+        default_text="learnt from the training units",
+        help="--target rul: failure threshold on the diagnosed clearance [m]",
+    )
     _add_json(t, "the metrics")
     t.set_defaults(handler="models:train")
 
@@ -447,10 +482,16 @@ def _add_models(command) -> None:
     _add_json(e, "the metrics")
     e.set_defaults(handler="models:evaluate")
 
-    # room for options that say how to read the file (a column map for lab CSV files) next to
-    # the file itself
     d = command("diagnose", "diagnose a recording: clearance with interval, fault class")
     d.add_argument("file", help="recording: .mcap, .parquet (one run) or .csv (docs/formats.md)")
+    d.add_argument(
+        "--map",
+        default=None,
+        metavar="MAP.toml",
+        default_text="contract column names",
+        help="column map of a rig's CSV or Parquet file: columns, units, sample rate, design "
+        "(docs/import.md; the same map import reads)",
+    )
     d.add_argument("--model", default=None, default_text=SHIPPED_MODEL, help="model bundle")
     d.add_argument(
         "--window",

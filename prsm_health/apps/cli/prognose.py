@@ -1,5 +1,5 @@
 """``prsm-health prognose``: a history file, or a fleet dataset's unit → remaining useful
-life."""
+life; ``prsm-health train --target rul``: a prognostics model fitted on a fleet dataset."""
 
 from __future__ import annotations
 
@@ -9,15 +9,17 @@ from pathlib import Path
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import load_bundle
 from prsm_health.prognostics import (
+    fit_prognostics_model,
     fleet_histories,
     load_prognostics_model,
     read_history,
+    save_prognostics_model,
 )
 from prsm_health.prognostics import (
     prognose as prognose_history,
 )
 
-from .output import hours, print_json, print_table, um
+from .output import hours, print_json, print_table, scaled, share, um
 
 #: The options that only a fleet dataset takes.
 FLEET_OPTIONS = (
@@ -95,4 +97,84 @@ def _prognosis_rows(args, prognosis, history, true_rul) -> list:
         ("model", f"{m['design']}, {m['units_trained']} training units, v{m['version']}", ""),
     ]
     rows += [("warning", text, "") for text in prognosis.warnings]
+    return rows
+
+
+# ----------------------------------------------------------------------------- train --target rul
+#: The options of ``train`` that only ``--target rul`` takes, and those it does not.
+RUL_OPTIONS = (("--model", "model"), ("--threshold", "threshold"))
+DIAGNOSIS_OPTIONS = (("--cv", "cv"),)
+
+
+def check_train_options(args) -> None:
+    """Options of ``train`` given with a target they do not apply to: one sentence."""
+    rul = args.target == "rul"
+    for option, name in DIAGNOSIS_OPTIONS if rul else RUL_OPTIONS:
+        if getattr(args, name) is not None:
+            applies = "clearance, fault or both" if rul else "rul"
+            raise PRSMHealthError(
+                f"{option} applies to --target {applies}, not to --target {args.target}"
+            )
+
+
+def train_prognostics(args) -> int:
+    """``train FLEET --target rul``: fit, save, print the report (a table, or ``--json``)."""
+    if Path(args.out).suffix != ".json":
+        raise PRSMHealthError(f"--out {args.out}: a prognostics model is a .json file")
+    if args.threshold is not None and args.threshold <= 0:
+        raise PRSMHealthError(f"--threshold {args.threshold:g} must be a clearance > 0 [m]")
+    bundle = None if args.model is None else load_bundle(args.model)
+    model, report = fit_prognostics_model(
+        args.dataset,
+        bundle=bundle,
+        threshold=args.threshold,
+        progress=not args.json and sys.stderr.isatty(),  # a person is watching
+    )
+    out = save_prognostics_model(args.out, model)
+    result = {"model": str(out), **report.as_dict()}
+    if args.json:
+        print_json(result)
+        return 0
+    print_table(fit_rows(result))
+    return 0
+
+
+def fit_rows(report: dict) -> list:
+    """The table of ``train --target rul``: the model file, its design, the data, the
+    threshold and each method's held-out score."""
+    fingerprint = report["design_fingerprint"]
+    rows = [
+        ("model", report["model"], ""),
+        ("design", report["design"] + (f" ({fingerprint})" if fingerprint else ""), ""),
+        (
+            "units",
+            f"{len(report['train_units'])} training, {len(report['test_units'])} held out",
+            f"({report['snapshots']} snapshots)",
+        ),
+        (
+            "failure threshold",
+            um(report["threshold"]).strip(),
+            "µm diagnosed clearance"
+            + (", learnt from the training units" if report["threshold_learnt"] else ", given"),
+        ),
+    ]
+    if report["true_failure_clearance"] is not None:
+        rows.append(
+            ("true failure clearance", um(report["true_failure_clearance"]).strip(), "µm (recipe)")
+        )
+    for method, metrics in report["summary"].items():
+        # a metric with nothing to count (no prediction late in life) is NaN: shown as "–"
+        m = {k: None if v is None or v != v else v for k, v in metrics.items()}
+        rows += [
+            (f"{method} held-out RMSE", scaled(m.get("rmse")), "h"),
+            (
+                f"{method} α–λ accuracy",
+                share(m.get("alpha_lambda"), "predictions"),
+                "(in the second half of life)",
+            ),
+            (f"{method} 90 % interval coverage", share(m.get("coverage"), "predictions"), ""),
+            (f"{method} prognostic horizon", scaled(m.get("prognostic_horizon")), "h"),
+        ]
+    if not report["summary"]:
+        rows.append(("held-out score", "–", "no held-out units"))
     return rows

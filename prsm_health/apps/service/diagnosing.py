@@ -1,8 +1,11 @@
 """The work done in worker threads or diagnosis processes: a request body (JSON, or a binary
-recording decoded by :mod:`prsm_health.io`) or an upload → a :class:`~prsm_health.core.run.Run` →
-the library's diagnosis → the encoded answer and its history rows (:class:`Answer`). The
-service's calls into :mod:`prsm_health.diagnostics.diagnosis` and :mod:`prsm_health.io` are here; recording
-checks are :meth:`Run.validate <prsm_health.core.run.Run.validate>`'s.
+recording decoded by :mod:`prsm_health.io`) or an upload (with its column map) → a
+:class:`~prsm_health.core.run.Run` → the library's diagnosis → the encoded answer and its
+history rows (:class:`Answer`). The service's calls into :mod:`prsm_health.diagnostics.diagnosis`
+and :mod:`prsm_health.io` are here; recordings are read by the library's one reader
+(:func:`prsm_health.io.read_with_warnings`: the reader ``diagnose`` and ``import`` use), recording
+checks are :meth:`Run.validate <prsm_health.core.run.Run.validate>`'s, and each request cuts
+its recording into windows once (:func:`~prsm_health.diagnostics.diagnosis.split_windows`).
 
 Everything that crosses to and from a diagnosis process is plain data: the request body as
 bytes (decoded in the process: cheaper to send than decoded arrays), and back the answer's
@@ -13,38 +16,33 @@ diagnosis).
 from __future__ import annotations
 
 import logging
-import math
-import re
-import threading
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from prsm_health.actuator.design import PRESETS
 from prsm_health.core.channels import CHANNEL_NAMES
-from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
+from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import json_ready
 from prsm_health.core.run import MIN_SAMPLES, Run
 from prsm_health.diagnostics.diagnosis import diagnose, split_windows
-from prsm_health.io import read_recording, read_recording_bytes
+from prsm_health.io import read_with_warnings
+from prsm_health.io.column_map import column_map_from_text
+from prsm_health.io.derived import derive_channels
 from prsm_health.signals.envelope_analysis import window_spectra
 
 from .history import history_rows, spectra_row, utc_now
-from .limits import MAX_ABS_VALUE, MAX_OPERATING_HOURS, MAX_TIME, ServiceLimits
+from .limits import MAX_ABS_VALUE, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
-from .schemas import ASSET_ID_PATTERN, DiagnoseRequest, parse_diagnose_request
+from .schemas import DiagnoseRequest, parse_diagnose_request
 from .uploads import ReceivedUpload, precheck_recording, precheck_upload
 
 log = logging.getLogger("prsm_health.apps.service")
 
-# warnings.catch_warnings changes process-wide state: one upload is read under it at a time.
-_warnings_lock = threading.Lock()
 
-
-def diagnosis_json(run: Run, bundle) -> dict:
-    """The library's diagnosis of ``run`` as a JSON-ready dict (with ``windows``)."""
-    return json_ready(diagnose(run, bundle).to_json())
+def diagnosis_json(run: Run, bundle, windows: tuple | None = None) -> dict:
+    """The library's diagnosis of ``run`` as a JSON-ready dict (with ``windows``);
+    ``windows``: ``run`` already cut by :func:`split_windows` with the model's window."""
+    return json_ready(diagnose(run, bundle, windows=windows).to_json())
 
 
 def check_run(run: Run, limits: ServiceLimits, *, max_samples: int, what: str = "") -> None:
@@ -94,16 +92,16 @@ class Answer:
 
 
 def last_window_spectra(
-    run: Run, bundle, asset_id: str, windows: list[dict], **row
+    last: Run, bundle, asset_id: str, windows: list[dict], **row
 ) -> tuple | None:
-    """The spectra row of the recording's last window (:func:`split_windows` with the model's
-    window, as the diagnosis cut it): :func:`prsm_health.signals.envelope_analysis.window_spectra` of
-    its nut axial acceleration at its mean screw speed, with the model's design. None when the
-    recording has no nut axial acceleration. ``windows``: the diagnosis' window entries (the
-    last one's index and span are stored); ``row``: :func:`spectra_row`'s keywords."""
-    if SPECTRA_CHANNEL not in run.channels:
+    """The spectra row of the recording's last window ``last`` (the one the diagnosis was
+    given: :func:`split_windows` with the model's window):
+    :func:`prsm_health.signals.envelope_analysis.window_spectra` of its nut axial acceleration
+    at its mean screw speed, with the model's design. None when the recording has no nut axial
+    acceleration. ``windows``: the diagnosis' window entries (the last one's index and span
+    are stored); ``row``: :func:`spectra_row`'s keywords."""
+    if SPECTRA_CHANNEL not in last.channels:
         return None
-    last = split_windows(run, bundle.window)[0][-1]
     speed = last.channels.get("screw_speed")
     try:
         spectra = window_spectra(
@@ -128,47 +126,6 @@ class BodyParams:
     load: float | None = None
     design: str | None = None
     operating_hours: float | None = None
-
-    FIELDS = ("asset_id", "speed", "load", "design", "operating_hours")
-
-    @classmethod
-    def from_query(cls, items: list[tuple[str, str]]) -> BodyParams:
-        """Parsed and checked query parameters; 422 naming the parameter otherwise."""
-        values: dict = {}
-        for name, text in items:
-            if name not in cls.FIELDS:
-                raise HTTPError(
-                    422,
-                    f"unknown query parameter {name!r}; a binary body takes "
-                    f"{', '.join(cls.FIELDS)}",
-                )
-            if name in values:
-                raise HTTPError(422, f"query parameter {name!r} given twice")
-            if name in ("speed", "load", "operating_hours"):
-                try:
-                    number = float(text)
-                except ValueError:
-                    number = math.nan
-                if not math.isfinite(number):
-                    raise HTTPError(422, f"{name} = {text[:40]!r}: a finite number expected")
-                if name == "operating_hours" and not 0 <= number <= MAX_OPERATING_HOURS:
-                    raise HTTPError(
-                        422,
-                        f"operating_hours = {text[:40]!r}: hours in [0, {MAX_OPERATING_HOURS:g}] "
-                        "expected",
-                    )
-                values[name] = number
-            elif name == "asset_id":
-                if not re.fullmatch(ASSET_ID_PATTERN, text):
-                    raise HTTPError(422, f"asset_id {text[:140]!r} must match {ASSET_ID_PATTERN}")
-                values[name] = text
-            else:
-                if text not in PRESETS:
-                    raise HTTPError(
-                        422, f"design = {text[:40]!r}: one of {', '.join(sorted(PRESETS))}"
-                    )
-                values[name] = text
-        return cls(**values)
 
 
 def check_design(design: str | None, bundle) -> None:
@@ -205,7 +162,10 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
         labels["screw_speed"] = float(req.speed)
     if req.load is not None:
         labels["axial_load"] = float(req.load)
-    return Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
+    # the channels a file reader derives (screw speed from the angle), derived here too
+    return derive_channels(
+        Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
+    )[0]
 
 
 def _too_long(n: int, rate: float, limits: ServiceLimits) -> HTTPError:
@@ -218,9 +178,10 @@ def _too_long(n: int, rate: float, limits: ServiceLimits) -> HTTPError:
 
 
 def read_body(body: bytes, fmt: str, limits: ServiceLimits) -> tuple[Run, list[str]]:
-    """A binary body of ``POST /v1/diagnose`` (``fmt``: ``arrow``, ``parquet``, ``mcap``) as
-    a measured recording, and the reader's notes. What the body declares (rows, decompressed
-    size) is checked against the limits before it is decoded."""
+    """A binary body of ``POST /v1/diagnose`` (``fmt``: ``arrow``, ``parquet``, ``mcap``,
+    ``csv`` with contract column names) as a measured recording, and the reader's notes. What
+    the body declares (rows, decompressed size) is checked against the limits before it is
+    decoded."""
     name = f"{fmt} body"
     if not body:
         raise HTTPError(400, f"empty request body: send the recording ({fmt})")
@@ -236,19 +197,27 @@ def read_body(body: bytes, fmt: str, limits: ServiceLimits) -> tuple[Run, list[s
         decoded_hint=" (max_body_decoded_bytes)",
         name=name,
     )
-    with _warnings_lock, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", TruncatedRecordingWarning)
-        try:
-            run = read_recording_bytes(body, fmt, name)
-        except PRSMHealthError as exc:
-            raise HTTPError(422, str(exc)) from None
-        except (ValueError, TypeError, OverflowError, KeyError, IndexError) as exc:
-            log.warning("unreadable %s", name, exc_info=True)
-            raise HTTPError(
-                422, f"{name}: not a readable recording ({type(exc).__name__}: {exc})"
-            ) from None
-    notes = [str(w.message) for w in caught if issubclass(w.category, TruncatedRecordingWarning)]
-    return run.without_truth(), notes
+    return read_measured(body, fmt=fmt, name=name)
+
+
+def read_measured(source, *, fmt: str, name: str, column_map=None) -> tuple[Run, list[str]]:
+    """A recording (a file or bytes) through the library's reader: the measured run (a
+    simulated file's truth is neither checked nor used) and the reader's notes. Anything the
+    reader refuses is the client's: 422, naming the recording as the client did."""
+    try:
+        recording = read_with_warnings(source, fmt=fmt, name=name, column_map=column_map)
+    except PRSMHealthError as exc:
+        raise HTTPError(422, str(exc)) from None
+    except (ValueError, TypeError, OverflowError, KeyError, IndexError) as exc:
+        # Decoding client bytes: the readers let a few of these through for damaged files;
+        # the file is at fault, not the server (no server path in the message: the reader
+        # was given the client's name).
+        log.warning("unreadable recording %r", name, exc_info=True)
+        text = str(exc).replace(str(source), name) if not isinstance(source, bytes) else str(exc)
+        raise HTTPError(
+            422, f"{name}: not a readable recording ({type(exc).__name__}: {text})"
+        ) from None
+    return recording.run.without_truth(), list(recording.warnings)
 
 
 def diagnose_body(
@@ -284,7 +253,8 @@ def diagnose_body(
     if len(run) > max_samples:
         raise _too_long(len(run), run.sample_rate, limits)
     check_run(run, limits, max_samples=max(max_samples, MIN_SAMPLES), what=_what(fmt))
-    result = diagnosis_json(run, bundle)
+    cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
+    result = diagnosis_json(run, bundle, cut)
     windows = result.get("windows", [])
     if len(windows) <= 1:
         result.pop("windows", None)
@@ -302,7 +272,7 @@ def diagnose_body(
             operating_hours=params.operating_hours,
         )
         spectra = last_window_spectra(
-            run,
+            cut[0][-1],
             bundle,
             params.asset_id,
             windows,
@@ -319,37 +289,24 @@ def _what(fmt: str) -> str:
 
 # ----------------------------------------------------------------------------- upload
 def read_upload(upload: ReceivedUpload, limits: ServiceLimits) -> tuple[Run, list[str]]:
-    """The uploaded recording and the reader's notes (truncated recording); messages name the
-    client's file name, never the server path."""
-
-    def hide_path(text: str) -> str:
-        return text.replace(str(upload.path), upload.filename or "upload")
-
+    """The uploaded recording, read through its column map when one came with it, and the
+    reader's notes (truncated recording); messages name the client's file names, never the
+    server path."""
     if upload.path is None or upload.file_bytes == 0:
         raise HTTPError(422, "no recording: send the file in the multipart field 'file'")
-    precheck_upload(upload.path, upload.suffix, limits)
-    with _warnings_lock, warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", TruncatedRecordingWarning)
+    column_map = None
+    if upload.column_map is not None:
         try:
-            run = read_recording(upload.path)
+            column_map = column_map_from_text(upload.column_map, upload.map_name or "map")
         except PRSMHealthError as exc:
-            raise HTTPError(422, hide_path(str(exc))) from None
-        except (ValueError, TypeError, OverflowError, KeyError, IndexError) as exc:
-            # Decoding client bytes: the readers let a few of these through for files
-            # with non-numeric channel columns; the file is at fault, not the server.
-            log.warning("unreadable upload %r", upload.filename, exc_info=True)
-            raise HTTPError(
-                422,
-                f"{upload.filename}: not a readable recording "
-                f"({type(exc).__name__}: {hide_path(str(exc))})",
-            ) from None
-    notes = [
-        hide_path(str(w.message))
-        for w in caught
-        if issubclass(w.category, TruncatedRecordingWarning)
-    ]
-    # The service diagnoses measurements: a simulated file's truth is neither checked nor used.
-    return run.without_truth(), notes
+            raise HTTPError(422, str(exc)) from None
+    precheck_upload(upload.path, upload.suffix, limits)
+    return read_measured(
+        upload.path,
+        fmt=upload.suffix.lstrip("."),
+        name=upload.filename or "upload",
+        column_map=column_map,
+    )
 
 
 def diagnose_upload(
@@ -363,7 +320,8 @@ def diagnose_upload(
     was read and the reader's notes; with an ``asset_id``, the windows' history rows."""
     run, notes = read_upload(upload, limits)
     check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
-    result = diagnosis_json(run, bundle)
+    cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
+    result = diagnosis_json(run, bundle, cut)
     per_window = result.pop("windows")
     recording = {
         "filename": upload.filename,
@@ -384,7 +342,7 @@ def diagnose_upload(
             filename=upload.filename,
         )
         spectra = last_window_spectra(
-            run,
+            cut[0][-1],
             bundle,
             asset_id,
             per_window,

@@ -10,8 +10,10 @@ import json
 import os
 import sqlite3
 import threading
+from collections.abc import Mapping
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import NamedTuple
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps, json_ready
@@ -68,6 +70,75 @@ CREATE TABLE IF NOT EXISTS spectra (
 #: database gets the column on open, its existing rows NULL); version 3 added the ``spectra``
 #: table (created on open: ``CREATE TABLE IF NOT EXISTS`` above).
 _SCHEMA_VERSION = 3
+
+
+class DiagnosisRow(NamedTuple):
+    """One row of the ``diagnoses`` table (every column but ``id``), named after its columns:
+    plain numbers and text, JSON already encoded (:func:`history_rows`)."""
+
+    asset_id: str
+    received_at: str
+    source: str
+    filename: str | None
+    window_index: int | None
+    window_start: float | None
+    window_end: float | None
+    speed: float | None
+    load: float | None
+    operating_hours: float | None
+    clearance_estimate: float | None
+    clearance_lower: float | None
+    clearance_upper: float | None
+    fault_class: str | None
+    class_probabilities: str
+    model_name: str
+    model_version: str
+    diagnosis: str
+
+
+class SpectraRow(NamedTuple):
+    """One row of the ``spectra`` table, named after its columns (:func:`spectra_row`)."""
+
+    asset_id: str
+    received_at: str
+    source: str
+    filename: str | None
+    window_index: int | None
+    window_start: float | None
+    window_end: float | None
+    operating_hours: float | None
+    channel: str
+    spectra: str
+
+
+class OperatingRow(NamedTuple):
+    """A stored diagnosis with operating hours, as a prognosis reads it
+    (:meth:`HistoryStore.operating_history`); ``design`` is the diagnosing model's."""
+
+    operating_hours: float
+    clearance_estimate: float | None
+    clearance_lower: float | None
+    clearance_upper: float | None
+    fault_class: str | None
+    design: str | None
+
+
+def _insert(verb: str, table: str, row_type: type[NamedTuple]) -> str:
+    """The ``INSERT`` statement of a row type, its values bound by column name."""
+    columns = row_type._fields
+    return (
+        f"{verb} INTO {table} ({', '.join(columns)}) VALUES ({', '.join(':' + c for c in columns)})"
+    )
+
+
+_INSERT_DIAGNOSIS = _insert("INSERT", "diagnoses", DiagnosisRow)
+_INSERT_SPECTRA = _insert("INSERT OR REPLACE", "spectra", SpectraRow)
+
+
+def _named(cursor: sqlite3.Cursor) -> list[dict]:
+    """A query's rows as dicts by column name (``AS`` names for expressions)."""
+    names = [d[0] for d in cursor.description]
+    return [dict(zip(names, row)) for row in cursor.fetchall()]
 
 
 def utc_now() -> str:
@@ -196,28 +267,17 @@ class HistoryStore:
             )
         )
 
-    def add_rows(self, rows: list[tuple], spectra: tuple | None = None) -> list[int]:
+    def add_rows(self, rows: list[DiagnosisRow], spectra: SpectraRow | None = None) -> list[int]:
         """Store rows made by :func:`history_rows` (possibly in another process) and, when
         given, the asset's latest spectra (a :func:`spectra_row`, replacing the asset's
-        previous one) in one transaction; returns the rows' ids."""
+        previous one) in one transaction; returns the rows' ids. Plain tuples in column
+        order are taken too."""
         ids = []
         with self._lock, self._transaction():
             if spectra is not None:
-                self._conn.execute(
-                    "INSERT OR REPLACE INTO spectra (asset_id, received_at, source, filename,"
-                    " window_index, window_start, window_end, operating_hours, channel, spectra)"
-                    " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    spectra,
-                )
+                self._conn.execute(_INSERT_SPECTRA, SpectraRow._make(spectra)._asdict())
             for row in rows:
-                cur = self._conn.execute(
-                    "INSERT INTO diagnoses (asset_id, received_at, source, filename, window_index,"
-                    " window_start, window_end, speed, load, operating_hours, clearance_estimate,"
-                    " clearance_lower, clearance_upper, fault_class, class_probabilities,"
-                    " model_name, model_version, diagnosis)"
-                    " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                    row,
-                )
+                cur = self._conn.execute(_INSERT_DIAGNOSIS, DiagnosisRow._make(row)._asdict())
                 ids.append(cur.lastrowid)
         return ids
 
@@ -232,26 +292,25 @@ class HistoryStore:
             total = self._conn.execute(
                 f"SELECT COUNT(*) FROM diagnoses WHERE {where}", args
             ).fetchone()[0]
-            rows = self._conn.execute(
-                "SELECT id, received_at, source, filename, window_index, window_start, window_end,"
-                f" speed, load, operating_hours, diagnosis FROM diagnoses WHERE {where}"
-                " ORDER BY received_at DESC, id DESC LIMIT ?",
-                [*args, int(limit)],
-            ).fetchall()
-        entries = []
-        for row in reversed(rows):
-            id_, received_at, source, filename, w_index, w_start, w_end, speed, load = row[:9]
-            hours, blob = row[9:]
-            entries.append(
-                {
-                    "id": id_,
-                    **_provenance(received_at, source, filename, w_index, w_start, w_end),
-                    "speed": speed,
-                    "load": load,
-                    "operating_hours": hours,
-                    "diagnosis": json.loads(blob),
-                }
+            rows = _named(
+                self._conn.execute(
+                    "SELECT id, received_at, source, filename, window_index, window_start,"
+                    " window_end, speed, load, operating_hours, diagnosis FROM diagnoses"
+                    f" WHERE {where} ORDER BY received_at DESC, id DESC LIMIT ?",
+                    [*args, int(limit)],
+                )
             )
+        entries = [
+            {
+                "id": row["id"],
+                **_provenance(row),
+                "speed": row["speed"],
+                "load": row["load"],
+                "operating_hours": row["operating_hours"],
+                "diagnosis": json.loads(row["diagnosis"]),
+            }
+            for row in reversed(rows)
+        ]
         return {
             "asset_id": asset_id,
             "count": len(entries),
@@ -260,37 +319,38 @@ class HistoryStore:
             "diagnoses": entries,
         }
 
-    def operating_history(self, asset_id: str) -> list[tuple]:
+    def operating_history(self, asset_id: str) -> list[OperatingRow]:
         """The asset's diagnoses stored with operating hours, by operating hours, then by
-        receive time and id (the latest received last): rows ``(operating_hours,
-        clearance_estimate, clearance_lower, clearance_upper, fault_class, design)``, the
-        design being the diagnosing model's (``model.design`` of the stored diagnosis)."""
+        receive time and id (the latest received last), the design being the diagnosing
+        model's (``model.design`` of the stored diagnosis)."""
         with self._lock:
-            return self._conn.execute(
-                "SELECT operating_hours, clearance_estimate, clearance_lower, clearance_upper,"
-                " fault_class, json_extract(diagnosis, '$.model.design') FROM diagnoses"
-                " WHERE asset_id = ? AND operating_hours IS NOT NULL"
-                " ORDER BY operating_hours, received_at, id",
-                (asset_id,),
-            ).fetchall()
+            rows = _named(
+                self._conn.execute(
+                    "SELECT operating_hours, clearance_estimate, clearance_lower,"
+                    " clearance_upper, fault_class,"
+                    " json_extract(diagnosis, '$.model.design') AS design FROM diagnoses"
+                    " WHERE asset_id = ? AND operating_hours IS NOT NULL"
+                    " ORDER BY operating_hours, received_at, id",
+                    (asset_id,),
+                )
+            )
+        return [OperatingRow(**row) for row in rows]
 
     def spectra(self, asset_id: str) -> dict | None:
         """The asset's latest stored spectra (:func:`spectra_row`), or None."""
         with self._lock:
-            row = self._conn.execute(
-                "SELECT received_at, source, filename, window_index, window_start, window_end,"
-                " operating_hours, channel, spectra FROM spectra WHERE asset_id = ?",
-                (asset_id,),
-            ).fetchone()
-        if row is None:
+            rows = _named(
+                self._conn.execute("SELECT * FROM spectra WHERE asset_id = ?", (asset_id,))
+            )
+        if not rows:
             return None
-        received_at, source, filename, w_index, w_start, w_end, hours, channel, blob = row
+        row = rows[0]
         return {
             "asset_id": asset_id,
-            **_provenance(received_at, source, filename, w_index, w_start, w_end),
-            "operating_hours": hours,
-            "channel": channel,
-            **json.loads(blob),
+            **_provenance(row),
+            "operating_hours": row["operating_hours"],
+            "channel": row["channel"],
+            **json.loads(row["spectra"]),
         }
 
     def assets(self, *, limit: int = 100) -> dict:
@@ -331,14 +391,17 @@ class HistoryStore:
 
     def _summary(self, asset_id: str, count: int, first: str, last: str) -> dict:
         # under self._lock
-        latest = self._conn.execute(
-            "SELECT received_at, source, filename, window_index, window_start, window_end,"
-            " operating_hours, clearance_estimate, clearance_lower, clearance_upper, fault_class,"
-            " class_probabilities, json_extract(diagnosis, '$.warnings'),"
-            " json_extract(diagnosis, '$.model') FROM diagnoses WHERE asset_id = ?"
-            " ORDER BY received_at DESC, id DESC LIMIT 1",
-            (asset_id,),
-        ).fetchone()
+        (latest,) = _named(
+            self._conn.execute(
+                "SELECT received_at, source, filename, window_index, window_start, window_end,"
+                " operating_hours, clearance_estimate, clearance_lower, clearance_upper,"
+                " fault_class, class_probabilities,"
+                " json_extract(diagnosis, '$.warnings') AS warnings,"
+                " json_extract(diagnosis, '$.model') AS model FROM diagnoses WHERE asset_id = ?"
+                " ORDER BY received_at DESC, id DESC LIMIT 1",
+                (asset_id,),
+            )
+        )
         with_hours, max_hours = self._conn.execute(
             "SELECT COUNT(operating_hours), MAX(operating_hours) FROM diagnoses WHERE asset_id = ?",
             (asset_id,),
@@ -346,8 +409,7 @@ class HistoryStore:
         spectra = self._conn.execute(
             "SELECT received_at FROM spectra WHERE asset_id = ?", (asset_id,)
         ).fetchone()
-        received_at, source, filename, w_index, w_start, w_end, hours = latest[:7]
-        estimate, lower, upper, fault_class, probabilities, warnings, model = latest[7:]
+        warnings, model = latest["warnings"], latest["model"]
         return {
             "asset_id": asset_id,
             "diagnoses": count,
@@ -356,16 +418,15 @@ class HistoryStore:
             "first_received_at": first,
             "last_received_at": last,
             "latest": {
-                "received_at": received_at,
-                "source": source,
-                "filename": filename,
-                "window": None
-                if w_index is None
-                else {"index": w_index, "start": w_start, "end": w_end},
-                "operating_hours": hours,
-                "clearance": {"estimate": estimate, "lower": lower, "upper": upper},
-                "fault_class": fault_class,
-                "class_probabilities": json.loads(probabilities),
+                **_provenance(latest),
+                "operating_hours": latest["operating_hours"],
+                "clearance": {
+                    "estimate": latest["clearance_estimate"],
+                    "lower": latest["clearance_lower"],
+                    "upper": latest["clearance_upper"],
+                },
+                "fault_class": latest["fault_class"],
+                "class_probabilities": json.loads(latest["class_probabilities"]),
                 "warnings": json.loads(warnings) if warnings else [],
                 "model": json.loads(model) if model else None,
             },
@@ -384,13 +445,16 @@ class HistoryStore:
             self._conn.close()
 
 
-def _provenance(received_at, source, filename, w_index, w_start, w_end) -> dict:
-    """Where a stored row came from: when, which body kind and file, which window."""
+def _provenance(row: Mapping) -> dict:
+    """Where a stored row (by column name) came from: when, which body kind and file, which
+    window."""
     return {
-        "received_at": received_at,
-        "source": source,
-        "filename": filename,
-        "window": None if w_index is None else {"index": w_index, "start": w_start, "end": w_end},
+        "received_at": row["received_at"],
+        "source": row["source"],
+        "filename": row["filename"],
+        "window": None
+        if row["window_index"] is None
+        else {"index": row["window_index"], "start": row["window_start"], "end": row["window_end"]},
     }
 
 
@@ -404,10 +468,10 @@ def history_rows(
     speed: float | None = None,
     load: float | None = None,
     operating_hours: float | None = None,
-) -> list[tuple]:
+) -> list[DiagnosisRow]:
     """The database rows of diagnoses (contract dicts; a ``window`` key places one in its
-    recording): plain tuples of numbers and text, JSON already encoded, for
-    :meth:`HistoryStore.add_rows`. The service builds them where the diagnosis ran."""
+    recording) for :meth:`HistoryStore.add_rows`. The service builds them where the diagnosis
+    ran."""
     received_at = received_at or utc_now()
     rows = []
     for d in diagnoses:
@@ -415,25 +479,25 @@ def history_rows(
         w = d.get("window") or {}
         model = d.get("model") or {}
         rows.append(
-            (
-                asset_id,
-                received_at,
-                source,
-                filename,
-                w.get("index"),
-                w.get("start"),
-                w.get("end"),
-                speed,
-                load,
-                operating_hours,
-                c.get("estimate"),
-                c.get("lower"),
-                c.get("upper"),
-                d.get("fault_class"),
-                dumps(d.get("class_probabilities", {})),
-                str(model.get("name", "")),
-                str(model.get("version", "")),
-                dumps(d),
+            DiagnosisRow(
+                asset_id=asset_id,
+                received_at=received_at,
+                source=source,
+                filename=filename,
+                window_index=w.get("index"),
+                window_start=w.get("start"),
+                window_end=w.get("end"),
+                speed=speed,
+                load=load,
+                operating_hours=operating_hours,
+                clearance_estimate=c.get("estimate"),
+                clearance_lower=c.get("lower"),
+                clearance_upper=c.get("upper"),
+                fault_class=d.get("fault_class"),
+                class_probabilities=dumps(d.get("class_probabilities", {})),
+                model_name=str(model.get("name", "")),
+                model_version=str(model.get("version", "")),
+                diagnosis=dumps(d),
             )
         )
     return rows
@@ -449,7 +513,7 @@ def spectra_row(
     window: dict | None = None,
     operating_hours: float | None = None,
     channel: str = "nut_axial_accel",
-) -> tuple:
+) -> SpectraRow:
     """The ``spectra`` row of an asset's latest window (``spectra``:
     :func:`prsm_health.signals.envelope_analysis.window_spectra`, JSON encoded here) for
     :meth:`HistoryStore.add_rows`."""
@@ -465,21 +529,21 @@ def spectra_row(
         )
     except (ValueError, TypeError):  # a non-finite or non-plain value among them after all
         text = dumps(spectra, compact=True)
-    return (
-        asset_id,
-        received_at,
-        source,
-        filename,
-        w.get("index"),
-        w.get("start"),
-        w.get("end"),
-        operating_hours,
-        channel,
-        text,
+    return SpectraRow(
+        asset_id=asset_id,
+        received_at=received_at,
+        source=source,
+        filename=filename,
+        window_index=w.get("index"),
+        window_start=w.get("start"),
+        window_end=w.get("end"),
+        operating_hours=operating_hours,
+        channel=channel,
+        spectra=text,
     )
 
 
-def prognosis_history(rows: list[tuple]):
+def prognosis_history(rows: list[OperatingRow]):
     """The history table a prognosis is made from
     (:func:`prsm_health.prognostics.rul.prognose`), from :meth:`HistoryStore.operating_history`
     rows, and notes on the rows left out.
@@ -500,14 +564,26 @@ def prognosis_history(rows: list[tuple]):
 
     from prsm_health.prognostics import HISTORY_COLUMNS
 
-    columns = [*HISTORY_COLUMNS, "fault_class", "design"]
-    usable = [r for r in rows if None not in r[1:4]]
+    usable = [
+        r for r in rows if None not in (r.clearance_estimate, r.clearance_lower, r.clearance_upper)
+    ]
     notes = []
     if len(usable) < len(rows):
         notes.append(
             f"{len(rows) - len(usable)} stored diagnosis(es) with operating hours but without a "
             "clearance estimate and interval were left out"
         )
-    table = pd.DataFrame(usable, columns=columns)
+    stored = {  # the history's column → the stored row's field
+        "age_hours": "operating_hours",
+        "clearance": "clearance_estimate",
+        "clearance_lower": "clearance_lower",
+        "clearance_upper": "clearance_upper",
+        "fault_class": "fault_class",
+        "design": "design",
+    }
+    table = pd.DataFrame(
+        {column: [getattr(r, name) for r in usable] for column, name in stored.items()},
+        columns=[*HISTORY_COLUMNS, "fault_class", "design"],
+    )
     table = table.drop_duplicates("age_hours", keep="last").reset_index(drop=True)
     return table, notes

@@ -52,8 +52,15 @@ def metrics_summary(model_path: Path | None, metadata: dict) -> dict | None:
             "n_splits",
         ),
         "clearance_test": ("n", "mae", "rmse", "interval_coverage", "mean_interval_width"),
-        "fault_cv": ("accuracy", "macro_f1", "log_loss", "n_samples", "n_splits", "classes"),
-        "fault_test": ("n", "accuracy", "macro_f1", "classes"),
+        "fault_cv": (
+            "accuracy",
+            "macro_f1_classifier",
+            "log_loss",
+            "n_samples",
+            "n_splits",
+            "classes",
+        ),
+        "fault_test": ("n", "accuracy", "macro_f1_classifier", "classes"),
         "off_grid": (
             "n",
             "clearance_mae",

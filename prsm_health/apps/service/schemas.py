@@ -5,11 +5,19 @@ limits are known: a request body is validated with ``context={"limits": limits}`
 (:func:`parse_diagnose_request`), which checks ``sample_rate`` against the limits with
 pydantic's own error types and messages, and :func:`document_limits` writes the same bounds
 into the app's OpenAPI document.
+
+The Diagnosis answer is not declared here: :func:`contract_model` generates its models from
+the library's declaration (:mod:`prsm_health.diagnostics.contract`), field by field. The query
+parameters of a binary body are the JSON body's fields (:class:`DiagnoseParams`), checked by
+the same model (:func:`parse_query_params`).
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+import dataclasses
+import types
+import typing
+from typing import Annotated
 
 from pydantic import (
     BaseModel,
@@ -22,8 +30,8 @@ from pydantic import (
 )
 from pydantic_core import PydanticKnownError
 
-from prsm_health.actuator.design import PRESETS
 from prsm_health.core.channels import CHANNEL_NAMES, CHANNELS, TRUTH_NAMES, TRUTH_PREFIX
+from prsm_health.diagnostics import contract
 
 from .limits import MAX_OPERATING_HOURS, ServiceLimits
 from .responses import HTTPError
@@ -53,14 +61,17 @@ Channels = create_model(
 )
 
 
-class DiagnoseRequest(BaseModel):
-    """A recording to diagnose: uniformly sampled contract channels."""
+class DiagnoseParams(BaseModel):
+    """What a diagnose request says besides the recording: fields of a JSON body, query
+    parameters of a binary body (:func:`parse_query_params`)."""
 
     model_config = ConfigDict(strict=True, extra="forbid")
-    sample_rate: Finite = Field(description="sample rate [Hz]")
-    channels: Channels  # type: ignore[valid-type]
-    design: Literal[tuple(sorted(PRESETS))] | None = Field(  # type: ignore[valid-type]
-        None, description="design preset of the actuator (must match the model's)"
+    design: str | None = Field(
+        None,
+        min_length=1,
+        max_length=128,
+        description="name of the actuator's design — a preset or a design file's name — which "
+        "must be the design the served model was trained on",
     )
     speed: Finite | None = Field(None, description="nominal screw speed [rad/s] (stored)")
     load: Finite | None = Field(None, description="nominal axial load [N] (stored)")
@@ -75,6 +86,13 @@ class DiagnoseRequest(BaseModel):
         pattern=ASSET_ID_PATTERN,
         description="store the diagnosis in this asset's history",
     )
+
+
+class DiagnoseRequest(DiagnoseParams):
+    """A recording to diagnose: uniformly sampled contract channels."""
+
+    sample_rate: Finite = Field(description="sample rate [Hz]")
+    channels: Channels  # type: ignore[valid-type]
     time_start: Finite = Field(0.0, ge=-1e7, le=1e7, description="time of the first sample [s]")
 
     @field_validator("sample_rate")
@@ -90,75 +108,73 @@ class DiagnoseRequest(BaseModel):
         return rate
 
 
-class Clearance(BaseModel):
-    estimate: float | None = Field(description="clearance estimate [m]")
-    lower: float | None = Field(description="lower bound of the 90 % interval [m]")
-    upper: float | None = Field(description="upper bound of the 90 % interval [m]")
+def contract_model(cls: type, models: dict[str, type[BaseModel]] | None = None):
+    """The pydantic model of a part of the Diagnosis contract, generated from its dataclass
+    declaration (:mod:`prsm_health.diagnostics.contract`): one field per dataclass field, with
+    its type (parts replaced by their models, recursively) and description; a field the JSON
+    leaves out when empty (``omit_empty``) is not required, every other one is; no other key
+    is allowed. ``models``: the models made so far, by class name (shared by the recursion)."""
+    models = {} if models is None else models
+    name = cls.__name__
+    if name in models:
+        return models[name]
+    hints = typing.get_type_hints(cls)
+    fields = {}
+    for f in dataclasses.fields(cls):
+        annotation = _contract_type(hints[f.name], models, name)
+        description = f.metadata.get("description")
+        if f.metadata.get("omit_empty"):
+            # absent, never null: the type without None, and no default in the schema
+            annotation = _without_none(annotation)
+            fields[f.name] = (annotation, Field(default_factory=_absent, description=description))
+        else:
+            fields[f.name] = (annotation, Field(description=description))
+    model = create_model(
+        name,
+        __config__=ConfigDict(extra="forbid"),
+        __doc__=(cls.__doc__ or "").strip(),
+        **fields,
+    )
+    models[name] = model
+    model.model_rebuild(_types_namespace=models)  # a part that holds itself (``windows``)
+    return model
 
 
-class ModelRef(BaseModel):
-    name: str
-    version: str
-    design: str = Field(description="design the model was trained for")
+def _absent():
+    return None
 
 
-class WindowRef(BaseModel):
-    index: int
-    start: float = Field(description="[s]")
-    end: float = Field(description="[s]")
+def _contract_type(hint, models: dict, building: str):
+    """``hint`` with contract dataclasses replaced by their models (the class being built by
+    its name: a forward reference resolved when it is done)."""
+    if dataclasses.is_dataclass(hint):
+        if hint.__name__ == building:
+            return hint.__name__
+        return contract_model(hint, models)
+    args = typing.get_args(hint)
+    if not args:
+        return hint
+    new = tuple(_contract_type(a, models, building) for a in args)
+    if _is_union(hint):
+        return typing.Union[new]  # noqa: UP007 (X | "Name" fails: a name among the members)
+    return typing.get_origin(hint)[new]
 
 
-class WindowDiagnosis(BaseModel):
-    clearance: Clearance
-    fault_class: str | None = Field(
-        description="the class, or cannot_tell (fault not observable, or several classes in "
-        "the class set)"
-    )
-    class_probabilities: dict[str, float]
-    class_set: list[str] = Field(
-        default_factory=list,
-        description="classes the evidence cannot rule out (the model's conformal class set)",
-    )
-    observability: dict[str, bool] = Field(
-        description="clearance, fault: whether the window lets the model see them"
-    )
-    ood_score: float | None = Field(
-        description="out-of-distribution score (1 = training 99th percentile; > 1.5 unlike it)"
-    )
-    indicators: dict[str, float | None]
-    indicator_groups: dict[str, str] = Field(description="group → computed, or why not")
-    model: ModelRef
-    window: WindowRef
-    warnings: list[str] = Field(description="sentences a person can act on")
+def _is_union(hint) -> bool:
+    return isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union
 
 
-class Diagnosis(BaseModel):
-    """The Diagnosis contract (docs/service.md)."""
+def _without_none(annotation):
+    if not _is_union(annotation):
+        return annotation
+    return typing.Union[tuple(a for a in typing.get_args(annotation) if a is not type(None))]  # noqa: UP007
 
-    clearance: Clearance
-    fault_class: str | None = Field(
-        description="the class, or cannot_tell (fault not observable, or several classes in "
-        "the class set)"
-    )
-    class_probabilities: dict[str, float]
-    class_set: list[str] = Field(
-        default_factory=list,
-        description="classes the evidence cannot rule out (the model's conformal class set)",
-    )
-    observability: dict[str, float] = Field(
-        description="clearance, fault: fraction of the windows that let the model see them"
-    )
-    ood_score: float | None = Field(description="median out-of-distribution score of the windows")
-    indicators: dict[str, float | None]
-    indicator_groups: dict[str, str] = Field(description="group → computed, or why not")
-    model: ModelRef
-    warnings: list[str] = Field(
-        description="sentences a person can act on: why a target is not observable, a missing "
-        "channel, a recording outside the trained range, a tail left undiagnosed"
-    )
-    windows: list[WindowDiagnosis] | None = Field(
-        None, description="per-window diagnoses, present when there is more than one window"
-    )
+
+#: The Diagnosis contract's models, generated once from its declaration.
+_CONTRACT: dict[str, type[BaseModel]] = {}
+Diagnosis = contract_model(contract.Diagnosis, _CONTRACT)
+ClearanceInterval = _CONTRACT["ClearanceInterval"]
+WindowSpan = _CONTRACT["WindowSpan"]
 
 
 class RecordingInfo(BaseModel):
@@ -171,7 +187,7 @@ class RecordingInfo(BaseModel):
 
 class FileDiagnosis(BaseModel):
     diagnosis: Diagnosis
-    windows: list[WindowDiagnosis]
+    windows: list[Diagnosis]  # type: ignore[valid-type]
     recording: RecordingInfo
     warnings: list[str]
 
@@ -181,7 +197,7 @@ class HistoryEntry(BaseModel):
     received_at: str = Field(description="server receive time, UTC ISO-8601")
     source: str = Field(description="'json' or 'file'")
     filename: str | None
-    window: WindowRef | None
+    window: WindowSpan | None  # type: ignore[valid-type]
     speed: float | None = Field(description="[rad/s]")
     load: float | None = Field(description="[N]")
     operating_hours: float | None = Field(
@@ -244,9 +260,9 @@ class LatestDiagnosis(BaseModel):
     received_at: str = Field(description="server receive time, UTC ISO-8601")
     source: str = Field(description="'json', 'arrow', 'parquet', 'mcap' or 'file'")
     filename: str | None
-    window: WindowRef | None
+    window: WindowSpan | None  # type: ignore[valid-type]
     operating_hours: float | None = Field(description="[h], as sent")
-    clearance: Clearance
+    clearance: ClearanceInterval  # type: ignore[valid-type]
     fault_class: str | None
     class_probabilities: dict[str, float]
     warnings: list[str]
@@ -318,7 +334,7 @@ class Spectra(BaseModel):
     received_at: str
     source: str
     filename: str | None
-    window: WindowRef | None
+    window: WindowSpan | None  # type: ignore[valid-type]
     operating_hours: float | None = Field(description="[h]")
     channel: str = Field(description="nut_axial_accel")
     sample_rate: float = Field(description="[Hz]")
@@ -383,6 +399,40 @@ def parse_diagnose_request(body: bytes, limits: ServiceLimits) -> DiagnoseReques
         raise HTTPError(
             422, format_errors(exc.errors(include_url=False, include_input=False))
         ) from None
+
+
+#: How a query parameter's pydantic error reads (by error type; others: pydantic's message).
+_QUERY_WORDS = {
+    "float_parsing": "{name} = {text!r}: a finite number expected",
+    "finite_number": "{name} = {text!r}: a finite number expected",
+    "string_pattern_mismatch": "{name} {text!r} must match {pattern}",
+    "literal_error": "{name} = {text!r}: one of {expected}",
+}
+
+
+def parse_query_params(items: list[tuple[str, str]]) -> DiagnoseParams:
+    """The query parameters of a binary body, checked by the model that checks a JSON body's
+    fields (:class:`DiagnoseParams`, numbers parsed from text); :class:`HTTPError` 422
+    naming the parameter otherwise."""
+    names = list(DiagnoseParams.model_fields)
+    values: dict[str, str] = {}
+    for name, text in items:
+        if name not in names:
+            raise HTTPError(
+                422, f"unknown query parameter {name!r}; a binary body takes {', '.join(names)}"
+            )
+        if name in values:
+            raise HTTPError(422, f"query parameter {name!r} given twice")
+        values[name] = text
+    try:
+        return DiagnoseParams.model_validate(values, strict=False)
+    except ValidationError as exc:
+        e = exc.errors(include_url=False)[0]
+        name = str(e["loc"][0])
+        ctx = {k: str(v).replace("'", "") for k, v in (e.get("ctx") or {}).items()}
+        template = _QUERY_WORDS.get(e["type"], "{name} = {text!r}: {msg}")
+        text = values[name][: 140 if name == "asset_id" else 40]
+        raise HTTPError(422, template.format(name=name, text=text, msg=e["msg"], **ctx)) from None
 
 
 def format_errors(errors: list[dict], prefix: str = "") -> str:

@@ -1,6 +1,7 @@
 """Uploaded recordings: the multipart body streamed to a private temporary directory
-(:func:`receive_upload`), and checks of a file's metadata before the library decodes it
-(:func:`precheck_upload`)."""
+(:func:`receive_upload`) — the recording (``file``: MCAP, Parquet or CSV), an optional column
+map (``map``: TOML, held in memory) and the ``asset_id`` — and checks of a file's metadata
+before the library decodes it (:func:`precheck_upload`)."""
 
 from __future__ import annotations
 
@@ -24,7 +25,11 @@ from .limits import ServiceLimits
 from .responses import HTTPError
 from .schemas import ASSET_ID_PATTERN
 
-UPLOAD_SUFFIXES = (".mcap", ".parquet")
+UPLOAD_SUFFIXES = (".mcap", ".parquet", ".csv")
+#: Largest column map (the ``map`` field) accepted [bytes]: a map is a few hundred bytes.
+MAX_MAP_BYTES = 64 * 1024
+#: Largest plain form field (``asset_id``) [bytes].
+MAX_FIELD_BYTES = 1024
 
 
 def precheck_upload(path: Path, suffix: str, limits: ServiceLimits) -> None:
@@ -52,7 +57,8 @@ def precheck_recording(
     than ``max_samples`` rows or ``max_decoded_bytes`` decompressed (413), or an implausible
     number of columns (422), before anything is decompressed or decoded. ``fmt``:
     ``"parquet"`` (footer: rows, row-group sizes), ``"mcap"`` (chunk headers: uncompressed
-    sizes), ``"arrow"`` (message headers: rows, buffer sizes). The hints end the messages
+    sizes), ``"arrow"`` (message headers: rows, buffer sizes), ``"csv"`` (lines and header
+    fields: rows × columns float64 values). The hints end the messages
     (which limit, what to do). A body the metadata cannot be read from is left to the reader,
     which reports it with its own message — except an Arrow stream, whose headers are the
     reader's first step (422 here; ``name`` names the recording)."""
@@ -78,6 +84,9 @@ def precheck_recording(
             raise HTTPError(422, str(exc)) from None
         rows, decoded, columns = sizes.rows, sizes.decoded_bytes, sizes.columns
         kind = "Arrow stream"
+    elif fmt == "csv":
+        rows, columns = _csv_shape(source)
+        decoded, kind = 8 * rows * columns, "CSV file"
     else:
         decoded = _mcap_chunk_bytes(source, max_decoded_bytes)
     if columns > 4 * len(UNITS):
@@ -133,23 +142,44 @@ def _mcap_chunk_bytes(source: Path | bytes, stop_above: int) -> int:
     return total
 
 
+def _csv_shape(source: Path | bytes) -> tuple[int, int]:
+    """Data rows and header fields of a CSV file, from its line breaks and first line alone
+    (nothing parsed; a row is at least one line, so rows are never undercounted)."""
+    if isinstance(source, Path):
+        lines, header, last = 0, b"", b""
+        with open(source, "rb") as f:
+            while block := f.read(1 << 20):
+                if lines == 0 and not header:
+                    header = block.split(b"\n", 1)[0]
+                lines += block.count(b"\n")
+                last = block[-1:]
+        lines += 1 if last and last != b"\n" else 0
+    else:
+        data = bytes(source)
+        header = data.split(b"\n", 1)[0]
+        lines = data.count(b"\n") + (1 if data and not data.endswith(b"\n") else 0)
+    return max(lines - 1, 0), (header.count(b",") + 1 if header.strip() else 0)
+
+
 @dataclass(frozen=True)
 class ReceivedUpload:
     """What a received upload is to the diagnosis: the file on disk and how the client named
-    it (plain data: it crosses to a diagnosis process)."""
+    it, and the column map sent with it (plain data: it crosses to a diagnosis process)."""
 
     path: Path | None
     filename: str | None
     suffix: str | None
     file_bytes: int
+    column_map: bytes | None = None
+    map_name: str | None = None
 
 
 class Upload:
     """Streams a multipart/form-data body: the ``file`` part straight into ``directory``
-    (under a fixed name; the client's file name only gives the suffix), small text fields in
-    memory."""
+    (under a fixed name; the client's file name only gives the suffix), the column map
+    (``map``, at most :data:`MAX_MAP_BYTES`) and small text fields in memory."""
 
-    FIELDS = ("file", "asset_id")
+    FIELDS = ("file", "map", "asset_id")
     #: python-multipart callbacks this class implements.
     CALLBACKS = (
         "on_part_begin",
@@ -167,6 +197,8 @@ class Upload:
         self.suffix: str | None = None
         self.path: Path | None = None
         self.fields: dict[str, str] = {}
+        self.column_map: bytes | None = None
+        self.map_name: str | None = None
         self.file_bytes = 0
         self._file = None
         self._name: str | None = None
@@ -204,11 +236,20 @@ class Upload:
         if name not in self.FIELDS:
             raise HTTPError(
                 422,
-                f"unknown form field {name!r}; expected 'file' (the recording) and optional 'asset_id'",
+                f"unknown form field {name!r}; expected 'file' (the recording), optional 'map' "
+                "(its column map, TOML) and optional 'asset_id'",
             )
-        if name in self.fields or (name == "file" and self.filename is not None):
+        if (
+            name in self.fields
+            or (name == "file" and self.filename is not None)
+            or (name == "map" and self.map_name is not None)
+        ):
             raise HTTPError(422, f"form field {name!r} given twice")
         self._name = name
+        if name == "map":
+            raw = options.get(b"filename")
+            given = raw.decode("utf-8", "replace").replace("\\", "/") if raw else ""
+            self.map_name = Path(given).name[:255] or "map"
         if name == "file":
             raw = options.get(b"filename")
             if raw is None:
@@ -218,7 +259,8 @@ class Upload:
             if suffix not in UPLOAD_SUFFIXES:
                 raise HTTPError(
                     415,
-                    f"unsupported recording type {suffix or filename!r}: upload a .mcap or .parquet file",
+                    f"unsupported recording type {suffix or filename!r}: upload a .mcap, "
+                    ".parquet or .csv file",
                 )
             self.filename, self.suffix, self._is_file = filename, suffix, True
             self.path = self.directory / f"recording{suffix}"
@@ -230,11 +272,14 @@ class Upload:
             self.file_bytes += end - start
         else:
             self._value += data[start:end]
-            if len(self._value) > 1024:
-                raise HTTPError(422, f"form field {self._name!r} longer than 1024 bytes")
+            limit = MAX_MAP_BYTES if self._name == "map" else MAX_FIELD_BYTES
+            if len(self._value) > limit:
+                raise HTTPError(422, f"form field {self._name!r} longer than {limit} bytes")
 
     def on_part_end(self):
-        if not self._is_file and self._name is not None:
+        if self._name == "map":
+            self.column_map = bytes(self._value)
+        elif not self._is_file and self._name is not None:
             self.fields[self._name] = self._value.decode("utf-8", "replace")
 
     def take_pending(self) -> bytes:
@@ -248,7 +293,9 @@ class Upload:
 
     def received(self) -> ReceivedUpload:
         """The received file, for the diagnosis."""
-        return ReceivedUpload(self.path, self.filename, self.suffix, self.file_bytes)
+        return ReceivedUpload(
+            self.path, self.filename, self.suffix, self.file_bytes, self.column_map, self.map_name
+        )
 
     def close(self) -> None:
         if self._file is not None:

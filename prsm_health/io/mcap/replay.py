@@ -3,7 +3,9 @@ classic indicators of a window (:func:`window_statistics`).
 
 The replay never holds the whole file: it decodes one chunk at a time, in log-time order
 (through the summary's chunk index when the file has one, else by scanning the records), and
-keeps only the unfinished window.
+keeps only the unfinished window. Window boundaries follow
+:func:`~prsm_health.core.run.window_span`, as :meth:`Run.windows <prsm_health.core.run.Run.windows>`
+cuts a run in memory (here in nanoseconds of log time, there in samples).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import numpy as np
 
 from prsm_health.core.channels import TOPIC_FIELDS
 from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
-from prsm_health.core.run import lookup_channel
+from prsm_health.core.run import lookup_channel, window_span
 
 from ._samples import _align, _Batch, _merge_topic, _require_positive, _sample_rate, _start_ns
 from ._scan import _chunk_batches, _Damaged, _Source, _unchunked_batches
@@ -293,8 +295,7 @@ class WindowStream(Iterator[Window]):
         # (+1 ns of log-time rounding) before its end.
         period = 1e9 / self._rate_hz if self._rate_hz else 0.0
         while True:
-            start = self._first + self._index * self.step_ns
-            end = start + self.window_ns
+            start, end = window_span(self._index, self.window_ns, self.step_ns, self._first)
             newest = {t: int(b.log_time[-1]) for t, b in self._buffers.items() if len(b)}
             if not newest:
                 return

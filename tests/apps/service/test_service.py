@@ -384,7 +384,7 @@ def test_file_upload_rejections(client, small_server, files):
     before = _upload_dirs()
     cases = [
         ({"file": ("notes.txt", b"hello")}, None, 415, "unsupported recording type"),
-        ({"file": ("run.csv", b"time\n0\n")}, None, 415, ".csv"),
+        ({"file": ("run.csv", b"time\n0\n")}, None, 422, "run.csv: "),  # CSV read, refused
         ({"file": ("broken.mcap", b"not an mcap at all")}, None, 422, "broken.mcap: not an MCAP"),
         ({"file": ("broken.parquet", b"PAR1 garbage")}, None, 422, "broken.parquet"),
         ({"other": ("x.mcap", b"")}, None, 422, "unknown form field 'other'"),

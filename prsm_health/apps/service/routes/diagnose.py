@@ -18,6 +18,7 @@ from ..schemas import (
     Diagnosis,
     Error,
     FileDiagnosis,
+    parse_query_params,
 )
 from ..uploads import multipart_boundary, receive_upload, upload_directory
 from .deps import Limits, Store, Workers
@@ -109,7 +110,13 @@ _MULTIPART_BODY = {
                         "file": {
                             "type": "string",
                             "format": "binary",
-                            "description": "recording (.mcap or .parquet, by file name)",
+                            "description": "recording (.mcap, .parquet or .csv, by file name)",
+                        },
+                        "map": {
+                            "type": "string",
+                            "format": "binary",
+                            "description": "column map of a CSV or Parquet recording (TOML, "
+                            "docs/import.md)",
                         },
                         "asset_id": {
                             "type": "string",
@@ -142,7 +149,7 @@ def body_params(request: Request, fmt: str) -> BodyParams | None:
     """A binary body's query parameters; a JSON body takes none (its fields say it all)."""
     items = request.query_params.multi_items()
     if fmt != "json":
-        return BodyParams.from_query(items)
+        return BodyParams(**parse_query_params(items).model_dump())
     if items:
         raise HTTPError(
             422,

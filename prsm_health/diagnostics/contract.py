@@ -1,0 +1,200 @@
+"""The Diagnosis contract, declared once: :class:`Diagnosis` and its typed parts.
+
+Every field carries its meaning (``metadata["description"]``, units in brackets).
+:meth:`Diagnosis.to_json` walks these fields to make the JSON that the CLI prints, the service
+answers and replay writes on ``/prsm/diagnosis``; the service's OpenAPI schema is generated
+from the same fields (:func:`prsm_health.apps.service.schemas.contract_model`), so the field
+list exists once. A field marked ``omit_empty`` is left out of the JSON when it is None or
+empty (``window`` of a recording, ``windows`` of a window); every other field is always there,
+``null`` where it has no value.
+
+The parts (:class:`ClearanceInterval`, :class:`Observability`, :class:`ModelReference`,
+:class:`WindowSpan`) are frozen and also read as the mappings they were before they had types
+(``d.clearance["estimate"]``, ``d.observability.get("clearance")``, equality with a dict), so
+code written against the dicts keeps working.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import ClassVar
+
+#: The class of a window whose class the model cannot see (clearance hidden, channels missing,
+#: indicators unlike the training set, or no class probable enough).
+CANNOT_TELL = "cannot_tell"
+
+
+def describe(description: str, *, omit_empty: bool = False, **kwargs):
+    """A dataclass field with its meaning (and whether JSON leaves it out when empty)."""
+    return field(metadata={"description": description, "omit_empty": omit_empty}, **kwargs)
+
+
+def contract_json(value):
+    """Plain JSON values of a contract object: dataclasses by their fields (``omit_empty``
+    fields left out when None or empty), lists and dicts item by item."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        out = {}
+        for f in dataclasses.fields(value):
+            item = getattr(value, f.name)
+            if f.metadata.get("omit_empty") and (item is None or item == []):
+                continue
+            out[f.name] = contract_json(item)
+        return out
+    if isinstance(value, Mapping):
+        return {k: contract_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [contract_json(v) for v in value]
+    return value
+
+
+class _Part(Mapping):
+    """A frozen part of the contract, also readable as the mapping of its fields."""
+
+    def __getitem__(self, key):
+        if key not in self._names():
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __iter__(self):
+        return iter(self._names())
+
+    def __len__(self):
+        return len(self._names())
+
+    @classmethod
+    def _names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in dataclasses.fields(cls))
+
+    @classmethod
+    def of(cls, value):
+        """``value`` as this part (a mapping of its fields is converted)."""
+        return value if isinstance(value, cls) or value is None else cls(**value)
+
+    def to_json(self) -> dict:
+        return contract_json(self)
+
+
+@dataclass(frozen=True, eq=False)
+class ClearanceInterval(_Part):
+    """The clearance estimate and its interval."""
+
+    estimate: float | None = describe("thread half-clearance estimate [m]")
+    lower: float | None = describe(
+        "lower bound of the prediction interval (90 % for the shipped model) [m]; the lower end "
+        "of the trained range where the clearance is not observable"
+    )
+    upper: float | None = describe(
+        "upper bound of the prediction interval [m]; the upper end of the trained range where "
+        "the clearance is not observable"
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class Observability(_Part):
+    """Whether the recording lets the model see each target.
+
+    Per window a bool; for a recording the fraction of its windows (0 … 1). A target is not
+    observable where a warning says why."""
+
+    clearance: bool | float = describe(
+        "clearance: a load or motion reversal (the rollers cross the clearance), the model's "
+        "channels, indicators like the training windows, and an interval narrower than the "
+        "trained range. Per window a bool, for a recording the fraction of its windows"
+    )
+    fault: bool | float = describe(
+        "fault class: the clearance observable (the wear classes differ by clearance) and the "
+        "window like the training windows. Per window a bool, for a recording the fraction of "
+        "its windows"
+    )
+
+    #: The targets, in field order.
+    TARGETS: ClassVar[tuple[str, ...]] = ("clearance", "fault")
+
+
+@dataclass(frozen=True, eq=False)
+class ModelReference(_Part):
+    """The model bundle that made the diagnosis."""
+
+    name: str = describe("model name")
+    version: str = describe("model version")
+    design: str = describe("design the model was trained for")
+    instrumentation: str | None = describe(
+        "instrumentation profile of the training runs (null: not recorded in the bundle)",
+        default=None,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class WindowSpan(_Part):
+    """Where a window lies in its recording."""
+
+    index: int = describe("window number from 0")
+    start: float = describe("time of the window's first sample from the recording start [s]")
+    end: float = describe("time of the window's last sample [s]")
+
+
+@dataclass(kw_only=True)
+class Diagnosis:
+    """The Diagnosis contract (docs/formats.md): of a window (with ``window``) or of a whole
+    recording (with ``windows``).
+
+    A recording's values: the clearance the medians over the windows where it was observable
+    (over all windows if none), the class probabilities the means over the windows given a
+    class, the indicators and OOD score the medians over the windows.
+    """
+
+    clearance: ClearanceInterval = describe("clearance estimate and interval [m]")
+    fault_class: str | None = describe(
+        "the most probable class when the window shows the fault and its probability reaches "
+        f"0.5, else {CANNOT_TELL!r}; null without a fault model"
+    )
+    class_probabilities: dict[str, float] = describe(
+        "class → calibrated probability (sum 1), given even with cannot_tell"
+    )
+    class_set: list[str] = describe(
+        "classes the evidence cannot rule out (the model's conformal class set; every class "
+        "where the fault is not observable)",
+        default_factory=list,
+    )
+    observability: Observability = describe(
+        "per target, whether the model can see it (window: bool; recording: fraction of windows)",
+        default_factory=lambda: Observability(False, False),
+    )
+    ood_score: float | None = describe(
+        "out-of-distribution score of the indicators (1 = the training windows' 99th "
+        "percentile; above 1.5 unlike the training set); a recording's is the median of its "
+        "windows'",
+        default=None,
+    )
+    indicators: dict[str, float | None] = describe(
+        "condition indicators by name (units in prsm_health.signals.features.FEATURES); null "
+        "where not computable"
+    )
+    indicator_groups: dict[str, str] = describe(
+        "indicator group → 'computed', or why not", default_factory=dict
+    )
+    model: ModelReference = describe("the model bundle")
+    warnings: list[str] = describe(
+        "sentences a person can act on: why a target is not observable, a missing channel, a "
+        "recording outside the trained range, a tail left undiagnosed",
+        default_factory=list,
+    )
+    window: WindowSpan | None = describe(
+        "the window's place in its recording (window diagnoses only)", omit_empty=True, default=None
+    )
+    windows: list[Diagnosis] = describe(
+        "per-window diagnoses (recording diagnoses only)", omit_empty=True, default_factory=list
+    )
+
+    def __post_init__(self):
+        # mappings accepted where a part is expected (code written before the parts had types)
+        self.clearance = ClearanceInterval.of(self.clearance)
+        self.observability = Observability.of(self.observability)
+        self.model = ModelReference.of(self.model)
+        self.window = WindowSpan.of(self.window)
+
+    def to_json(self) -> dict:
+        """The Diagnosis contract as plain JSON values."""
+        return contract_json(self)
