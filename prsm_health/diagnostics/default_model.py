@@ -192,7 +192,8 @@ def default_severity(
 
 def honesty_checks(bundle, reference: Recipe, *, n: int = 6) -> dict:
     """Recordings the model must not answer confidently (:data:`HONESTY_CASES`): another
-    design, another instrumentation, no load reversal, the accelerometer alone.
+    design (its recordings stripped of the design they say, which the model would refuse),
+    another instrumentation, no load reversal, the accelerometer alone.
 
     Each case simulates the first ``n`` test-split points of ``reference`` (points the model
     was not trained on) with new seeds (recipe seed + 1000 + k) and diagnoses them.
@@ -228,6 +229,12 @@ def honesty_checks(bundle, reference: Recipe, *, n: int = 6) -> dict:
             run = one.scenario().simulate()
             if "channels" in change:
                 run.channels = {c: run.channels[c] for c in change["channels"]}
+            if "design" in change:
+                # A recording that says its design is refused (ModelBundle.refuses); what is
+                # checked here is one that does not say it — a rig's file of unknown origin.
+                run.labels = {
+                    k: v for k, v in run.labels.items() if k not in ("design", "design_fingerprint")
+                }
             d = diagnose(run, bundle)
             top = max(d.class_probabilities.values())
             true_class = one.labels()["fault_class"]
@@ -691,8 +698,8 @@ Fault class (drop of accuracy):
 
 ## What it does not cover
 
-- One design (paper01); another design's recording is warned about and scored out of
-  distribution (honesty checks), not diagnosed.
+- One design (paper01); another design's recording is refused when it says its design, and
+  scored out of distribution when it does not (honesty checks), not diagnosed.
 - One instrumentation (flight-ema). A recording without one of its channels is diagnosed with
   what it has, the clearance is not observable without the LVDT, and the class is
   `cannot_tell`.

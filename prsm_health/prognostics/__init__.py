@@ -2,7 +2,7 @@
 
 - :mod:`.history` — the history table: columns, reading a file, validation with row-naming errors
 - :mod:`.degradation` — the Bayesian degradation model's arithmetic (Gebraeel et al. 2005)
-- :mod:`.rul` — :class:`PrognosticsModel` (degradation model, similarity baseline) → :class:`Prognosis`
+- :mod:`.rul` — :class:`RULModel` (degradation model, similarity baseline) → :class:`Prognosis`
 - :mod:`.model_files` — JSON model files
 - :mod:`.fleet` — a fleet dataset's snapshots diagnosed into histories
 - :mod:`.fitting` — a model fitted for a fleet of any design, scored on its held-out units
@@ -16,7 +16,7 @@ from .fleet import fleet_histories
 from .history import HISTORY_COLUMNS, HistoryError, read_history, validate_history
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
 from .prognosis import Prognosis
-from .rul import HORIZON_FACTOR, METHODS, PrognosticsModel, prognose
+from .rul import HORIZON_FACTOR, METHODS, RULModel, prognose
 
 __all__ = [
     "DEFAULT_PROGNOSTICS_MODEL",
@@ -26,7 +26,7 @@ __all__ = [
     "METHODS",
     "HistoryError",
     "Prognosis",
-    "PrognosticsModel",
+    "RULModel",
     "diagnosed_threshold",
     "fit_prognostics_model",
     "fleet_histories",

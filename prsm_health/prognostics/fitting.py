@@ -18,7 +18,7 @@ from prsm_health.core.errors import PRSMHealthError, require
 
 from .fleet import fleet_histories
 from .metrics import evaluate_units
-from .rul import PrognosticsModel
+from .rul import RULModel
 
 #: Diagnoses of a unit's last share of life used to read the indicator at failure.
 LAST_SHARE = 0.25
@@ -102,8 +102,8 @@ def fit_prognostics_model(
     evaluate: bool = True,
     alpha: float = ALPHA,
     progress: bool = False,
-) -> tuple[PrognosticsModel, FitReport]:
-    """Fit a :class:`~prsm_health.prognostics.PrognosticsModel` on a fleet dataset of any design.
+) -> tuple[RULModel, FitReport]:
+    """Fit a :class:`~prsm_health.prognostics.RULModel` on a fleet dataset of any design.
 
     1. Every snapshot is diagnosed (:func:`~prsm_health.prognostics.fleet_histories`) by
        ``bundle``, unless ``histories`` are given (e.g. kept from an earlier call).
@@ -126,7 +126,7 @@ def fit_prognostics_model(
         The fleet's diagnosed histories (columns of :func:`fleet_histories`), instead of
         diagnosing; they must be of the fleet's design.
     method, n_samples, random_state
-        Of the :class:`PrognosticsModel`.
+        Of the :class:`RULModel`.
     evaluate : bool
         Score the held-out units.
     alpha : float
@@ -136,7 +136,7 @@ def fit_prognostics_model(
 
     Returns
     -------
-    model : PrognosticsModel
+    model : RULModel
         Fitted; save it with :func:`~prsm_health.prognostics.save_prognostics_model`.
     report : FitReport
 
@@ -177,7 +177,7 @@ def fit_prognostics_model(
     learnt = threshold is None
     if learnt:
         threshold = diagnosed_threshold(train)
-    model = PrognosticsModel(
+    model = RULModel(
         method=method,
         threshold=threshold,
         design=name,

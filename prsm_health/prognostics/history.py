@@ -112,7 +112,7 @@ def validate_history(history: pd.DataFrame, model=None) -> pd.DataFrame:
         from row to row, ``clearance``, ``clearance_lower`` <= ``clearance_upper`` [m], all
         finite), optionally ``design`` (one design name), ``design_fingerprint`` (one
         fingerprint), ``unit_id`` (one unit), ``fault_class``.
-    model : PrognosticsModel, optional
+    model : RULModel, optional
         When given, the history must be of the model's design: its ``design_fingerprint``
         equal to the model's where both have one, else its ``design`` name to the model's.
 

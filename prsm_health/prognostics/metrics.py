@@ -31,7 +31,7 @@ import pandas as pd
 from prsm_health.core.errors import ParameterError, require, require_range
 
 from .history import HISTORY_COLUMNS
-from .rul import PrognosticsModel
+from .rul import RULModel
 
 __all__ = [
     "alpha_lambda_accuracy",
@@ -200,7 +200,7 @@ def interval_coverage(true, lower, upper) -> float:
 def evaluate_units(
     histories: pd.DataFrame,
     failure_ages: Mapping,
-    model: PrognosticsModel,
+    model: RULModel,
     after_fraction: float = 0.5,
     methods=("degradation", "similarity"),
     alpha: float = 0.2,
@@ -219,7 +219,7 @@ def evaluate_units(
         (:data:`prsm_health.prognostics.HISTORY_COLUMNS`).
     failure_ages : Mapping
         Unit id -> true failure age [h].
-    model : PrognosticsModel
+    model : RULModel
         A fitted model.
     after_fraction : float, default 0.5
         The alpha-lambda accuracy and the ``*_after`` entries use the predictions made at
@@ -252,10 +252,10 @@ def evaluate_units(
     missing = [c for c in HISTORY_COLUMNS if c not in histories.columns]
     require(not missing, "histories", missing, "lacks these history columns")
     require(
-        isinstance(model, PrognosticsModel),
+        isinstance(model, RULModel),
         "model",
         type(model).__name__,
-        "must be a PrognosticsModel",
+        "must be a RULModel",
     )
     require_range("after_fraction", after_fraction, 0.0, 1.0)
     require(after_fraction < 1.0, "after_fraction", after_fraction, "must be < 1")

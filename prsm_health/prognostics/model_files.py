@@ -12,20 +12,20 @@ from prsm_health.core.errors import (
 )
 
 from .history import one_line
-from .rul import PrognosticsModel
+from .rul import RULModel
 
 #: The shipped prognostics model (fitted on datasets/fleet.toml by tools/release/train_prognostics_model.py).
 DEFAULT_PROGNOSTICS_MODEL = Path(__file__).resolve().parents[2] / "models" / "prognostics.json"
 
 
-def save_prognostics_model(path, model: PrognosticsModel) -> Path:
+def save_prognostics_model(path, model: RULModel) -> Path:
     """Write a fitted model as a JSON file (atomically: temporary file, then rename).
 
     Parameters
     ----------
     path : str or Path
         Destination (conventionally ``*.json``); replaced if it exists.
-    model : PrognosticsModel
+    model : RULModel
         A fitted model.
 
     Returns
@@ -36,16 +36,16 @@ def save_prognostics_model(path, model: PrognosticsModel) -> Path:
     Raises
     ------
     ParameterError
-        Not a fitted :class:`PrognosticsModel`.
+        Not a fitted :class:`RULModel`.
     PRSMHealthError
         An unwritable path.
     """
     path = Path(path)
     require(
-        isinstance(model, PrognosticsModel) and model._is_fitted(),
+        isinstance(model, RULModel) and model._is_fitted(),
         "model",
         type(model).__name__,
-        "must be a fitted PrognosticsModel",
+        "must be a fitted RULModel",
     )
     from prsm_health.diagnostics.model_files import write_atomic
 
@@ -54,7 +54,7 @@ def save_prognostics_model(path, model: PrognosticsModel) -> Path:
     return path
 
 
-def load_prognostics_model(path=None) -> PrognosticsModel:
+def load_prognostics_model(path=None) -> RULModel:
     """Read a model written by :func:`save_prognostics_model` (default: the shipped one,
     :data:`DEFAULT_PROGNOSTICS_MODEL`).
 
@@ -77,7 +77,7 @@ def load_prognostics_model(path=None) -> PrognosticsModel:
     except ValueError as err:
         raise PRSMHealthError(f"{path}: not a prognostics model (invalid JSON: {err})") from None
     try:
-        return PrognosticsModel.from_dict(d)
+        return RULModel.from_dict(d)
     except ModelVersionError as err:
         raise ModelVersionError(f"{path}: {err}") from None
     except PRSMHealthError as err:

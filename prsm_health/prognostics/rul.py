@@ -3,7 +3,7 @@
 A **history** is a table of diagnoses of one asset over its operating hours (columns
 :data:`HISTORY_COLUMNS`: the age [h] and the diagnosed clearance [m] with its 90 % interval;
 optionally ``design``, ``fault_class``, ``unit_id``). The health indicator is the clearance; a
-unit fails when its true clearance reaches ``threshold`` [m]. A :class:`PrognosticsModel` is
+unit fails when its true clearance reaches ``threshold`` [m]. A :class:`RULModel` is
 fitted on a training fleet (the histories of units run to failure and their failure ages) and
 predicts a :class:`Prognosis`: the RUL [h] with a 90 % interval (5 % and 95 % quantiles).
 
@@ -73,7 +73,7 @@ from .degradation import (
 from .history import Z90, HistoryError, history_arrays, model_design, one_line, validate_history
 from .prognosis import Prognosis
 
-#: Methods :meth:`PrognosticsModel.predict` accepts. ``"degradation"`` uses the form chosen at
+#: Methods :meth:`RULModel.predict` accepts. ``"degradation"`` uses the form chosen at
 #: fit time; ``"degradation-exponential"`` / ``"degradation-linear"`` force a form.
 METHODS = ("degradation", "degradation-exponential", "degradation-linear", "similarity")
 #: Quantiles reported: lower bound, estimate (median), upper bound.
@@ -120,7 +120,7 @@ def _package_version() -> str:
 # --------------------------------------------------------------------------------------------
 
 
-class PrognosticsModel:
+class RULModel:
     """RUL from a history of diagnoses: Bayesian degradation model and similarity baseline.
 
     ``__init__`` stores its arguments; :meth:`fit` learns from a training fleet (attributes
@@ -286,7 +286,7 @@ class PrognosticsModel:
 
     # ---------------------------------------------------------------------------- fitting
 
-    def fit(self, histories: pd.DataFrame, failure_ages: Mapping) -> PrognosticsModel:
+    def fit(self, histories: pd.DataFrame, failure_ages: Mapping) -> RULModel:
         """Fit both methods on a training fleet run to failure.
 
         Parameters
@@ -300,7 +300,7 @@ class PrognosticsModel:
 
         Returns
         -------
-        PrognosticsModel
+        RULModel
             self.
 
         Raises
@@ -712,7 +712,7 @@ class PrognosticsModel:
         return json_ready(out)
 
     @classmethod
-    def from_dict(cls, d: dict) -> PrognosticsModel:
+    def from_dict(cls, d: dict) -> RULModel:
         """Rebuild a model from :meth:`to_dict` output.
 
         Raises
@@ -769,14 +769,14 @@ class PrognosticsModel:
         return model
 
 
-def prognose(history: pd.DataFrame, model: PrognosticsModel, method=None) -> Prognosis:
-    """RUL of one unit: :func:`validate_history` then :meth:`PrognosticsModel.predict`.
+def prognose(history: pd.DataFrame, model: RULModel, method=None) -> Prognosis:
+    """RUL of one unit: :func:`validate_history` then :meth:`RULModel.predict`.
 
     Parameters
     ----------
     history : pandas.DataFrame
         One unit's diagnoses (:data:`HISTORY_COLUMNS`).
-    model : PrognosticsModel
+    model : RULModel
         A fitted model.
     method : str, optional
         One of :data:`METHODS`; default ``model.method``.
@@ -786,10 +786,10 @@ def prognose(history: pd.DataFrame, model: PrognosticsModel, method=None) -> Pro
     Prognosis
     """
     require(
-        isinstance(model, PrognosticsModel),
+        isinstance(model, RULModel),
         "model",
         type(model).__name__,
-        "must be a PrognosticsModel",
+        "must be a RULModel",
     )
     clean = validate_history(history, model)
     return model.predict(clean, method=method)

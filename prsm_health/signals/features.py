@@ -220,7 +220,7 @@ def indicator_groups(row: dict, channels) -> dict[str, str]:
 @lru_cache(maxsize=256)
 def axial_baseline_frequency(design: PRSMDesign, load: float) -> float:
     """Healthy nut axial frequency √(k_axial/m_N)/2π [Hz] at an axial load [N] (paper 04 stiffness)."""
-    from prsm_health.physics.stiffness.thread import roller_side_stiffness
+    from prsm_health.physics.stiffness.thread_load import roller_side_stiffness
 
     per_roller = max(abs(load), 20.0) / design.n_rollers
     k_s = float(roller_side_stiffness(design, per_roller, "screw"))

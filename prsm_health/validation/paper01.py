@@ -13,7 +13,7 @@ from prsm_health.actuator.design import preset
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
 from prsm_health.physics.kinematics import characteristic_frequencies, speed_ratios
-from prsm_health.physics.stiffness.thread import roller_side_stiffness
+from prsm_health.physics.stiffness.thread_load import roller_side_stiffness
 from prsm_health.signals.spectra import amplitude_spectrum, dominant_frequency
 from prsm_health.simulation.dynamics.model import SimulationOptions
 from prsm_health.simulation.scenario import simulate

@@ -2,7 +2,7 @@
 
 The paper does not give the specimen's thread geometry, roller count, engaged threads or
 clearances, so its absolute stiffnesses cannot be recomputed; each such row still shows what
-:mod:`prsm_health.physics.stiffness.thread` gives for the ``paper04`` preset (21/7/35 mm pitch
+:mod:`prsm_health.physics.stiffness` gives for the ``paper04`` preset (21/7/35 mm pitch
 diameters, 5 starts, lead angle 1.74° → 0.4 mm pitch; assumed 7 rollers, 10 engaged threads,
 100 mm free screw). The model stiffness is the secant F/δ including the shaft (the paper's
 rig reports both secant and incremental stiffness without saying which its tables hold).
@@ -25,7 +25,8 @@ import math
 from scipy.optimize import brentq
 
 from prsm_health.actuator.design import preset
-from prsm_health.physics.stiffness import thread
+from prsm_health.physics.stiffness.axial import axial_stiffness
+from prsm_health.physics.stiffness.clearance import radial_to_axial_gap
 
 from . import Row, inconsistent, not_computable, reproduced
 
@@ -68,7 +69,7 @@ _PRESET_NOTE = (
 @functools.cache
 def _secant(load: float, contact_angle_deg: float = 45.0, n_rollers: int = 7) -> float:
     d = preset("paper04").with_(contact_angle=math.radians(contact_angle_deg), n_rollers=n_rollers)
-    return float(thread.axial_stiffness(d, load).secant_stiffness) / N_PER_UM
+    return float(axial_stiffness(d, load).secant_stiffness) / N_PER_UM
 
 
 def _exponent(k1: float, k2: float, f1: float, f2: float) -> float:
@@ -295,18 +296,16 @@ def _roller_rows() -> list[Row]:
 def _eccentricity_row() -> Row:
     d = preset("paper04")
     load = 10 * KN
-    ideal = thread.axial_stiffness(d, load)
+    ideal = axial_stiffness(d, load)
     ideal_roller = float(ideal.roller_deflections.max())
 
     def increase(e):
-        r = thread.axial_stiffness(d, load, eccentricity=e)
+        r = axial_stiffness(d, load, eccentricity=e)
         return float(r.roller_deflections.max()) / ideal_roller - 1.0
 
     model = 100.0 * increase(ECCENTRICITY)
-    loaded = int(
-        (thread.axial_stiffness(d, load, eccentricity=ECCENTRICITY).roller_loads > 0).sum()
-    )
-    gap = float(thread.radial_to_axial_gap(d, 2 * ECCENTRICITY))
+    loaded = int((axial_stiffness(d, load, eccentricity=ECCENTRICITY).roller_loads > 0).sum())
+    gap = float(radial_to_axial_gap(d, 2 * ECCENTRICITY))
     e15 = brentq(lambda e: increase(e) - ECCENTRIC_INCREASE / 100.0, 1e-8, ECCENTRICITY, xtol=1e-9)
     return not_computable(
         PAPER,

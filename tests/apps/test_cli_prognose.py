@@ -21,7 +21,7 @@ from prsm_health.datasets import Recipe, generate
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.prognostics import (
     METHODS,
-    PrognosticsModel,
+    RULModel,
     fleet_histories,
     load_prognostics_model,
     prognose,
@@ -71,9 +71,7 @@ def model_file(tmp_path_factory):
     rng = np.random.default_rng(0)
     units = [_unit(uid, rng) for uid in range(10)]
     histories = pd.concat([t for t, _ in units], ignore_index=True)
-    model = PrognosticsModel(n_samples=2000).fit(
-        histories, {i: life for i, (_, life) in enumerate(units)}
-    )
+    model = RULModel(n_samples=2000).fit(histories, {i: life for i, (_, life) in enumerate(units)})
     return save_prognostics_model(tmp_path_factory.mktemp("model") / "prognostics.json", model)
 
 

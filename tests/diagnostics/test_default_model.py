@@ -89,19 +89,22 @@ def test_no_confident_wrong_class_when_clearance_is_hidden_or_channels_missing(b
 
 
 def test_another_design_or_instrumentation_is_flagged(bundle, reference):
-    # A paper-02 PRSM and the lab-rig instrumentation: out of distribution (score above the
-    # limit) and warned, no class. The model card's honesty table has six of each.
+    # A paper-02 PRSM: refused while its recording says so; without its design labels (a
+    # file of unknown origin) and with the lab-rig instrumentation: out of distribution (score
+    # above the limit) and warned, no class. The model card's honesty table has six of each.
+    from prsm_health.core.errors import PRSMHealthError
     from prsm_health.diagnostics.diagnosis import OOD_LIMIT
 
     spec = [s for s in reference.runs() if s.split == "test"][5]
-    for change, needle in (
-        ({"design": "paper02"}, "design 'paper02'"),
-        ({"instrumentation": "lab-rig"}, "out-of-distribution"),
-    ):
-        run, _ = _point_run(reference, spec, **change)
+    other, _ = _point_run(reference, spec, design="paper02")
+    with pytest.raises(PRSMHealthError, match="design 'paper02.*trained on design 'paper01'"):
+        diagnose(other, bundle)
+    other.labels = {k: v for k, v in other.labels.items() if not k.startswith("design")}
+    lab_rig, _ = _point_run(reference, spec, instrumentation="lab-rig")
+    for run in (other, lab_rig):
         d = diagnose(run, bundle)
-        assert d.ood_score > OOD_LIMIT and d.fault_class == "cannot_tell", change
-        assert any(needle in w for w in d.warnings), d.warnings
+        assert d.ood_score > OOD_LIMIT and d.fault_class == "cannot_tell", run.labels
+        assert any("out-of-distribution" in w for w in d.warnings), d.warnings
 
 
 def test_interval_widens_where_the_regime_hides_clearance(bundle, reference):

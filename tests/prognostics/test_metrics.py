@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from prsm_health.core.errors import ParameterError
-from prsm_health.prognostics import PrognosticsModel
+from prsm_health.prognostics import RULModel
 from prsm_health.prognostics.metrics import (
     PREDICTION_COLUMNS,
     alpha_lambda_accuracy,
@@ -102,7 +102,7 @@ def _fleet(n_units, n_points, seed, first_id=0):
 
 def test_evaluate_units_table_and_summary():
     train, train_lives = _fleet(8, 12, seed=0)
-    model = PrognosticsModel(n_samples=500).fit(train, train_lives)
+    model = RULModel(n_samples=500).fit(train, train_lives)
     test, lives = _fleet(4, 10, seed=1, first_id=50)
     # a diagnosis after failure is not scored
     extra = test[test["unit_id"] == 50].iloc[[-1]].copy()
@@ -147,7 +147,7 @@ def test_evaluate_units_table_and_summary():
 
 def test_evaluate_units_refusals():
     train, lives = _fleet(4, 6, seed=2)
-    model = PrognosticsModel(n_samples=200).fit(train, lives)
+    model = RULModel(n_samples=200).fit(train, lives)
     with pytest.raises(ParameterError, match="no failure age"):
         evaluate_units(train, {0: lives[0]}, model)
     with pytest.raises(ParameterError, match="after_fraction"):

@@ -14,7 +14,7 @@ from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.prognostics import (
     DEFAULT_PROGNOSTICS_MODEL,
     HistoryError,
-    PrognosticsModel,
+    RULModel,
     load_prognostics_model,
     prognose,
     save_prognostics_model,
@@ -56,7 +56,7 @@ def _fleet(n_units=4, n_points=6, seed=0, **columns) -> tuple[pd.DataFrame, dict
 @pytest.fixture(scope="module")
 def model_a():
     histories, lives = _fleet(design="acme-ema-24", design_fingerprint=PRINT_A)
-    model = PrognosticsModel(design="acme-ema-24", design_fingerprint=PRINT_A, n_samples=200)
+    model = RULModel(design="acme-ema-24", design_fingerprint=PRINT_A, n_samples=200)
     return model.fit(histories, lives)
 
 
@@ -91,7 +91,7 @@ def test_a_model_of_design_a_refuses_design_b_of_the_same_name(model_a):
 
 def test_fitting_on_histories_of_another_design_is_refused():
     histories, lives = _fleet(design="acme-ema-24", design_fingerprint=PRINT_B)
-    model = PrognosticsModel(design="acme-ema-24", design_fingerprint=PRINT_A, n_samples=200)
+    model = RULModel(design="acme-ema-24", design_fingerprint=PRINT_A, n_samples=200)
     with pytest.raises(HistoryError, match="unit 0: history is of design"):
         model.fit(histories, lives)
 
@@ -115,5 +115,5 @@ def test_an_old_model_file_with_only_a_preset_name_stands_for_that_preset(tmp_pa
     with pytest.raises(HistoryError, match="another design"):
         validate_history(_one_unit(design="paper01", design_fingerprint=PRINT_B), model)
     # a design known by name only keeps the name rule
-    named = PrognosticsModel(design="acme-ema-24")
+    named = RULModel(design="acme-ema-24")
     assert named.design_id == ("acme-ema-24", None)

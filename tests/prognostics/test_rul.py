@@ -19,7 +19,7 @@ from prsm_health.prognostics import (
     HORIZON_FACTOR,
     HistoryError,
     Prognosis,
-    PrognosticsModel,
+    RULModel,
     load_prognostics_model,
     prognose,
     read_history,
@@ -91,7 +91,7 @@ def history_of(histories, uid, rows=None):
 @pytest.fixture(scope="module")
 def fleet_model():
     histories, lives, _ = exponential_fleet(seed=0)
-    return PrognosticsModel().fit(histories, lives)
+    return RULModel().fit(histories, lives)
 
 
 @pytest.fixture(scope="module")
@@ -184,7 +184,7 @@ def test_similarity_finds_the_library_unit_a_history_repeats():
     # own library curve far better than any other, so the kernel weights single it out and the
     # RUL is its remaining life; the fleet's median remaining life at that age is far off.
     histories, lives, _ = exponential_fleet(n_units=12, seed=8, sd_range=(0.04e-6, 0.06e-6))
-    model = PrognosticsModel(method="similarity").fit(histories, lives)
+    model = RULModel(method="similarity").fit(histories, lives)
     fastest = min(lives, key=lives.get)
     history = history_of(histories, fastest, rows=20)
     age = history["age_hours"].iloc[-1]
@@ -200,7 +200,7 @@ def test_form_selection_follows_the_generating_model(fleet_model):
     assert fleet_model.form_ == "exponential"
     assert fleet_model.loo_rmse_["exponential"] < fleet_model.loo_rmse_["linear"]
     histories, lives, _ = linear_fleet(seed=3)
-    linear = PrognosticsModel().fit(histories, lives)
+    linear = RULModel().fit(histories, lives)
     assert linear.form_ == "linear"
     # the profile-likelihood baseline recovers the generating one (PHI0) to a few % of the rise
     phi = fleet_model.forms_["exponential"]["phi"]
@@ -211,7 +211,7 @@ def test_similarity_aligns_on_the_linear_form_too():
     # a model whose chosen form is linear aligns the history on its units' straight lines
     # (regression: that branch once shadowed the curve function and raised UnboundLocalError)
     histories, lives, _ = linear_fleet(seed=3)
-    model = PrognosticsModel().fit(histories, lives)
+    model = RULModel().fit(histories, lives)
     assert model.form_ == "linear"
     unit = histories[histories["unit_id"] == 0].drop(columns="unit_id").iloc[:10]
     p = model.predict(unit, method="similarity")
@@ -226,7 +226,7 @@ def test_similarity_aligns_on_the_linear_form_too():
 
 def test_noiseless_linear_history_gives_the_exact_crossing():
     histories, lives, _ = linear_fleet(seed=4, sd=0.0)
-    model = PrognosticsModel().fit(histories, lives)
+    model = RULModel().fit(histories, lives)
     slope, c0 = 2.3e-9, 10.5e-6
     ages = np.linspace(0.0, 3000.0, 9)
     value = c0 + slope * ages
@@ -244,7 +244,7 @@ def test_noiseless_linear_history_gives_the_exact_crossing():
 
 def test_posterior_collapses_to_the_truth_as_the_history_grows():
     histories, lives, _ = linear_fleet(seed=5)
-    model = PrognosticsModel(method="degradation-linear").fit(histories, lives)
+    model = RULModel(method="degradation-linear").fit(histories, lives)
     rng = np.random.default_rng(7)
     c0, slope, sd = 9.7e-6, 1.8e-9, 0.3e-6
     sds, errors = [], []
@@ -404,21 +404,21 @@ def test_validate_history_returns_a_clean_copy():
 def test_fit_refusals():
     histories, lives, _ = linear_fleet(n_units=3, n_points=5, seed=6)
     with pytest.raises(ParameterError, match="at least 3 training units"):
-        PrognosticsModel().fit(histories[histories["unit_id"] < 2], lives)
+        RULModel().fit(histories[histories["unit_id"] < 2], lives)
     with pytest.raises(ParameterError, match="no failure age"):
-        PrognosticsModel().fit(histories, {0: lives[0], 1: lives[1]})
+        RULModel().fit(histories, {0: lives[0], 1: lives[1]})
     with pytest.raises(ParameterError, match="unit 1: .*strictly increasing"):
         bad = histories.copy()
         bad.loc[bad.index[bad["unit_id"] == 1][2], "age_hours"] = 0.0
-        PrognosticsModel().fit(bad, lives)
+        RULModel().fit(bad, lives)
     with pytest.raises(ParameterError, match="threshold"):
-        PrognosticsModel(threshold=5e-6).fit(histories, lives)
+        RULModel(threshold=5e-6).fit(histories, lives)
     with pytest.raises(ParameterError, match="method"):
-        PrognosticsModel(method="oracle").fit(histories, lives)
+        RULModel(method="oracle").fit(histories, lives)
     with pytest.raises(ParameterError, match="n_samples"):
-        PrognosticsModel(n_samples=10).fit(histories, lives)
+        RULModel(n_samples=10).fit(histories, lives)
     with pytest.raises(PRSMHealthError, match="not fitted"):
-        PrognosticsModel().predict(_good())
+        RULModel().predict(_good())
 
 
 # --------------------------------------------------------------------------------------------
@@ -463,7 +463,7 @@ def test_dict_and_file_round_trips_give_identical_predictions(fleet_model, held_
     history = history_of(histories, 102, rows=15)
     d = fleet_model.to_dict()
     text = json.dumps(d, allow_nan=False)  # plain JSON
-    rebuilt = PrognosticsModel.from_dict(json.loads(text))
+    rebuilt = RULModel.from_dict(json.loads(text))
     path = save_prognostics_model(tmp_path / "prognostics.json", fleet_model)
     loaded = load_prognostics_model(path)
     assert rebuilt.to_dict() == d and loaded.to_dict() == d
@@ -502,4 +502,4 @@ def test_truncated_fitted_state_is_refused(fleet_model, tmp_path):
     with pytest.raises(PRSMHealthError, match="malformed prognostics model"):
         load_prognostics_model(path)
     with pytest.raises(ParameterError, match="fitted"):
-        save_prognostics_model(tmp_path / "unfitted.json", PrognosticsModel())
+        save_prognostics_model(tmp_path / "unfitted.json", RULModel())

@@ -1,23 +1,28 @@
 """Fingerprint what users see, to show a refactor changed nothing that was not meant to change.
 
-Runs the installed ``prsm-health`` command (so it works on any layout of the package) and
-prints one SHA-256 digest per behaviour:
+Runs the ``prsm-health`` command line (so it works on any layout of the package) and
+records, per behaviour and per part of it, a SHA-256 digest — and for the JSON parts the
+values, so that a change can be shown key by key:
 
 - ``validate``: ``prsm-health validate --json`` (the papers-vs-model report);
-- ``simulate_parquet`` / ``simulate_mcap``: a seeded ``simulate`` written to Parquet and to
-  MCAP, digested by content (every column's values, units and labels; every MCAP message's
-  topic, log time and data, metadata and attachments), not by file bytes, which carry the
-  writer library's version;
-- ``diagnose_shipped``: the shipped model's ``diagnose --json`` of that MCAP recording.
+- ``simulate_parquet.*`` / ``simulate_mcap.*``: a seeded ``simulate`` written to Parquet and to
+  MCAP, by content: the signal columns / messages (values, log times), the units, the labels,
+  the scenario — not by file bytes, which carry the writer library's version;
+- ``diagnose_shipped.*``: the shipped model's ``diagnose --json`` of that MCAP recording: its
+  numbers (clearance, class, probabilities, indicators, OOD score, observability), its model
+  reference, its warnings.
 
 Usage::
 
-    python tools/release/behaviour_fingerprint.py --out before.json      # on the old commit
-    python tools/release/behaviour_fingerprint.py --compare before.json  # on the new one
+    # on the old commit, e.g. a worktree in /tmp/old (run from outside the new checkout):
+    PYTHONPATH=/tmp/old python tools/release/behaviour_fingerprint.py \
+        --command "python -m prsm_health.cli" --out before.json
+    python tools/release/behaviour_fingerprint.py --compare before.json   # on the new one
 
-``--compare`` exits 1 and names each behaviour whose digest differs. Digests are exact: compare
-runs made on one machine with one set of library versions (a seeded run is reproducible there,
-not across CPUs; docs/formats.md → Reproducibility).
+``--compare`` prints each part that differs (for a JSON part, the keys added, removed and
+changed) and exits 1 if any did. Digests are exact: compare runs made on one machine with one
+set of library versions (a seeded run is reproducible there, not across CPUs;
+docs/formats.md → Reproducibility).
 """
 
 from __future__ import annotations
@@ -38,7 +43,12 @@ SIMULATE = [
 ]  # fmt: skip
 
 
+COMMAND: list[str] = []
+
+
 def _cli() -> list[str]:
+    if COMMAND:
+        return [sys.executable if word == "python" else word for word in COMMAND]
     found = shutil.which("prsm-health") or str(Path(sys.executable).with_name("prsm-health"))
     return [found]
 
@@ -57,63 +67,113 @@ def _digest(chunks) -> str:
     return h.hexdigest()
 
 
-def _parquet_chunks(path: Path):
+def _parquet_parts(path: Path) -> dict:
     import pyarrow.parquet as pq
 
     table = pq.read_table(path)
     meta = table.schema.metadata or {}
-    for key in sorted(meta):
-        if key not in (b"pandas",):
-            yield key + b"=" + meta[key]
+    columns = []
     for name in table.column_names:
-        yield name
-        yield table.column(name).combine_chunks().to_numpy(zero_copy_only=False).tobytes()
+        columns += [name, table.column(name).combine_chunks().to_numpy(zero_copy_only=False)]
+    parts = {"columns": _digest(c.tobytes() if hasattr(c, "tobytes") else c for c in columns)}
+    for key in (b"prsm_health.units", b"prsm_health.labels", b"prsm_health.scenario"):
+        parts[key.decode().removeprefix("prsm_health.")] = json.loads(meta.get(key, b"null"))
+    return parts
 
 
-def _mcap_chunks(path: Path):
+def _mcap_parts(path: Path) -> dict:
     from mcap.reader import make_reader
 
+    messages, metadata, attachments = [], {}, {}
     with open(path, "rb") as f:
         reader = make_reader(f)
         for _schema, channel, message in reader.iter_messages(log_time_order=True):
-            yield channel.topic
-            yield message.log_time
-            yield message.data
+            messages += [channel.topic, message.log_time, message.data]
         for record in reader.iter_metadata():
-            yield record.name
-            yield json.dumps(record.metadata, sort_keys=True)
+            metadata[record.name] = dict(record.metadata)
         for attachment in reader.iter_attachments():
-            yield attachment.name
-            yield attachment.data
+            attachments[attachment.name] = _digest([attachment.data])
+    return {"messages": _digest(messages), "metadata": metadata, "attachments": attachments}
 
 
-def fingerprint() -> dict[str, str]:
+def _diagnosis_parts(text: str) -> dict:
+    answer = json.loads(text)
+    numbers = {
+        k: answer.get(k)
+        for k in (
+            "clearance",
+            "fault_class",
+            "class_probabilities",
+            "class_set",
+            "indicators",
+            "ood_score",
+            "observability",
+        )
+    }
+    return {"numbers": numbers, "model": answer.get("model"), "warnings": answer.get("warnings")}
+
+
+def fingerprint() -> dict:
     out = {"validate": _digest([_run(["validate", "--json"])])}
     with tempfile.TemporaryDirectory() as tmp:
         parquet, mcap = Path(tmp, "run.parquet"), Path(tmp, "run.mcap")
         _run([*SIMULATE, "--out", str(parquet)])
         _run([*SIMULATE, "--out", str(mcap)])
-        out["simulate_parquet"] = _digest(_parquet_chunks(parquet))
-        out["simulate_mcap"] = _digest(_mcap_chunks(mcap))
-        out["diagnose_shipped"] = _digest([_run(["diagnose", str(mcap), "--json"])])
+        for name, parts in (
+            ("simulate_parquet", _parquet_parts(parquet)),
+            ("simulate_mcap", _mcap_parts(mcap)),
+            ("diagnose_shipped", _diagnosis_parts(_run(["diagnose", str(mcap), "--json"]))),
+        ):
+            out.update({f"{name}.{part}": value for part, value in parts.items()})
     return out
+
+
+def _differences(before, now, where: str = "") -> list[str]:
+    """Key-level differences of two JSON values: added, removed, changed."""
+    if isinstance(before, dict) and isinstance(now, dict):
+        lines = []
+        for key in sorted(set(before) | set(now), key=str):
+            at = f"{where}.{key}" if where else str(key)
+            if key not in before:
+                lines.append(f"  added {at} = {json.dumps(now[key])[:120]}")
+            elif key not in now:
+                lines.append(f"  removed {at}")
+            else:
+                lines += _differences(before[key], now[key], at)
+        return lines
+    if before != now:
+        return [f"  changed {where}: {json.dumps(before)[:120]} -> {json.dumps(now)[:120]}"]
+    return []
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", type=Path, help="write the fingerprint to this JSON file")
     parser.add_argument("--compare", type=Path, help="compare with a fingerprint written before")
+    parser.add_argument(
+        "--command",
+        default="prsm-health",
+        help="how to run the command line, e.g. 'python -m prsm_health.cli' for an old checkout "
+        "on PYTHONPATH (default: prsm-health)",
+    )
     args = parser.parse_args()
+    if args.command != "prsm-health":
+        COMMAND[:] = args.command.split()
     now = fingerprint()
-    print(json.dumps(now, indent=2))
+    if not args.compare:
+        print(json.dumps(now, indent=2))
     if args.out:
         args.out.write_text(json.dumps(now, indent=2) + "\n")
     if args.compare:
         before = json.loads(args.compare.read_text())
         changed = [k for k in sorted(set(before) | set(now)) if before.get(k) != now.get(k)]
+        for key in sorted(set(before) | set(now)):
+            if key not in changed:
+                print(f"identical: {key}")
         for key in changed:
             print(f"changed: {key}")
-        print("identical" if not changed else f"{len(changed)} behaviour(s) changed")
+            print("\n".join(_differences(before.get(key), now.get(key))))
+        print("identical" if not changed else f"{len(changed)} part(s) changed")
         return 1 if changed else 0
     return 0
 

@@ -9,7 +9,7 @@
    user's fleet would give (cached beside the dataset as ``<dataset>-diagnoses.parquet``).
 3. Fits the model with :func:`prsm_health.prognostics.fit_prognostics_model` (what
    ``prsm-health train FLEET --target rul`` runs) on the cached histories: a
-   :class:`~prsm_health.prognostics.PrognosticsModel` of the fleet's design (name and
+   :class:`~prsm_health.prognostics.RULModel` of the fleet's design (name and
    fingerprint) fitted on the training units. Its failure threshold is in the units of the
    health indicator, the *diagnosed* clearance: the diagnosed clearance at failure, learnt from
    the training units (:func:`prsm_health.prognostics.diagnosed_threshold`) — the recipe's
@@ -34,7 +34,7 @@ import pandas as pd
 from prsm_health.datasets import Dataset, generate, load_recipe
 from prsm_health.prognostics import (
     DEFAULT_PROGNOSTICS_MODEL,
-    PrognosticsModel,
+    RULModel,
     fit_prognostics_model,
     fleet_histories,
     load_prognostics_model,
@@ -142,7 +142,7 @@ def sensitivity_table(recipe) -> list[str]:
                 )
             table = pd.concat(frames, ignore_index=True)
             train, test = table[table["unit_id"] < 40], table[table["unit_id"] >= 40]
-            model = PrognosticsModel(threshold=spec.failure_clearance, design=recipe.design)
+            model = RULModel(threshold=spec.failure_clearance, design=recipe.design)
             model.fit(train, {u: failure[u] for u in range(40)})
             _, summary = evaluate_units(
                 test, {u: failure[u] for u in range(40, 60)}, model, alpha=ALPHA

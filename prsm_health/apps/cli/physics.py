@@ -14,9 +14,9 @@ from prsm_health.physics.kinematics import (
     defect_frequencies,
     speed_ratios,
 )
+from prsm_health.physics.stiffness.axial import axial_stiffness
 from prsm_health.physics.stiffness.cylinder import ElectricCylinder, cylinder_deformation
 from prsm_health.physics.stiffness.gear_mesh import mesh_stiffness
-from prsm_health.physics.stiffness.thread import axial_stiffness
 from prsm_health.simulation.instrumentation import list_profiles, load_instrumentation
 from prsm_health.validation import _fmt, collect, summary, to_markdown
 

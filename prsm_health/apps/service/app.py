@@ -69,7 +69,7 @@ def create_app(
         Prognostics model (:func:`prsm_health.prognostics.rul.save_prognostics_model`) for
         ``GET /v1/assets/{asset_id}/prognosis``, loaded once, here. None: the shipped
         ``models/prognostics.json`` if it exists, else none (that endpoint answers 503).
-    prognostics_model : PrognosticsModel or None
+    prognostics_model : RULModel or None
         An already loaded model (overrides ``prognostics_model_path``).
 
     Raises
@@ -149,7 +149,7 @@ def _load_prognostics_model(path, model):
         what = str(path)
     else:
         what = "the prognostics model given"
-    if not isinstance(model, prognostics.PrognosticsModel) or not hasattr(model, "form_"):
+    if not isinstance(model, prognostics.RULModel) or not hasattr(model, "form_"):
         raise PRSMHealthError(f"{what}: not a fitted prognostics model")
     return model
 

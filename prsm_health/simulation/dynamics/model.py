@@ -248,7 +248,7 @@ def _thread_laws(
     design: PRSMDesign, roller_load: float, law: str
 ) -> tuple[list[float], list[float]]:
     """Per roller side: the law coefficient for the kernel and the tangent stiffness [N/m]."""
-    from prsm_health.physics.stiffness.thread import roller_side_force, roller_side_stiffness
+    from prsm_health.physics.stiffness.thread_load import roller_side_force, roller_side_stiffness
 
     coefficients, tangents = [], []
     for side in ("screw", "nut"):

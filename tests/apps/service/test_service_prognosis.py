@@ -36,7 +36,7 @@ from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import load_bundle
 from prsm_health.io.arrow import write_run_arrow
 from prsm_health.io.parquet import write_run_parquet
-from prsm_health.prognostics import PrognosticsModel, prognose, save_prognostics_model
+from prsm_health.prognostics import RULModel, prognose, save_prognostics_model
 
 TOKEN = "prognosis-token-81c2"
 Z90 = 1.6448536269514722
@@ -100,7 +100,7 @@ def model_file(tmp_path_factory):
             )
         )
         lives[uid] = life
-    model = PrognosticsModel(n_samples=2000).fit(pd.concat(parts, ignore_index=True), lives)
+    model = RULModel(n_samples=2000).fit(pd.concat(parts, ignore_index=True), lives)
     return save_prognostics_model(tmp_path_factory.mktemp("prognostics") / "model.json", model)
 
 
@@ -371,7 +371,7 @@ def test_no_prognostics_model_is_503(bundle, monkeypatch, tmp_path):
             warmup=False,
             prognostics_model_path=tmp_path / "bad.json",
         )
-    unfitted = PrognosticsModel()
+    unfitted = RULModel()
     with pytest.raises(PRSMHealthError, match="not a fitted prognostics model"):
         create_app(None, ":memory:", bundle=bundle, warmup=False, prognostics_model=unfitted)
 

@@ -1,5 +1,4 @@
-"""Thread contact geometry, load distribution and PRSM axial stiffness (stiffness/thread.py
-and the modules it re-exports: thread_geometry, thread_compliance, thread_load, clearance,
+"""Thread contact geometry, load distribution and PRSM axial stiffness (stiffness/: thread_geometry, thread_compliance, thread_load, clearance,
 axial).
 
 Checks are against closed forms (paper 05's curvatures, Yamamoto's tooth terms), independent
@@ -17,7 +16,29 @@ from scipy.integrate import quad
 
 from prsm_health.actuator.design import preset
 from prsm_health.core.errors import ConvergenceError, ParameterError
-from prsm_health.physics.stiffness import thread as th
+from prsm_health.physics.stiffness._thread_inputs import SIDES
+from prsm_health.physics.stiffness.axial import axial_stiffness
+from prsm_health.physics.stiffness.clearance import eccentricity_to_gaps, radial_to_axial_gap
+from prsm_health.physics.stiffness.thread_compliance import (
+    body_compliances,
+    shaft_stiffness,
+    tooth_compliances,
+    tooth_geometry,
+)
+from prsm_health.physics.stiffness.thread_geometry import (
+    helical_surface_curvature,
+    normal_load,
+    thread_contact_geometry,
+    thread_contacts,
+    thread_surface_curvatures,
+)
+from prsm_health.physics.stiffness.thread_load import (
+    roller_side_force,
+    roller_side_power_law,
+    roller_side_stiffness,
+    thread_load_distribution,
+    thread_pair_deflection,
+)
 from prsm_health.validation import NOT_REPRODUCED, REPRODUCED
 from prsm_health.validation import paper04 as v04
 
@@ -40,7 +61,7 @@ def _roller_lower_flank(design, lead):
 
 def test_fundamental_forms_against_closed_form_and_finite_differences():
     surface, rho, fp, fpp = _roller_lower_flank(P01, P01.roller_lead)
-    s = th.helical_surface_curvature(rho, P01.roller_lead, fp, fpp, theta=math.pi, material="above")
+    s = helical_surface_curvature(rho, P01.roller_lead, fp, fpp, theta=math.pi, material="above")
     h = P01.roller_lead / (2 * math.pi)
     w = math.sqrt(rho**2 * (1 + fp**2) + h**2)
     # Closed forms for r = (ρ cos θ, ρ sin θ, hθ + f): E = ρ² + h², F = h f', G = 1 + f'²;
@@ -76,7 +97,7 @@ def test_principal_curvatures_against_height_function_fit(design):
     # principal curvatures as eigenvalues. Patch ±0.4 % of ρ: the neglected quartic terms
     # change the fitted Hessian by ~(patch/ρ)² ≈ 1e-5 relative; 1e-3 leaves margin.
     surface, rho, _, _ = _roller_lower_flank(design, design.roller_lead)
-    s = th.thread_surface_curvatures(design)["roller_screw_side"]
+    s = thread_surface_curvatures(design)["roller_screw_side"]
     p0 = surface(math.pi, rho)
     n_in = -s.normal
     e1 = s.directions[0]
@@ -96,7 +117,7 @@ def test_principal_curvatures_against_height_function_fit(design):
 
 
 def test_gaussian_and_mean_curvature_paper04_formulas():
-    for s in th.thread_surface_curvatures(P01).values():
+    for s in thread_surface_curvatures(P01).values():
         k1, k2 = s.principal
         # Paper 04: κ1,2 = H ± √(H² − K) (its H has the opposite normal, hence the sign).
         assert k1 == pytest.approx(s.mean + math.sqrt(s.mean**2 - s.gaussian), rel=1e-9, abs=1e-9)
@@ -108,7 +129,7 @@ def test_gaussian_and_mean_curvature_paper04_formulas():
 def test_curvatures_match_paper05_closed_forms_small_lead():
     d = P04
     beta = d.contact_angle
-    surf = th.thread_surface_curvatures(d)
+    surf = thread_surface_curvatures(d)
     lam_s, lam_n = d.screw_lead_angle, d.nut_lead_angle
     roller = 2 * math.cos(beta) / d.roller_diameter
     screw = 2 * math.cos(beta) / (d.screw_diameter * math.cos(lam_s))
@@ -135,14 +156,14 @@ def test_zero_lead_reproduces_paper05_exactly_and_split_is_linear_in_lead():
     root = math.sqrt(big_r**2 - r**2)
     splits = []
     for lead in (0.0, 1e-4, 2e-4):
-        s = th.helical_surface_curvature(
+        s = helical_surface_curvature(
             r, lead, r / root, big_r**2 / root**3, theta=math.pi, material="above"
         )
         splits.append(s.principal[0] - s.principal[1])
         if lead == 0.0:
             # Surfaces of revolution: paper 05's forms are exact.
             assert s.principal == pytest.approx((math.cos(beta) / r,) * 2, rel=1e-12)
-    screw = th.helical_surface_curvature(10e-3, 0.0, -1.0, 0.0, material="below")
+    screw = helical_surface_curvature(10e-3, 0.0, -1.0, 0.0, material="below")
     assert screw.principal == pytest.approx((math.cos(beta) / 10e-3, 0.0), rel=1e-12, abs=1e-12)
     # Doubling a small lead doubles the split (first order), to the O(λ²) remainder (1 %).
     assert splits[2] / splits[1] == pytest.approx(2.0, rel=1e-2)
@@ -150,7 +171,7 @@ def test_zero_lead_reproduces_paper05_exactly_and_split_is_linear_in_lead():
 
 def test_contact_normals_and_angle():
     for d in (P04, P01):
-        s, n = th.thread_contact_geometry(d)
+        s, n = thread_contact_geometry(d)
         # Roller and nut share the lead angle: the nominal point is a true contact point.
         assert n.normal_misalignment < 1e-12
         # Screw side: same-hand helices tilt the normals apart by ≈ sinβ(tanλ_s + tanλ_r)
@@ -169,14 +190,14 @@ def test_contact_normals_and_angle():
 
 # ============================================================================ contact laws
 def test_hertz_exponent_and_axial_projection():
-    for contact in th.thread_contacts(P04):
+    for contact in thread_contacts(P04):
         # Per contact δ ∝ Q^(2/3) exactly.
         q = np.array([10.0, 20.0, 1000.0])
         d = contact.deflection(q)
         assert np.log(d[1] / d[0]) / np.log(2.0) == pytest.approx(2 / 3, rel=1e-12)
-    geo_s, _ = th.thread_contact_geometry(P04)
+    geo_s, _ = thread_contact_geometry(P04)
     fa = 150.0
-    q = th.normal_load(P04, fa, "screw")
+    q = normal_load(P04, fa, "screw")
     assert q == pytest.approx(
         fa / (math.sin(P04.contact_angle) * math.cos(P04.screw_lead_angle)), rel=1e-15
     )
@@ -189,10 +210,10 @@ def test_hertz_exponent_and_axial_projection():
 @pytest.mark.parametrize("beta_deg", [30.0, 45.0, 60.0])
 def test_yamamoto_bending_and_shear_against_quadrature(beta_deg):
     d = P04.with_(contact_angle=math.radians(beta_deg))
-    g = th.tooth_geometry(d)
+    g = tooth_geometry(d)
     a, b, c, phi = g["a"], g["b"], g["c"], g["flank_angle"]
     nu, e = d.screw_material.poisson_ratio, d.screw_material.youngs_modulus
-    t = th.tooth_compliances(d)["screw"]
+    t = tooth_compliances(d)["screw"]
     scale = e * t.load_length
     tan_p = math.tan(phi)
 
@@ -218,7 +239,7 @@ def test_yamamoto_terms_equal_paper05_gammas_for_45deg_v_thread():
     # line load W (cylinder.py documents that reading): E·ℓ·δ_k/W equals the brackets below.
     d = P04
     nu = d.screw_material.poisson_ratio
-    t = th.tooth_compliances(d)["screw"]
+    t = tooth_compliances(d)["screw"]
     scale = d.screw_material.youngs_modulus * t.load_length
     assert t.bending * scale == pytest.approx(
         (1 - nu**2) * 3 * (4 * math.log(2) - 3) / 8, rel=1e-12
@@ -233,7 +254,7 @@ def test_yamamoto_terms_equal_paper05_gammas_for_45deg_v_thread():
 # ============================================================================ distribution
 def test_load_distribution_equilibrium_and_first_thread():
     loads = np.array([5.0, 1000 / 7, 2e4])
-    ld = th.thread_load_distribution(P01, loads)
+    ld = thread_load_distribution(P01, loads)
     for side in (ld.screw, ld.nut):
         assert np.allclose(side.sum(axis=1), loads, rtol=1e-9, atol=0)
         assert np.all(np.argmax(side, axis=1) == 0)
@@ -241,11 +262,11 @@ def test_load_distribution_equilibrium_and_first_thread():
 
 
 def test_load_distribution_satisfies_compatibility():
-    ld = th.thread_load_distribution(P01, 3000.0, body_scale=20.0)  # strongly non-uniform
-    bodies = {k: 20.0 * v for k, v in th.body_compliances(P01).items()}
+    ld = thread_load_distribution(P01, 3000.0, body_scale=20.0)  # strongly non-uniform
+    bodies = {k: 20.0 * v for k, v in body_compliances(P01).items()}
     q_s, q_n = ld.screw, ld.nut
-    u_s = th.thread_pair_deflection(P01, q_s, "screw")
-    u_n = th.thread_pair_deflection(P01, q_n, "nut")
+    u_s = thread_pair_deflection(P01, q_s, "screw")
+    u_n = thread_pair_deflection(P01, q_n, "nut")
     beyond_s = q_s.sum() - np.cumsum(q_s)[:-1]  # Σ_{k>j} Q_k
     beyond_n = q_n.sum() - np.cumsum(q_n)[:-1]
     rhs_s = (bodies["screw"] + bodies["roller"]) * beyond_s - bodies["roller"] * beyond_n
@@ -261,14 +282,12 @@ def test_load_distribution_satisfies_compatibility():
 def test_rigid_bodies_give_uniform_sharing():
     w = 1000.0
     n = P01.engaged_threads
-    rigid = th.thread_load_distribution(P01, w, body_scale=0.0)
+    rigid = thread_load_distribution(P01, w, body_scale=0.0)
     assert np.all(rigid.screw == w / n) and np.all(rigid.nut == w / n)
-    uniform = th.thread_load_distribution(P01, w, combination="uniform")
+    uniform = thread_load_distribution(P01, w, combination="uniform")
     assert np.array_equal(uniform.screw, rigid.screw)
     # Limit: the spread of the distributed solution vanishes linearly with the body compliance.
-    spreads = [
-        np.ptp(th.thread_load_distribution(P01, w, body_scale=s).screw) for s in (1e-2, 1e-3)
-    ]
+    spreads = [np.ptp(thread_load_distribution(P01, w, body_scale=s).screw) for s in (1e-2, 1e-3)]
     assert spreads[1] < spreads[0] and spreads[1] / (w / n) < 1e-3
     assert spreads[0] / spreads[1] == pytest.approx(10.0, rel=1e-2)
 
@@ -276,28 +295,28 @@ def test_rigid_bodies_give_uniform_sharing():
 def test_paper01_series_reading():
     w = 1000 / 7
     n = P01.engaged_threads
-    series = th.thread_load_distribution(P01, w, combination="paper01_series")
+    series = thread_load_distribution(P01, w, combination="paper01_series")
     assert np.all(series.screw == w)  # series springs all carry the roller load
-    bodies = th.body_compliances(P01)
+    bodies = body_compliances(P01)
     expected = n * (
-        th.thread_pair_deflection(P01, w, "screw") + (bodies["screw"] + bodies["roller"]) * w
+        thread_pair_deflection(P01, w, "screw") + (bodies["screw"] + bodies["roller"]) * w
     )
     assert series.screw_deflection == pytest.approx(expected, rel=1e-12)
-    dist = th.thread_load_distribution(P01, w)
+    dist = thread_load_distribution(P01, w)
     # Contact part alone is n^(5/3) = 46× softer in series; the whole side well over n×.
     assert series.screw_stiffness < dist.screw_stiffness / n
 
 
 # ============================================================================ mechanism
 def test_paper04_order_of_magnitude():
-    k = th.axial_stiffness(P04, 10e3).secant_stiffness
+    k = axial_stiffness(P04, 10e3).secant_stiffness
     # Notes: 150–800 N/µm at 10 kN for such sizes (model gives ≈ 237 N/µm).
     assert 150e6 < k < 800e6
 
 
 def test_stiffness_sublinear_in_load_and_tangent():
     loads = np.array([1e3, 1e4, 2e4, 5e4, 7e4])
-    r = th.axial_stiffness(P04, loads)
+    r = axial_stiffness(P04, loads)
     ks = r.secant_stiffness
     assert np.all(np.diff(ks) > 0)
     # Hertz (δ ∝ F^(2/3)) + linear springs: secant grows at most as F^(1/3).
@@ -309,21 +328,21 @@ def test_stiffness_sublinear_in_load_and_tangent():
         2
         * h
         / (
-            th.axial_stiffness(P04, loads + h).deformation
-            - th.axial_stiffness(P04, loads - h).deformation
+            axial_stiffness(P04, loads + h).deformation
+            - axial_stiffness(P04, loads - h).deformation
         )
     )
     assert np.allclose(r.tangent_stiffness, fd, rtol=1e-6)
     parts = r.deformation_split
     assert np.allclose(sum(parts.values()), r.deformation, rtol=1e-12)
     assert np.all(parts["gaps"] == 0)
-    zero = th.axial_stiffness(P04, 0.0)
+    zero = axial_stiffness(P04, 0.0)
     assert zero.deformation == 0 and zero.secant_stiffness == 0 and zero.tangent_stiffness == 0
 
 
 def test_scalar_and_array_loads_agree():
-    r = th.axial_stiffness(P04, [1e4, 2e4])
-    s = th.axial_stiffness(P04, 2e4)
+    r = axial_stiffness(P04, [1e4, 2e4])
+    s = axial_stiffness(P04, 2e4)
     # the same equations; numpy's vectorised and scalar paths may round the last bit apart
     # (seen 1 ulp on this machine), so agreement to 1e-12, not bitwise
     assert s.secant_stiffness == pytest.approx(r.secant_stiffness[1], rel=1e-12)
@@ -334,14 +353,14 @@ def test_scalar_and_array_loads_agree():
 def test_stiffness_rises_with_roller_count_sublinearly():
     load = 2e4
     counts = (5, 7, 9, 11)
-    k = [th.axial_stiffness(P04.with_(n_rollers=n), load).secant_stiffness for n in counts]
+    k = [axial_stiffness(P04.with_(n_rollers=n), load).secant_stiffness for n in counts]
     assert np.all(np.diff(k) > 0)
     # Bound: contact stiffens as n_R^(2/3); shaft, nut dilation and screw/nut teeth do not
     # change with n_R (only the tiny roller-tooth term falls faster, as 1/n_R).
     assert k[-1] / k[0] <= (counts[-1] / counts[0]) ** (2 / 3)
     # The contact part alone scales exactly as n_R^(-2/3) when the threads share uniformly.
     c = [
-        th.axial_stiffness(P04.with_(n_rollers=n), load, combination="uniform").deformation_split[
+        axial_stiffness(P04.with_(n_rollers=n), load, combination="uniform").deformation_split[
             "contact"
         ]
         for n in (5, 11)
@@ -351,7 +370,7 @@ def test_stiffness_rises_with_roller_count_sublinearly():
 
 def test_stiffness_rises_with_contact_angle():
     k = [
-        th.axial_stiffness(P04.with_(contact_angle=math.radians(b)), 1e4).secant_stiffness
+        axial_stiffness(P04.with_(contact_angle=math.radians(b)), 1e4).secant_stiffness
         for b in (30, 45, 60)
     ]
     assert k[0] < k[1] < k[2]
@@ -359,9 +378,9 @@ def test_stiffness_rises_with_contact_angle():
 
 def test_zero_and_equal_gaps_reproduce_the_ideal_case_exactly():
     loads = np.array([0.0, 500.0, 5e3])
-    ideal = th.axial_stiffness(P01, loads)
+    ideal = axial_stiffness(P01, loads)
     for gaps in (np.zeros(7), np.full(7, 5e-6)):
-        r = th.axial_stiffness(P01, loads, roller_gaps=gaps)
+        r = axial_stiffness(P01, loads, roller_gaps=gaps)
         for name in (
             "deformation",
             "secant_stiffness",
@@ -371,15 +390,15 @@ def test_zero_and_equal_gaps_reproduce_the_ideal_case_exactly():
         ):
             assert np.array_equal(getattr(r, name), getattr(ideal, name))
     assert np.array_equal(
-        th.axial_stiffness(P01, loads, eccentricity=0.0).deformation, ideal.deformation
+        axial_stiffness(P01, loads, eccentricity=0.0).deformation, ideal.deformation
     )
 
 
 def test_uneven_gaps_and_eccentricity_reduce_stiffness():
     loads = np.array([300.0, 3e3])
-    ideal = th.axial_stiffness(P01, loads)
+    ideal = axial_stiffness(P01, loads)
     gaps = np.array([0, 2, 4, 6, 8, 10, 12]) * 1e-6
-    r = th.axial_stiffness(P01, loads, roller_gaps=gaps)
+    r = axial_stiffness(P01, loads, roller_gaps=gaps)
     assert np.all(r.secant_stiffness < ideal.secant_stiffness)
     assert np.all(r.tangent_stiffness < ideal.tangent_stiffness)
     assert np.allclose(r.roller_loads.sum(axis=1), loads, rtol=1e-10)
@@ -389,7 +408,7 @@ def test_uneven_gaps_and_eccentricity_reduce_stiffness():
         assert np.ptp(row_d[on] + gaps[on]) < 1e-9 * row_d.max()
         assert np.all(row_d[~on] == 0) and np.all(gaps[~on] >= gaps[on].max())
     assert np.allclose(sum(r.deformation_split.values()), r.deformation, rtol=1e-12)
-    e = th.axial_stiffness(P01, loads, eccentricity=10e-6)
+    e = axial_stiffness(P01, loads, eccentricity=10e-6)
     assert np.all(e.secant_stiffness < ideal.secant_stiffness)
 
 
@@ -397,73 +416,71 @@ def test_far_roller_carries_nothing_and_others_share_equally():
     load = 2000.0
     gaps = np.zeros(7)
     gaps[3] = 1e-3  # far beyond any approach at 2 kN
-    r = th.axial_stiffness(P01, load, roller_gaps=gaps)
+    r = axial_stiffness(P01, load, roller_gaps=gaps)
     assert r.roller_loads[3] == 0.0
     others = np.delete(r.roller_loads, 3)
     assert np.allclose(others, load / 6, rtol=1e-10)
     # Δ equals one roller's approach at F/6 (independent load-controlled solve) + shaft.
-    one = th.thread_load_distribution(P01, load / 6)
-    expected = one.screw_deflection + one.nut_deflection + load / th.shaft_stiffness(P01)
+    one = thread_load_distribution(P01, load / 6)
+    expected = one.screw_deflection + one.nut_deflection + load / shaft_stiffness(P01)
     assert r.deformation == pytest.approx(expected, rel=1e-10)
 
 
 def test_radial_to_axial_gap_and_eccentricity():
     d = P01
     lam = 0.5 * (1 / math.cos(d.screw_lead_angle) + 1 / math.cos(d.nut_lead_angle))
-    assert th.radial_to_axial_gap(d, 1e-5) == pytest.approx(
+    assert radial_to_axial_gap(d, 1e-5) == pytest.approx(
         1e-5 * lam / math.tan(d.contact_angle), rel=1e-14
     )
-    gaps = th.eccentricity_to_gaps(d, 10e-6)
+    gaps = eccentricity_to_gaps(d, 10e-6)
     assert gaps.min() == 0.0 and gaps[0] == 0.0  # roller 0 faces the offset
     # Rollers at 2πi/7: room changes from −e (i = 0) to +e·cos(π/7) (i = 3, 4).
     assert np.ptp(gaps) == pytest.approx(
-        th.radial_to_axial_gap(d, 10e-6) * (1 + math.cos(math.pi / 7)), rel=1e-12
+        radial_to_axial_gap(d, 10e-6) * (1 + math.cos(math.pi / 7)), rel=1e-12
     )
     assert np.allclose(gaps[1:], gaps[1:][::-1])  # symmetric about the offset direction
 
 
 # ============================================================================ simulator API
-@pytest.mark.parametrize("side", th.SIDES)
+@pytest.mark.parametrize("side", SIDES)
 def test_roller_side_force_inverts_the_distribution(side):
     w = np.array([1.0, 50.0, 2000.0])
-    ld = th.thread_load_distribution(P01, w)
+    ld = thread_load_distribution(P01, w)
     defl = getattr(ld, f"{side}_deflection")
-    assert np.allclose(th.roller_side_force(P01, defl, side), w, rtol=1e-10)
-    assert np.all(th.roller_side_force(P01, np.array([-1e-6, 0.0]), side) == 0.0)
+    assert np.allclose(roller_side_force(P01, defl, side), w, rtol=1e-10)
+    assert np.all(roller_side_force(P01, np.array([-1e-6, 0.0]), side) == 0.0)
     # Tangent stiffness against central differences of the force law (step 1e-6·δ).
     h = 1e-6 * defl
-    fd = (th.roller_side_force(P01, defl + h, side) - th.roller_side_force(P01, defl - h, side)) / (
-        2 * h
-    )
-    assert np.allclose(th.roller_side_stiffness(P01, w, side), fd, rtol=1e-6)
-    assert th.roller_side_stiffness(P01, 0.0, side) == 0.0
+    fd = (roller_side_force(P01, defl + h, side) - roller_side_force(P01, defl - h, side)) / (2 * h)
+    assert np.allclose(roller_side_stiffness(P01, w, side), fd, rtol=1e-6)
+    assert roller_side_stiffness(P01, 0.0, side) == 0.0
 
 
 def test_sides_in_series_reproduce_the_mechanism_roller_law():
     f = 1000.0
     w = f / P01.n_rollers
-    r = th.axial_stiffness(P01, f)
-    ld = th.thread_load_distribution(P01, w)
+    r = axial_stiffness(P01, f)
+    ld = thread_load_distribution(P01, w)
     assert r.roller_deflections[0] == pytest.approx(
         ld.screw_deflection + ld.nut_deflection, rel=1e-12
     )
     k_roller = 1 / (
-        1 / th.roller_side_stiffness(P01, w, "screw") + 1 / th.roller_side_stiffness(P01, w, "nut")
+        1 / roller_side_stiffness(P01, w, "screw") + 1 / roller_side_stiffness(P01, w, "nut")
     )
-    k_total = 1 / (1 / (P01.n_rollers * k_roller) + 1 / th.shaft_stiffness(P01))
+    k_total = 1 / (1 / (P01.n_rollers * k_roller) + 1 / shaft_stiffness(P01))
     assert r.tangent_stiffness == pytest.approx(k_total, rel=1e-9)
 
 
 def test_power_law_fit():
     lo, hi = 100 / 7, 1000 / 7
-    for side in th.SIDES:
-        fit = th.roller_side_power_law(P01, side, (lo, hi))
+    for side in SIDES:
+        fit = roller_side_power_law(P01, side, (lo, hi))
         c, n, err = fit
         # Hertz alone: 1.5; linear teeth/bodies in series lower it (F = cδ^n with n < 1.5).
         assert 1.3 < n < 1.5
         assert err < 0.01
         w = np.geomspace(lo, hi, 7)
-        defl = getattr(th.thread_load_distribution(P01, w), f"{side}_deflection")
+        defl = getattr(thread_load_distribution(P01, w), f"{side}_deflection")
         assert np.all(np.abs(c * defl**n / w - 1) <= err * (1 + 1e-9) + 1e-12)
 
 
@@ -477,24 +494,24 @@ def test_paper01_per_roller_side_stiffness_regression():
         (1000 / 7, "nut"): 9.374e7,
     }
     for (w, side), k in expected.items():
-        assert th.roller_side_stiffness(P01, w, side) == pytest.approx(k, rel=1e-3)
+        assert roller_side_stiffness(P01, w, side) == pytest.approx(k, rel=1e-3)
 
 
 # ============================================================================ errors
 @pytest.mark.parametrize(
     ("call", "field"),
     [
-        (lambda: th.axial_stiffness(P01, -1.0), "load"),
-        (lambda: th.axial_stiffness(P01, [1.0, float("nan")]), "load"),
-        (lambda: th.axial_stiffness(P01, 1.0, roller_gaps=[-1e-6] * 7), "roller_gaps"),
-        (lambda: th.axial_stiffness(P01, 1.0, roller_gaps=[0.0] * 6), "roller_gaps"),
-        (lambda: th.axial_stiffness(P01, 1.0, eccentricity=-1e-6), "eccentricity"),
-        (lambda: th.axial_stiffness(P01, 1.0, combination="series"), "combination"),
-        (lambda: th.roller_side_force(P01, 1e-6, "roller"), "side"),
-        (lambda: th.roller_side_stiffness(P01, -5.0, "nut"), "roller_axial_load"),
-        (lambda: th.roller_side_power_law(P01, "nut", (10.0, 1.0)), "load_range"),
-        (lambda: th.thread_load_distribution(P01, 1.0, body_scale=-1.0), "body_scale"),
-        (lambda: th.radial_to_axial_gap(P01, "x"), "radial_offset"),
+        (lambda: axial_stiffness(P01, -1.0), "load"),
+        (lambda: axial_stiffness(P01, [1.0, float("nan")]), "load"),
+        (lambda: axial_stiffness(P01, 1.0, roller_gaps=[-1e-6] * 7), "roller_gaps"),
+        (lambda: axial_stiffness(P01, 1.0, roller_gaps=[0.0] * 6), "roller_gaps"),
+        (lambda: axial_stiffness(P01, 1.0, eccentricity=-1e-6), "eccentricity"),
+        (lambda: axial_stiffness(P01, 1.0, combination="series"), "combination"),
+        (lambda: roller_side_force(P01, 1e-6, "roller"), "side"),
+        (lambda: roller_side_stiffness(P01, -5.0, "nut"), "roller_axial_load"),
+        (lambda: roller_side_power_law(P01, "nut", (10.0, 1.0)), "load_range"),
+        (lambda: thread_load_distribution(P01, 1.0, body_scale=-1.0), "body_scale"),
+        (lambda: radial_to_axial_gap(P01, "x"), "radial_offset"),
     ],
 )
 def test_errors_name_the_field(call, field):
@@ -510,25 +527,14 @@ def test_newton_failure_is_a_convergence_error(monkeypatch):
         ConvergenceError,
         match=r"thread load distribution: Newton .* roller load W = \[5, 2000\] N .*'paper01'",
     ):
-        th.thread_load_distribution(P01, [5.0, 2000.0])
+        thread_load_distribution(P01, [5.0, 2000.0])
 
 
 def test_common_approach_failure_is_a_convergence_error(monkeypatch):
     axial = importlib.import_module("prsm_health.physics.stiffness.axial")
     monkeypatch.setattr(axial, "_APPROACH_MAXITER", 0)
     with pytest.raises(ConvergenceError, match=r"common approach .* F = 1000 N with roller gaps"):
-        th.axial_stiffness(P04, 1000.0, eccentricity=5e-6)
-
-
-# ============================================================================ layout
-def test_front_reexports_every_public_name():
-    for sub in ("thread_geometry", "thread_compliance", "thread_load", "clearance", "axial"):
-        module = importlib.import_module(f"prsm_health.physics.stiffness.{sub}")
-        for name in dir(module):
-            obj = getattr(module, name)
-            if not name.startswith("_") and getattr(obj, "__module__", None) == module.__name__:
-                assert getattr(th, name) is obj, name
-                assert name in th.__all__, name
+        axial_stiffness(P04, 1000.0, eccentricity=5e-6)
 
 
 # ============================================================================ validation

@@ -19,7 +19,7 @@ from prsm_health import (
     speed_ratios,
 )
 from prsm_health.actuator.drive_train import DriveTrain
-from prsm_health.physics.stiffness.thread import roller_side_stiffness
+from prsm_health.physics.stiffness.thread_load import roller_side_stiffness
 from prsm_health.signals.spectra import amplitude_spectrum, dominant_frequency
 from prsm_health.simulation.dynamics.model import build_model
 from prsm_health.simulation.dynamics.simulate import linearised_eigenvalues, max_stable_step

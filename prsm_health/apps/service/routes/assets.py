@@ -11,7 +11,7 @@ from fastapi import Path as PathParam
 from ..history import HistoryStore
 from ..responses import HTTPError, encode, json_response
 from ..schemas import ASSET_ID_PATTERN, AssetList, AssetSummary, Error, Spectra
-from .deps import Limits, PrognosticsModel, Store
+from .deps import Limits, RULModel, Store
 from .history import bounded_limit
 from .prognosis import asset_prognosis
 
@@ -49,7 +49,7 @@ async def get_assets(
     request: Request,
     store: Store,
     limits: Limits,
-    model: PrognosticsModel,
+    model: RULModel,
     limit: Annotated[int, Query(ge=1, description="the N most recently seen assets")] = 100,
     prognosis: Annotated[bool, _PROGNOSIS] = False,
 ):
@@ -80,7 +80,7 @@ async def get_assets(
 async def get_asset(
     asset_id: Annotated[str, PathParam(pattern=ASSET_ID_PATTERN)],
     store: Store,
-    model: PrognosticsModel,
+    model: RULModel,
     prognosis: Annotated[bool, _PROGNOSIS] = False,
 ):
     """What `GET /v1/assets` lists for this asset."""

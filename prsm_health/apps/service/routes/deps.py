@@ -5,7 +5,7 @@ from typing import Annotated
 from fastapi import Depends, Request
 
 from prsm_health.diagnostics.diagnosis import ModelBundle
-from prsm_health.prognostics import PrognosticsModel as _PrognosticsModel
+from prsm_health.prognostics import RULModel as _PrognosticsModel
 
 from ..history import HistoryStore
 from ..limits import ServiceLimits
@@ -39,7 +39,7 @@ Bundle = Annotated[ModelBundle, Depends(get_bundle)]
 #: The history database.
 Store = Annotated[HistoryStore, Depends(get_store)]
 #: The prognostics model (None: none loaded).
-PrognosticsModel = Annotated[_PrognosticsModel | None, Depends(get_prognostics)]
+RULModel = Annotated[_PrognosticsModel | None, Depends(get_prognostics)]
 #: The service's limits.
 Limits = Annotated[ServiceLimits, Depends(get_limits)]
 #: The worker pool diagnoses run in (and the admission counter).

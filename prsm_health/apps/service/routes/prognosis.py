@@ -13,7 +13,7 @@ from prsm_health.prognostics import METHODS, HistoryError, prognose
 from ..history import HistoryStore, prognosis_history
 from ..responses import HTTPError, encode, json_response
 from ..schemas import ASSET_ID_PATTERN, Error, Prognosis
-from .deps import PrognosticsModel, Store
+from .deps import RULModel, Store
 
 router = APIRouter()
 
@@ -65,7 +65,7 @@ def asset_prognosis(store: HistoryStore, model, asset_id: str, method: str | Non
 async def get_prognosis(
     asset_id: Annotated[str, PathParam(pattern=ASSET_ID_PATTERN)],
     store: Store,
-    model: PrognosticsModel,
+    model: RULModel,
     method: Annotated[
         Literal[METHODS] | None,  # type: ignore[valid-type]
         Query(
