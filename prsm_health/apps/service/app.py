@@ -66,7 +66,7 @@ def create_app(
         Diagnose a blank recording in the background at start-up, so the first request does
         not pay for one-time compilation and caches.
     prognostics_model_path : path or None
-        Prognostics model (:func:`prsm_health.prognostics.rul.save_prognostics_model`) for
+        Prognostics model (:func:`prsm_health.prognostics.save_prognostics_model`) for
         ``GET /v1/assets/{asset_id}/prognosis``, loaded once, here. None: the shipped
         ``models/prognostics.json`` if it exists, else none (that endpoint answers 503).
     prognostics_model : RULModel or None

@@ -545,7 +545,7 @@ def spectra_row(
 
 def prognosis_history(rows: list[OperatingRow]):
     """The history table a prognosis is made from
-    (:func:`prsm_health.prognostics.rul.prognose`), from :meth:`HistoryStore.operating_history`
+    (:func:`prsm_health.prognostics.prognose`), from :meth:`HistoryStore.operating_history`
     rows, and notes on the rows left out.
 
     ``age_hours`` is the stored operating hours; ``clearance``, ``clearance_lower``,

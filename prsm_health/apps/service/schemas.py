@@ -246,7 +246,7 @@ class PrognosisModel(BaseModel):
 
 
 class Prognosis(BaseModel):
-    """Remaining useful life of an asset (``prsm_health.prognostics.rul.Prognosis.as_dict``)."""
+    """Remaining useful life of an asset (``prsm_health.prognostics.Prognosis.as_dict``)."""
 
     rul_hours: RulHours
     health_indicator: HealthIndicator

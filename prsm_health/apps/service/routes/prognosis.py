@@ -1,6 +1,6 @@
 """``GET /v1/assets/{asset_id}/prognosis``: the asset's stored diagnoses with operating hours
 as a history (:func:`~..history.prognosis_history`) → the library's prognosis
-(:func:`prsm_health.prognostics.rul.prognose`) with the service's prognostics model."""
+(:func:`prsm_health.prognostics.prognose`) with the service's prognostics model."""
 
 from typing import Annotated, Literal
 
@@ -19,7 +19,7 @@ router = APIRouter()
 
 NO_MODEL = (
     "no prognostics model loaded: start the service with --prognostics-model FILE (a model "
-    "saved by prsm_health.prognostics.rul.save_prognostics_model; default models/prognostics.json)"
+    "saved by prsm_health.prognostics.save_prognostics_model; default models/prognostics.json)"
 )
 
 
