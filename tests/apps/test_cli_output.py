@@ -39,7 +39,7 @@ def test_diagnose_says_of_what_the_observability_is_a_share(capsys):
         class_probabilities={"wear": 0.8, "healthy": 0.2},
         observability={"clearance": 1.0, "fault": 0.5},
         ood_score=0.4,
-        windows=[None] * 4,
+        windows=[SimpleNamespace(ood_score=0.4)] * 4,
         model={"name": "m", "version": "1"},
         warnings=[],
     )
@@ -88,3 +88,22 @@ def test_train_says_its_macro_f1_is_the_classifiers_alone(capsys):
     assert lines[cv].endswith(" 0.6")
     assert lines["fault held-out macro-F1 (the classifier alone: no cannot_tell)"].endswith("–")
     assert lines["clearance held-out 90 % interval coverage"].endswith("in 85 % of runs")
+
+
+def test_the_ood_row_is_a_true_sentence(tmp_path, capsys):
+    # a score below the limit must not read "> 1.5: unlike the training set"
+    from prsm_health.apps.cli.models import diagnosis_rows
+    from prsm_health.diagnostics.contract import Diagnosis
+
+    d = Diagnosis(
+        clearance={"estimate": 1e-5, "lower": 5e-6, "upper": 2e-5},
+        fault_class="wear",
+        class_probabilities={"wear": 1.0},
+        indicators={},
+        observability={"clearance": True, "fault": True},
+        ood_score=0.663,
+        warnings=[],
+        model={"name": "m", "version": "1", "design": "paper01", "instrumentation": None},
+    )
+    row = next(r for r in diagnosis_rows("f.mcap", d) if r[0] == "out-of-distribution score")
+    assert "≤ 1.5" in row[1] and "unlike" not in row[1], row

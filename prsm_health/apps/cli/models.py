@@ -7,7 +7,7 @@ import sys
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset
 from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
-from prsm_health.diagnostics.diagnosis import load_bundle
+from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
 from prsm_health.diagnostics.evaluation import evaluate_model
 from prsm_health.diagnostics.training import train as train_model
@@ -136,7 +136,7 @@ def diagnosis_rows(file: str, result) -> list:
     rows += [
         ("clearance observable", share(result.observability.get("clearance"), "windows"), ""),
         ("class observable", share(result.observability.get("fault"), "windows"), ""),
-        ("out-of-distribution score", result.ood_score, "> 1.5: unlike the training set"),
+        ("out-of-distribution score", ood_verdict(result), ""),
         ("windows", len(result.windows), ""),
         ("model", f"{result.model['name']} v{result.model['version']}", ""),
     ]
