@@ -14,6 +14,7 @@ from prsm_health.physics.kinematics import (
     defect_frequencies,
     speed_ratios,
 )
+from prsm_health.physics.load_rating import load_ratings
 from prsm_health.physics.stiffness.axial import axial_stiffness
 from prsm_health.physics.stiffness.cylinder import ElectricCylinder, cylinder_deformation
 from prsm_health.physics.stiffness.gear_mesh import mesh_stiffness
@@ -72,7 +73,14 @@ def design_show(args) -> int:
     if args.json:
         print_json(design.to_dict())
     else:
-        print_table(design_rows(design))
+        ratings = load_ratings(design)
+        print_table(
+            design_rows(design)
+            + [
+                ("load rating C_a (dynamic, 1e6 rev, 90 %)", ratings.dynamic / 1e3, "kN"),
+                ("load rating C_0a (static, 4.2 GPa)", ratings.static / 1e3, "kN"),
+            ]
+        )
     return 0
 
 
@@ -140,6 +148,8 @@ def kinematics(args) -> int:
         "frequencies": freqs.as_dict(),
         "defect_frequencies": defect_frequencies(design, args.speed),
     }
+    ratings = load_ratings(design)
+    out["load_ratings"] = {"dynamic": ratings.dynamic, "static": ratings.static}
     if args.json:
         print_json(out)
         return 0
