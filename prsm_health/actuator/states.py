@@ -92,11 +92,32 @@ class HealthState:
         )
 
     @classmethod
-    def from_dict(cls, values: dict, table: str = "health") -> HealthState:
+    def from_dict(
+        cls, values: dict, table: str = "health", *, base: dict | HealthState | None = None
+    ) -> HealthState:
         """From a health table: the fields, ``clearance`` as shorthand for screw, nut and gear,
-        and ``faults`` as a list of tables (``[[faults]]``); unknown keys name the table."""
-        if isinstance(values, cls):
+        and ``faults`` as a list of tables (``[[faults]]``); unknown keys name the table.
+
+        ``base`` (a health table read by the same rules, or a state) is what ``values`` is laid
+        over: a key of ``values`` replaces the same key of ``base`` — its ``clearance``
+        shorthand is first expanded to the keys it stands for, so ``clearance`` replaces every
+        clearance of ``base`` unless ``values`` gives one of them too — and what ``values``
+        does not name is kept. That is how ``prsm-health simulate``'s flags overlay a health
+        file.
+        """
+        if isinstance(values, cls) and base is None:
             return values
+        layered = cls._fields_of(values, table)
+        if base is not None:
+            layered = cls._fields_of(base, table) | layered
+        return cls(**layered)
+
+    @classmethod
+    def _fields_of(cls, values, table: str) -> dict:
+        """A health table (or state) as field → value: ``clearance`` expanded to the screw, nut
+        and gear clearances the table does not give, unknown keys refused."""
+        if isinstance(values, cls):
+            return {f.name: getattr(values, f.name) for f in fields(cls)}
         require(isinstance(values, dict), table, values, "must be a table of parameters")
         values = dict(values)
         if "clearance" in values:
@@ -104,7 +125,7 @@ class HealthState:
             for key in ("clearance_screw", "clearance_nut", "clearance_gear"):
                 values.setdefault(key, clearance)
         require_known_keys(table, values, ["clearance", *(f.name for f in fields(cls))])
-        return cls(**values)
+        return values
 
     @classmethod
     def from_toml(cls, path) -> HealthState:

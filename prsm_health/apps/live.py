@@ -4,8 +4,8 @@
 the recording's topics with the MCAP contract's schemas (:mod:`prsm_health.io.mcap.schema`: same
 topics, schema names, JSON schemas and field names as a ``.mcap`` file) and publishes one JSON
 message per sample and topic — every ``decimate``-th sample — paced so that the recording's log
-time advances ``rate`` times as fast as the wall clock. The diagnosis of each window (a
-``diagnose`` function given by the caller: this module is below the diagnosis layer) is
+time advances ``rate`` times as fast as the wall clock. The diagnosis of each window (by a
+model bundle, :func:`window_diagnoser`, or any ``diagnose`` function the caller gives) is
 published on :data:`~prsm_health.core.channels.TOPIC_DIAGNOSIS` once the window has been played, at
 ``log_time`` = the window's end, with the payload and schema of the MCAP replay writer
 (:func:`~prsm_health.io.mcap.diagnosis_topic.diagnosis_payload`,
@@ -38,9 +38,9 @@ from foxglove.websocket import ServerListener
 
 from prsm_health.core.channels import TOPIC_DIAGNOSIS, TOPIC_FIELDS, TOPIC_TRUTH
 from prsm_health.core.errors import PRSMHealthError
-from prsm_health.core.run import Run
+from prsm_health.core.run import Run, window_span
 from prsm_health.io.mcap.diagnosis_topic import diagnosis_payload
-from prsm_health.io.mcap.replay import Window, iter_windows
+from prsm_health.io.mcap.replay import Window, iter_windows, window_origin_ns, window_reached_ns
 from prsm_health.io.mcap.schema import (
     DIAGNOSIS_SCHEMA_NAME,
     SCHEMA_NAMES,
@@ -57,6 +57,7 @@ __all__ = [
     "LivePlayer",
     "LiveStats",
     "play_live",
+    "window_diagnoser",
 ]
 
 #: Bind address: this machine only (the protocol has no authentication).
@@ -81,6 +82,20 @@ _BACKLOG_MIN, _BACKLOG_MAX = 1024, 1 << 18
 
 #: A window's diagnosis as the Diagnosis contract's per-window JSON object (``to_json()``).
 Diagnose = Callable[[Window], dict]
+
+
+def window_diagnoser(bundle) -> Diagnose:
+    """Window → its Diagnosis JSON object by a model ``bundle``
+    (:func:`~prsm_health.diagnostics.diagnosis.load_bundle`): the window's measured channels
+    diagnosed as a run (:func:`~prsm_health.diagnostics.diagnosis.diagnose_window`), the object
+    ``replay --out`` writes on ``/prsm/diagnosis``. Truth signals are never an input."""
+    # Imported here: playing without a model does not load the estimators.
+    from prsm_health.diagnostics.diagnosis import diagnose_window
+
+    def diagnose(w: Window) -> dict:
+        return diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
+
+    return diagnose
 
 
 @dataclass
@@ -164,18 +179,18 @@ class _DiagnosisWorker:
 
 def _run_windows(run: Run, window: float) -> Iterator[Window]:
     """A run cut into windows exactly as :func:`~prsm_health.io.mcap.replay.iter_windows` cuts
-    its MCAP recording (log-time spans ``[t0 + k·window, t0 + (k+1)·window)``, run start
-    ``t0`` = log time 0), the last one possibly incomplete."""
+    its MCAP recording, by the same log-time rules (run start = log time 0): window ``k`` is
+    ``window_span(k, window, origin=window_origin_ns(0, first sample))``, the last one
+    possibly incomplete."""
     log = np.round(np.asarray(run.time, dtype=np.float64) * 1e9).astype(np.int64)
     n = len(log)
     if n == 0:
         raise PRSMHealthError("the run has no samples")
     length = int(round(window * 1e9))
-    first = min(0, int(log[0]))
+    first = window_origin_ns(0, log[0])
     a, k = 0, 0
     while a < n:
-        start = first + k * length
-        end = start + length
+        start, end = window_span(k, length, origin=first)
         b = int(np.searchsorted(log, end))
         if b > a:
             yield Window(
@@ -201,11 +216,10 @@ def _log_times(window: Window) -> np.ndarray:
 
 def _complete(window: Window, log: np.ndarray) -> bool:
     """The window reaches its end (its last sample is at most one sample period before it) —
-    the rule by which the MCAP replay releases a window."""
+    the rule by which the MCAP replay releases a window (:func:`window_reached_ns`)."""
     if not len(log):
         return False
-    period = 1e9 / window.sample_rate if window.sample_rate > 0 else 0.0
-    return int(log[-1]) >= window.end_ns - period - 1
+    return int(log[-1]) >= window_reached_ns(window.end_ns, window.sample_rate)
 
 
 def _topics(window: Window) -> dict[str, list[tuple[str, str]]]:
@@ -241,7 +255,10 @@ class LivePlayer:
     diagnose : callable, optional
         Window → the per-window Diagnosis JSON object; called for every complete window in a
         background thread, its result published on ``/prsm/diagnosis`` at the window's end.
-        None: no diagnosis topic.
+        None: no diagnosis topic (unless ``bundle``).
+    bundle : ModelBundle, optional
+        Diagnose by this model (:func:`window_diagnoser`): what ``replay --out`` writes on
+        ``/prsm/diagnosis``. Not with ``diagnose``.
     host : str
         Bind address (default 127.0.0.1: this machine only).
     port : int
@@ -258,8 +275,8 @@ class LivePlayer:
     Raises
     ------
     PRSMHealthError
-        A recording that cannot be read, bad parameters, a port that cannot be bound, or an
-        error of ``diagnose`` on the first window.
+        A recording that cannot be read, bad parameters (``diagnose`` and ``bundle`` both), a
+        port that cannot be bound, or an error of the diagnosis on the first window.
     """
 
     def __init__(
@@ -268,6 +285,7 @@ class LivePlayer:
         *,
         window: float = 1.0,
         diagnose: Diagnose | None = None,
+        bundle=None,
         host: str = DEFAULT_HOST,
         port: int = DEFAULT_PORT,
         rate: float | None = 1.0,
@@ -286,6 +304,10 @@ class LivePlayer:
             raise PRSMHealthError(f"decimate = {decimate!r} must be an integer >= 1, or None")
         if not isinstance(port, (int, np.integer)) or not 0 <= port <= 65535:
             raise PRSMHealthError(f"port = {port!r} must be an integer in 0…65535")
+        if bundle is not None:
+            if diagnose is not None:
+                raise PRSMHealthError("give LivePlayer a diagnose function or a bundle, not both")
+            diagnose = window_diagnoser(bundle)
         self.rate = rate
         self._server = None
         self._diagnose = diagnose

@@ -25,8 +25,8 @@ from prsm_health.simulation.dynamics import layout as L
 from prsm_health.simulation.dynamics._kernels import screw_motion
 from prsm_health.simulation.dynamics.model import build_model, initial_state
 from prsm_health.simulation.dynamics.simulate import (
-    _integrate,
     choose_step,
+    integrate,
     integration_step,
     linearised_modes,
     max_stable_step,
@@ -40,7 +40,7 @@ def truth(profile, drive_train=None, health=None, options=None):
         preset("paper01"), health or HealthState(), profile, options, 1, drive_train
     )
     h, _ = integration_step(options.max_step, *max_stable_step(model), 20_000.0)
-    raw = _integrate(model, initial_state(model), h, int(round(profile.duration / h)), False)
+    raw = integrate(model, initial_state(model), h, int(round(profile.duration / h)))
     half = len(raw) // 2
     return {name: raw[half:, k] for k, name in enumerate(TRUTH_NAMES)}
 

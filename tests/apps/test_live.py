@@ -32,12 +32,20 @@ from mcap.reader import make_reader
 from prsm_health import HealthState, OperatingProfile, simulate
 from prsm_health.actuator.faults import FAULT_CLASSES
 from prsm_health.apps.cli import main
-from prsm_health.apps.live import MESSAGE_BUDGET, LivePlayer
+from prsm_health.apps.live import (
+    MESSAGE_BUDGET,
+    LivePlayer,
+    _complete,
+    _log_times,
+    _run_windows,
+    window_diagnoser,
+)
 from prsm_health.core.channels import TOPIC_DIAGNOSIS, TOPIC_DRIVE, TOPIC_FIELDS, TOPIC_TRUTH
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 from prsm_health.diagnostics.diagnosis import CANNOT_TELL, diagnose_window, load_bundle, replay
 from prsm_health.io.mcap import iter_windows, read_mcap, write_mcap
+from prsm_health.io.mcap.replay import window_origin_ns, window_reached_ns
 from prsm_health.io.mcap.schema import diagnosis_schema, topic_schema
 
 SUBPROTOCOLS = ("foxglove.sdk.v1", "foxglove.websocket.v1")
@@ -264,6 +272,69 @@ def test_live_run_as_fast_as_possible_with_automatic_decimation():
     assert values[:2] == [channels["drive_torque"][0], channels["drive_torque"][2]]
     assert values[2] == channels["drive_torque"][4] and values[3] == channels["drive_torque"][6]
     assert [m[2] for m in got] == [round(t * 1e9) for t in time_s[::2]]
+
+
+def test_live_run_with_a_bundle_publishes_what_replay_writes(recording, bundle):
+    """``bundle=`` (what ``simulate --live`` and ``replay --live`` pass): a Run in memory is
+    cut and diagnosed as ``replay --out`` cuts and diagnoses its MCAP file — the same
+    diagnoses, at the same window ends."""
+    expected = [step.diagnosis.to_json() for step in replay(recording, bundle, window=WINDOW)]
+    assert len(expected) == 3
+    with LivePlayer(
+        read_mcap(recording), window=WINDOW, bundle=bundle, port=0, rate=None, decimate=50
+    ) as player:
+        assert player.diagnosing
+        seen, stats = _session(player, [TOPIC_DRIVE, TOPIC_DIAGNOSIS])
+    assert stats.diagnoses == 3
+    got = [m for m in seen["messages"] if m[1] == TOPIC_DIAGNOSIS]
+    assert [m[2] for m in got] == [round((k + 1) * WINDOW * 1e9) for k in range(3)]
+    assert [json.loads(m[3]) for m in got] == json.loads(json.dumps(expected))
+
+
+def test_window_diagnoser_is_the_diagnosis_of_the_window_as_a_run(recording, bundle):
+    with contextlib.closing(iter_windows(recording, WINDOW)) as stream:
+        w = next(stream)
+    want = diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
+    assert window_diagnoser(bundle)(w) == want
+
+
+def test_diagnose_and_bundle_together_are_refused(recording, bundle):
+    with pytest.raises(PRSMHealthError, match="not both"):
+        LivePlayer(recording, bundle=bundle, diagnose=_diagnoser(bundle), port=0)
+
+
+@pytest.mark.parametrize("window", [WINDOW, 0.07])
+def test_a_run_is_cut_where_the_mcap_replay_cuts(recording, window):
+    """The live view's windows of a Run in memory and the MCAP replay's of its file: the same
+    log-time spans (window_span from window_origin_ns), samples and completeness
+    (window_reached_ns) — 0.07 s leaves an incomplete last window."""
+    run = read_mcap(recording)
+    with contextlib.closing(iter_windows(recording, window, partial=True)) as stream:
+        replayed = list(stream)
+    with contextlib.closing(iter_windows(recording, window)) as stream:
+        released = len(list(stream))  # complete windows only
+    live = list(_run_windows(run, window))
+    assert len(live) == len(replayed) > 1
+    for a, b in zip(live, replayed):
+        assert (a.index, a.start_ns, a.end_ns) == (b.index, b.start_ns, b.end_ns)
+        assert a.start == b.start and a.end == b.end
+        assert np.array_equal(a.time, b.time)
+        assert a.channels.keys() == b.channels.keys()
+        for name in a.channels:
+            assert np.array_equal(a.channels[name], b.channels[name], equal_nan=True), name
+        assert a.truth.keys() == b.truth.keys() and a.truth.keys()
+        for name in a.truth:
+            assert np.array_equal(a.truth[name], b.truth[name], equal_nan=True), name
+    complete = [_complete(w, _log_times(w)) for w in live]
+    assert complete == [True] * released + [False] * (len(live) - released)
+    assert released == int(round(DURATION / window, 9))  # 3 of 0.1 s; 4 of 0.07 s
+
+
+def test_log_time_window_rules():
+    assert window_origin_ns(0, 5) == 0 and window_origin_ns(0, -7) == -7
+    # 20 kHz: complete once a sample lies within one period (50 µs) + 1 ns of the end
+    assert window_reached_ns(1_000_000, 20_000.0) == 1_000_000 - 50_000 - 1
+    assert window_reached_ns(1_000_000, None) == window_reached_ns(1_000_000, 0.0) == 999_999
 
 
 def test_live_errors_are_user_errors(tmp_path, recording):

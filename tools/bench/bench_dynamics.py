@@ -23,14 +23,12 @@ import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 
-import numpy as np
 from scipy.integrate import solve_ivp
 
 from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
 from prsm_health.actuator.design import preset
-from prsm_health.simulation.dynamics import _kernels
-from prsm_health.simulation.dynamics import layout as L
 from prsm_health.simulation.dynamics.model import build_model, initial_state
+from prsm_health.simulation.dynamics.simulate import integrate, right_hand_side
 
 PROFILE = dict(speed=100.0, load=100.0)
 
@@ -49,26 +47,8 @@ def bench_kernel(duration: float) -> float:
     h = 5e-6
     n = int(duration / h)
     y = initial_state(model)
-    raw = np.empty((n, L.N_CHANNELS))
-    work = [np.empty(model.n_state) for _ in range(5)]
-    aux = np.zeros(L.n_aux(model.n_rollers))
     t0 = time.perf_counter()
-    _kernels.integrate(
-        y,
-        0.0,
-        h,
-        n,
-        1,
-        model.params,
-        model.rollers,
-        model.mesh_table,
-        model.motion,
-        model.load_knots,
-        model.errors,
-        raw,
-        *work,
-        aux,
-    )
+    integrate(model, y, h, n)  # what simulate() runs: the kernel on 20 ms at a time
     return duration / (time.perf_counter() - t0)
 
 
@@ -81,27 +61,8 @@ def bench_solve_ivp(duration: float) -> tuple[float, int]:
         0,
     )
     y0 = initial_state(model)
-    nq = model.n_coordinates
-    aux = np.zeros(L.n_aux(model.n_rollers))
-
-    def f(t, y):
-        y = np.array(y)
-        th, w, _ = _kernels.screw_motion(t, model.motion)  # prescribed motor, as in the kernel
-        y[L.Q_THM], y[nq + L.Q_THM] = th, w
-        dy = np.empty_like(y)
-        _kernels.rhs(
-            t,
-            y,
-            model.params,
-            model.rollers,
-            model.mesh_table,
-            model.motion,
-            model.load_knots,
-            model.errors,
-            dy,
-            aux,
-        )
-        return dy
+    # the kernel's right-hand side, the prescribed motor angle set from the motion at t
+    f = right_hand_side(model)
 
     t0 = time.perf_counter()
     sol = solve_ivp(f, (0.0, duration), y0, method="RK45", rtol=1e-6, atol=1e-12)
@@ -109,17 +70,16 @@ def bench_solve_ivp(duration: float) -> tuple[float, int]:
 
 
 PURE_PYTHON = """
-import time, numpy as np
+import time
 from prsm_health import HealthState, OperatingProfile, SimulationOptions
 from prsm_health.actuator.design import preset
-from prsm_health.simulation.dynamics import _kernels, layout as L
 from prsm_health.simulation.dynamics.model import build_model, initial_state
+from prsm_health.simulation.dynamics.simulate import integrate
 d = {duration}
 m = build_model(preset("paper01"), HealthState(), OperatingProfile(duration=d, speed=100.0, load=100.0), SimulationOptions(), 0)
-n = int(d / 5e-6); y = initial_state(m); raw = np.empty((n, L.N_CHANNELS))
-work = [np.empty(m.n_state) for _ in range(5)]; aux = np.zeros(L.n_aux(m.n_rollers))
+y = initial_state(m)
 t0 = time.perf_counter()
-_kernels.integrate(y, 0.0, 5e-6, n, 1, m.params, m.rollers, m.mesh_table, m.motion, m.load_knots, m.errors, raw, *work, aux)
+integrate(m, y, 5e-6, int(d / 5e-6))
 print(d / (time.perf_counter() - t0))
 """
 

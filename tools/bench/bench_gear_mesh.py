@@ -28,67 +28,22 @@ from prsm_health.actuator.design import preset
 from prsm_health.physics.stiffness import gear_mesh as gm
 
 
-def _teeth(design, *, threaded: bool):
-    """Pinion (roller gear) and ring tooth exactly as design_mesh_stiffness builds them."""
-    g = design.gear
-    roller, nut = design.roller_material, design.nut_material
-    r_r = design.roller_diameter / 2
-    half = design.pitch * math.tan(design.contact_angle) / 4
-    if threaded:
-        width1 = gm._WidthLaw(
-            g.face_width,
-            threaded=True,
-            reading="envelope",
-            crest_fraction=gm.THREAD_CREST_FRACTION,
-            full_radius=r_r - half,
-            crest_radius=r_r + half,
-        )
-    else:
-        width1 = gm._WidthLaw(g.face_width)
-    ha, hf = g.addendum_coefficient, g.dedendum_coefficient
-    pinion = gm.ToothGeometry(
-        g.roller_teeth,
-        g.module,
-        g.pressure_angle,
-        ha,
-        hf,
-        internal=False,
-        width=width1,
-        E=roller.youngs_modulus,
-        G=roller.G,
-        h_fi=gm.SOLID_BODY_HFI,
-    )
-    ring = gm.ToothGeometry(
-        g.ring_teeth,
-        g.module,
-        g.pressure_angle,
-        ha,
-        hf,
-        internal=True,
-        width=gm._WidthLaw(g.face_width),
-        E=nut.youngs_modulus,
-        G=nut.G,
-        h_fi=gm.SOLID_BODY_HFI,
-    )
-    return pinion, ring, width1
-
-
 def _scalar_terms(tooth, t_c: float) -> float:
     """Bending + shear + axial + foundation compliance of one tooth, one contact, by quad."""
-    y_c, h_c, _ = (float(v) for v in tooth._involute(t_c))
+    y_c, h_c, _ = (float(v) for v in tooth.involute(t_c))
     zeta_c = (tooth.y_root - y_c) if tooth.internal else (y_c - tooth.y_root)
     a1 = float(tooth.load_angle(t_c))
     c1, s1 = math.cos(a1), math.sin(a1)
     E, G = tooth.E, tooth.G
 
     def section_involute(t):
-        y, h, dy = (float(v) for v in tooth._involute(t))
+        y, h, dy = (float(v) for v in tooth.involute(t))
         zeta = (tooth.y_root - y) if tooth.internal else (y - tooth.y_root)
-        w = float(tooth.width(tooth._radius(t)))
+        w = float(tooth.width(tooth.radius(t)))
         return zeta, h, w, dy
 
     def section_fillet(g):
-        y, h, dy, r = (float(v) for v in tooth._fillet(g))
+        y, h, dy, r = (float(v) for v in tooth.fillet(g))
         return y - tooth.y_root, h, float(tooth.width(r)), -dy
 
     def terms(section):
@@ -112,15 +67,15 @@ def _scalar_terms(tooth, t_c: float) -> float:
         for f in terms(section_involute):
             total += quad(f, t_c, tooth.t_root, limit=200)[0]
     else:
-        kinks_t = [tooth._t_of_radius(r) for r in tooth.width.kinks if r > tooth.rb]
+        kinks_t = [tooth.t_of_radius(r) for r in tooth.width.kinks if r > tooth.rb]
         pts = [t for t in kinks_t if tooth.t_usable < t < t_c] or None
         for f in terms(section_involute):
             total += quad(f, tooth.t_usable, t_c, points=pts, limit=200)[0]
         # The width law's kinks inside the fillet, found on the fillet curve, so that quad
         # does not have to resolve a corner it cannot see.
-        r_top = float(tooth._fillet(tooth.g_junction)[3])
+        r_top = float(tooth.fillet(tooth.g_junction)[3])
         g_pts = [
-            brentq(lambda g, rk=rk: float(tooth._fillet(g)[3]) - rk, tooth.g_junction, math.pi / 2)
+            brentq(lambda g, rk=rk: float(tooth.fillet(g)[3]) - rk, tooth.g_junction, math.pi / 2)
             for rk in tooth.width.kinks
             if tooth.rf < rk < r_top
         ] or None
@@ -144,7 +99,8 @@ def _scalar_terms(tooth, t_c: float) -> float:
 
 def baseline(design, ms_reference, *, threaded: bool, n_points: int) -> np.ndarray:
     """Mesh stiffness over one cycle, scalar loop over contact positions."""
-    pinion, ring, width1 = _teeth(design, threaded=threaded)
+    pinion, ring = gm.design_teeth(design, threaded)  # as design_mesh_stiffness builds them
+    width1 = pinion.width
     roller, nut = design.roller_material, design.nut_material
     # Contact positions on the baseline's own phase grid, read off the reference path.
     p_b = ms_reference.base_pitch

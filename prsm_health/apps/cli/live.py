@@ -6,9 +6,6 @@ from __future__ import annotations
 import signal
 import sys
 
-from prsm_health.core.run import Run
-from prsm_health.diagnostics.diagnosis import diagnose_window
-
 from ..live import LivePlayer
 
 #: Bind addresses that only this machine reaches.
@@ -29,7 +26,7 @@ def play_live(source, args, bundle, window: float, *, rate: float | None) -> int
         live = LivePlayer(
             source,
             window=window,
-            diagnose=window_diagnoser(bundle) if bundle is not None else None,
+            bundle=bundle,
             host=args.host,
             port=args.port,
             rate=rate,
@@ -69,16 +66,3 @@ def play_live(source, args, bundle, window: float, *, rate: float | None) -> int
         if live is not None:
             live.close()
     return 0
-
-
-def window_diagnoser(bundle):
-    """Window → its Diagnosis JSON object (what ``replay --out`` writes on /prsm/diagnosis).
-
-    Library logic that belongs below the front door (a ``LivePlayer`` option taking the
-    bundle); kept here until apps/live.py offers it.
-    """
-
-    def diagnose(w) -> dict:
-        return diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
-
-    return diagnose

@@ -200,7 +200,7 @@ def _add_simulate(command) -> None:
         "each health flag below replaces what the file says of the same parameters",
     )
     # The health flags: None where not given, so that only what the user typed is laid over
-    # the health file (simulate.health_table); the defaults shown are HealthState's.
+    # the health file (simulate.health_state); the defaults shown are HealthState's.
     s.add_argument(
         "--clearance",
         type=finite_float,

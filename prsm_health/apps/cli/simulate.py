@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from prsm_health.actuator.drive_train import load_drive_train
+from prsm_health.actuator.states import HealthState
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.tomlfile import read_toml
 from prsm_health.diagnostics.diagnosis import load_bundle
@@ -29,23 +30,20 @@ HEALTH_FLAGS = {
 }
 
 
-def health_table(args) -> dict:
-    """The run's health table: the health file's (``--health``), with the health flags the
+def health_state(args) -> HealthState:
+    """The run's health state: the health file's (``--health``), with the health flags the
     user gave laid over it.
 
-    The flags form a health table of their own, read by the same rules as a health file
-    (``HealthState.from_dict``, applied by ``Scenario.from_dict``), so the command line and a
-    file cannot disagree: ``--clearance X`` is ``clearance = X``, the screw, nut and gear
-    clearances unless ``--gear-clearance`` gives the gear's. A flag replaces what the file
+    The flags form a health table of their own, read by the same rules as a health file and
+    laid over it by :meth:`HealthState.from_dict` (``base=`` the file's table), so the command
+    line and a file cannot disagree: ``--clearance X`` is ``clearance = X``, the screw, nut and
+    gear clearances unless ``--gear-clearance`` gives the gear's. A flag replaces what the file
     says of the same parameters — ``--clearance`` every clearance of the file.
     """
     table = read_toml(args.health, "health file") if args.health else {}
     flags = {key: getattr(args, flag) for flag, key in HEALTH_FLAGS.items()}
     flags = {key: value for key, value in flags.items() if value is not None}
-    if "clearance" in flags:
-        # the file's own shorthand and specific clearances are what the flag replaces
-        table = {k: v for k, v in table.items() if not k.startswith("clearance")}
-    return table | flags
+    return HealthState.from_dict(flags, "health", base=table)
 
 
 def scenario_from_args(args) -> Scenario:
@@ -53,7 +51,7 @@ def scenario_from_args(args) -> Scenario:
     return Scenario.from_dict(
         {
             "design": args.design,
-            "health": health_table(args),
+            "health": health_state(args),
             "profile": {
                 "duration": args.duration,
                 "motion": args.profile,

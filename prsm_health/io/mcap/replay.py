@@ -5,7 +5,10 @@ The replay never holds the whole file: it decodes one chunk at a time, in log-ti
 (through the summary's chunk index when the file has one, else by scanning the records), and
 keeps only the unfinished window. Window boundaries follow
 :func:`~prsm_health.core.run.window_span`, as :meth:`Run.windows <prsm_health.core.run.Run.windows>`
-cuts a run in memory (here in nanoseconds of log time, there in samples).
+cuts a run in memory (here in nanoseconds of log time, there in samples), from
+:func:`window_origin_ns`; a window is complete once a sample reaches
+:func:`window_reached_ns` — the log-time rules the live view (:mod:`prsm_health.apps.live`)
+also cuts a run in memory by.
 """
 
 from __future__ import annotations
@@ -26,7 +29,28 @@ from prsm_health.core.run import lookup_channel, window_span
 from ._samples import _align, _Batch, _merge_topic, _require_positive, _sample_rate, _start_ns
 from ._scan import _chunk_batches, _Damaged, _Source, _unchunked_batches
 
-__all__ = ["Window", "WindowStream", "iter_windows", "window_statistics"]
+__all__ = [
+    "Window",
+    "WindowStream",
+    "iter_windows",
+    "window_origin_ns",
+    "window_reached_ns",
+    "window_statistics",
+]
+
+
+def window_origin_ns(run_start_ns: int, first_sample_ns: int) -> int:
+    """Log time [ns] at which window 0 starts: the run start, or the first sample when one
+    comes before it (windows are then :func:`~prsm_health.core.run.window_span` from there)."""
+    return min(int(run_start_ns), int(first_sample_ns))
+
+
+def window_reached_ns(end_ns: int, sample_rate: float | None) -> float:
+    """Log time [ns] a window ending at ``end_ns`` is complete from: its last sample lies at most
+    one sample period (+1 ns of log-time rounding) before its end. ``sample_rate`` [Hz] None or
+    0: unknown, the end itself (−1 ns)."""
+    period = 1e9 / sample_rate if sample_rate else 0.0
+    return end_ns - period - 1
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,7 +300,7 @@ class WindowStream(Iterator[Window]):
             return
         info = self._source.info()
         self._origin = _start_ns(info, batch.log_time)
-        self._first = min(self._origin, int(batch.log_time[0]))
+        self._first = window_origin_ns(self._origin, batch.log_time[0])
         try:
             self._rate_hz = _sample_rate(info, batch.log_time, self._source.path)
         except PRSMHealthError:
@@ -291,9 +315,6 @@ class WindowStream(Iterator[Window]):
         if self._first is None:
             return
         declared = set(self._source.wanted.values()) & set(self._buffers)
-        # A window is complete once its last sample is in: a sample at most one sample period
-        # (+1 ns of log-time rounding) before its end.
-        period = 1e9 / self._rate_hz if self._rate_hz else 0.0
         while True:
             start, end = window_span(self._index, self.window_ns, self.step_ns, self._first)
             newest = {t: int(b.log_time[-1]) for t, b in self._buffers.items() if len(b)}
@@ -302,7 +323,7 @@ class WindowStream(Iterator[Window]):
             latest = max(newest.values())
             if latest < start:
                 return
-            reached = end - period - 1
+            reached = window_reached_ns(end, self._rate_hz)  # complete once a sample is there
             if final:
                 if latest < reached and not self.partial:
                     return

@@ -139,7 +139,10 @@ __all__ = [
     "MeshStiffness",
     "SOLID_BODY_HFI",
     "THREAD_CREST_FRACTION",
+    "ToothGeometry",
+    "WidthLaw",
     "design_mesh_stiffness",
+    "design_teeth",
     "hertz_compliance",
     "involute_contact_ratio",
     "mesh_stiffness",
@@ -375,8 +378,9 @@ def hertz_compliance(
 
 
 # ============================================================================ width laws
-class _WidthLaw:
-    """Face width of a tooth section as a function of its radius.
+class WidthLaw:
+    """Face width of a tooth section as a function of its radius: constant, or the threaded
+    roller tooth's (module docstring; :func:`mesh_stiffness`'s ``thread_*`` parameters).
 
     ``kinks`` are the radii where the law has a corner; integration panels split there.
     """
@@ -434,14 +438,16 @@ class ToothGeometry:
 
     Flank points are parametrised by t = tan α_r (α_r the pressure angle at radius r, so
     r = r_b·√(1 + t²)); the line of action touches the flank at roll distance r_b·t from the
-    tangent point on the base circle.
+    tangent point on the base circle. ``nu`` (Poisson's ratio, for the Hertz term) is only
+    kept for the mesh.
     """
 
-    def __init__(self, z, m, alpha, ha, hf, *, internal, width, E, G, h_fi, tip_ha=None):
+    def __init__(self, z, m, alpha, ha, hf, *, internal, width, E, G, h_fi, tip_ha=None, nu=None):
         # ha, hf: basic-rack (tool) proportions; tip_ha: this tooth's addendum if shortened.
         tip_ha = ha if tip_ha is None else tip_ha
         self.z, self.m, self.alpha, self.internal = z, m, alpha, internal
-        self.E, self.G, self.width, self.h_fi = E, G, width, h_fi
+        self.E, self.G, self.nu, self.width, self.h_fi = E, G, nu, width, h_fi
+        self.tip_ha = tip_ha
         self.rp = z * m / 2.0
         self.rb = self.rp * math.cos(alpha)
         if internal:
@@ -452,7 +458,7 @@ class ToothGeometry:
             self.t_root = math.sqrt((self.rf / self.rb) ** 2 - 1.0)
             self.t_tip = math.sqrt(max((self.ra / self.rb) ** 2 - 1.0, 0.0))
             self.theta_f = self.c + float(_inv(math.atan(self.t_root)))
-            self.y_root = float(self._involute(self.t_root)[0])
+            self.y_root = float(self.involute(self.t_root)[0])
             self.t_usable = self.t_root  # involute all the way to the root circle
         else:
             self.ra = self.rp + tip_ha * m
@@ -468,7 +474,7 @@ class ToothGeometry:
         self.sainsot = _sainsot(self.theta_f, h_fi)
 
     # ------------------------------------------------------------------ geometry
-    def _involute(self, t):
+    def involute(self, t):
         """Section coordinate y (from the gear centre), half thickness h, dy/dt."""
         t = np.asarray(t, dtype=float)
         rb = self.rb
@@ -494,7 +500,7 @@ class ToothGeometry:
         self.u_c = math.pi * m / 4 + self.v_c * math.tan(alpha) + self.rho / math.cos(alpha)
         self.h_l = hf * m - self.rho * (1.0 - math.sin(alpha))
 
-    def _fillet(self, g):
+    def fillet(self, g):
         """Generated fillet at normal angle γ ∈ [α, π/2] (π/2: root circle).
 
         Returns y, h, dy/dγ, r. The cutter tip-circle point whose normal passes through the
@@ -517,7 +523,7 @@ class ToothGeometry:
 
     def _fillet_angle(self, g):
         """Polar angle of the fillet point from the tooth centreline and its radius."""
-        y, h, _, r = self._fillet(g)
+        y, h, _, r = self.fillet(g)
         return np.arctan2(h, y), r
 
     def _involute_angle(self, r):
@@ -546,7 +552,7 @@ class ToothGeometry:
         # monotonically with γ along the fillet).
         if self.rf < self.rb:
             g_b = brentq(
-                lambda g: float(self._fillet(g)[3]) - self.rb, alpha, math.pi / 2, xtol=1e-15
+                lambda g: float(self.fillet(g)[3]) - self.rb, alpha, math.pi / 2, xtol=1e-15
             )
         else:  # pragma: no cover - undercut needs r_f < r_b for standard proportions
             g_b = math.pi / 2
@@ -564,10 +570,12 @@ class ToothGeometry:
         self.t_usable = math.sqrt(max((r_j / self.rb) ** 2 - 1.0, 0.0))
 
     # --------------------------------------------------------------- quadrature
-    def _radius(self, t):
+    def radius(self, t):
+        """Radius of the flank point at t = tan α_r: r_b·√(1 + t²)."""
         return self.rb * np.sqrt(1.0 + np.asarray(t, dtype=float) ** 2)
 
-    def _t_of_radius(self, r):
+    def t_of_radius(self, r):
+        """t = tan α_r of the flank point at radius r (0 at or below the base circle)."""
         return math.sqrt(max((r / self.rb) ** 2 - 1.0, 0.0))
 
     def _fillet_sections(self):
@@ -575,11 +583,11 @@ class ToothGeometry:
         edges = [self.g_junction, math.pi / 2]
         for rk in self.width.kinks:
             # r decreases monotonically from the junction to the root along the fillet.
-            r_top = float(self._fillet(self.g_junction)[3])
+            r_top = float(self.fillet(self.g_junction)[3])
             if self.rf < rk < r_top:
                 edges.append(
                     brentq(
-                        lambda g, rk=rk: float(self._fillet(g)[3]) - rk,
+                        lambda g, rk=rk: float(self.fillet(g)[3]) - rk,
                         self.g_junction,
                         math.pi / 2,
                         xtol=1e-15,
@@ -588,7 +596,7 @@ class ToothGeometry:
         edges = np.sort(np.asarray(edges))
         nodes, weights = _panel_nodes(edges[:-1], edges[1:])
         g, wq = nodes.ravel(), weights.ravel()
-        y, h, dy, r = self._fillet(g)
+        y, h, dy, r = self.fillet(g)
         # y grows from the root to the junction while γ falls, so dζ = −dy/dγ·dγ.
         return y - self.y_root, h, self.width(r), -dy * wq
 
@@ -598,19 +606,19 @@ class ToothGeometry:
         if self.internal:
             # Ring tooth: sections from the contact point out to the root circle.
             nodes, weights = _panel_nodes(t_c, np.full_like(t_c, self.t_root))
-            y, h, dy = self._involute(nodes)
-            return self.y_root - y, h, self.width(self._radius(nodes)), dy * weights
+            y, h, dy = self.involute(nodes)
+            return self.y_root - y, h, self.width(self.radius(nodes)), dy * weights
         edges = [np.full_like(t_c, self.t_usable)]
         for rk in self.width.kinks:
-            tk = self._t_of_radius(rk) if rk > self.rb else self.t_usable
+            tk = self.t_of_radius(rk) if rk > self.rb else self.t_usable
             edges.append(np.clip(np.full_like(t_c, tk), self.t_usable, t_c))
         edges.append(t_c)
         edges = np.sort(np.stack(edges, axis=-1), axis=-1)
         nodes, weights = _panel_nodes(edges[:, :-1], edges[:, 1:])
         nodes = nodes.reshape(t_c.size, -1)
         weights = weights.reshape(t_c.size, -1)
-        y, h, dy = self._involute(nodes)
-        return y - self.y_root, h, self.width(self._radius(nodes)), dy * weights
+        y, h, dy = self.involute(nodes)
+        return y - self.y_root, h, self.width(self.radius(nodes)), dy * weights
 
     def compliances(self, t_c, damage=None):
         """Bending, shear, axial and foundation compliances [m/N] at contact parameters t_c.
@@ -621,7 +629,7 @@ class ToothGeometry:
         second moment where a crack or pit removes material.
         """
         t_c = np.asarray(t_c, dtype=float)
-        y_c, h_c, _ = self._involute(t_c)
+        y_c, h_c, _ = self.involute(t_c)
         zeta_c = (self.y_root - y_c) if self.internal else (y_c - self.y_root)
         a1 = self.load_angle(t_c)
         cos1, sin1 = np.cos(a1), np.sin(a1)
@@ -663,68 +671,6 @@ class ToothGeometry:
 # ============================================================================ validation
 def _is_int(value) -> bool:
     return isinstance(value, numbers.Integral) and not isinstance(value, bool)
-
-
-def _validate(
-    z1,
-    z2,
-    module,
-    pressure_angle,
-    face_width,
-    internal,
-    bore_diameter,
-    youngs_modulus,
-    poisson_ratio,
-    n_points,
-    ha,
-    hf,
-):
-    require(_is_int(z1) and z1 >= 6, "z1", z1, "must be an integer ≥ 6")
-    if internal:
-        require(
-            _is_int(z2) and z2 > z1,
-            "z2",
-            z2,
-            f"must be an integer > z1 = {z1} (teeth of the internal ring gear)",
-        )
-    else:
-        require(_is_int(z2) and z2 >= 6, "z2", z2, "must be an integer ≥ 6")
-    require_positive("module", module)
-    require(
-        isinstance(pressure_angle, numbers.Real)
-        and math.radians(10) <= pressure_angle <= math.radians(35),
-        "pressure_angle",
-        pressure_angle,
-        f"must lie in [{math.radians(10):.4f}, {math.radians(35):.4f}] rad (10°…35°)",
-    )
-    require_positive("face_width", face_width)
-    require_range("addendum_coefficient", ha, 0.5, 1.5)
-    require(
-        isinstance(hf, numbers.Real) and ha < hf <= 1.6,
-        "dedendum_coefficient",
-        hf,
-        f"must lie in (addendum_coefficient = {ha:g}, 1.6] (root clearance > 0)",
-    )
-    # The generating rack tooth must keep a tip land at the depth it cuts.
-    hf_max = math.pi / (4 * math.tan(pressure_angle))
-    require(
-        hf < hf_max,
-        "dedendum_coefficient",
-        hf,
-        f"must be < π/(4·tan α) = {hf_max:.4g} at this pressure angle "
-        "(the generating rack tooth would be pointed)",
-    )
-    root_d = (z1 - 2 * hf) * module
-    require(
-        isinstance(bore_diameter, numbers.Real) and 0.0 <= bore_diameter <= root_d / MIN_HFI,
-        "bore_diameter",
-        bore_diameter,
-        f"must lie in [0, root diameter / {MIN_HFI:g} = {root_d / MIN_HFI:.6g}] m "
-        "(thinner rims bend as rings, outside the fillet-foundation model)",
-    )
-    require_positive("youngs_modulus", youngs_modulus)
-    require_range("poisson_ratio", poisson_ratio, 0.0, 0.5, inclusive=False)
-    require(_is_int(n_points) and n_points >= 16, "n_points", n_points, "must be an integer ≥ 16")
 
 
 def _check_tooth_tip(tooth: ToothGeometry, name: str) -> None:
@@ -848,23 +794,114 @@ def mesh_stiffness(
     Tian (2004); Sainsot et al. (2004); Chen & Shao (2013); Liang et al. (2014); Ma et al.
     (2014). Full list in the module docstring.
     """
-    ha, hf = addendum_coefficient, dedendum_coefficient
-    ha2 = ha if gear_addendum_coefficient is None else gear_addendum_coefficient
-    require_range("gear_addendum_coefficient", ha2, 0.5, 1.5)
-    _validate(
+    teeth = _mesh_teeth(
         z1,
         z2,
         module,
         pressure_angle,
         face_width,
-        internal,
-        bore_diameter,
-        youngs_modulus,
-        poisson_ratio,
-        n_points,
-        ha,
-        hf,
+        internal=internal,
+        bore_diameter=bore_diameter,
+        youngs_modulus=youngs_modulus,
+        poisson_ratio=poisson_ratio,
+        threaded_tooth=threaded_tooth,
+        n_points=n_points,
+        youngs_modulus2=youngs_modulus2,
+        poisson_ratio2=poisson_ratio2,
+        shear_modulus=shear_modulus,
+        shear_modulus2=shear_modulus2,
+        gear_bore_diameter=gear_bore_diameter,
+        addendum_coefficient=addendum_coefficient,
+        dedendum_coefficient=dedendum_coefficient,
+        gear_addendum_coefficient=gear_addendum_coefficient,
+        thread_reading=thread_reading,
+        thread_crest_fraction=thread_crest_fraction,
+        thread_full_radius=thread_full_radius,
+        thread_crest_radius=thread_crest_radius,
     )
+    return _pair_stiffness(*teeth, n_points, pinion_damage, gear_damage)
+
+
+def _mesh_teeth(
+    z1,
+    z2,
+    module,
+    pressure_angle,
+    face_width,
+    *,
+    internal,
+    bore_diameter,
+    youngs_modulus,
+    poisson_ratio,
+    threaded_tooth,
+    n_points,
+    youngs_modulus2,
+    poisson_ratio2,
+    shear_modulus,
+    shear_modulus2,
+    gear_bore_diameter,
+    addendum_coefficient,
+    dedendum_coefficient,
+    gear_addendum_coefficient,
+    thread_reading,
+    thread_crest_fraction,
+    thread_full_radius,
+    thread_crest_radius,
+) -> tuple[ToothGeometry, ToothGeometry]:
+    """:func:`mesh_stiffness`'s parameters checked, its pinion and gear built (``n_points``
+    None: not checked)."""
+    ha, hf = addendum_coefficient, dedendum_coefficient
+    ha2 = ha if gear_addendum_coefficient is None else gear_addendum_coefficient
+    require_range("gear_addendum_coefficient", ha2, 0.5, 1.5)
+    require(_is_int(z1) and z1 >= 6, "z1", z1, "must be an integer ≥ 6")
+    if internal:
+        require(
+            _is_int(z2) and z2 > z1,
+            "z2",
+            z2,
+            f"must be an integer > z1 = {z1} (teeth of the internal ring gear)",
+        )
+    else:
+        require(_is_int(z2) and z2 >= 6, "z2", z2, "must be an integer ≥ 6")
+    require_positive("module", module)
+    require(
+        isinstance(pressure_angle, numbers.Real)
+        and math.radians(10) <= pressure_angle <= math.radians(35),
+        "pressure_angle",
+        pressure_angle,
+        f"must lie in [{math.radians(10):.4f}, {math.radians(35):.4f}] rad (10°…35°)",
+    )
+    require_positive("face_width", face_width)
+    require_range("addendum_coefficient", ha, 0.5, 1.5)
+    require(
+        isinstance(hf, numbers.Real) and ha < hf <= 1.6,
+        "dedendum_coefficient",
+        hf,
+        f"must lie in (addendum_coefficient = {ha:g}, 1.6] (root clearance > 0)",
+    )
+    # The generating rack tooth must keep a tip land at the depth it cuts.
+    hf_max = math.pi / (4 * math.tan(pressure_angle))
+    require(
+        hf < hf_max,
+        "dedendum_coefficient",
+        hf,
+        f"must be < π/(4·tan α) = {hf_max:.4g} at this pressure angle "
+        "(the generating rack tooth would be pointed)",
+    )
+    root_d = (z1 - 2 * hf) * module
+    require(
+        isinstance(bore_diameter, numbers.Real) and 0.0 <= bore_diameter <= root_d / MIN_HFI,
+        "bore_diameter",
+        bore_diameter,
+        f"must lie in [0, root diameter / {MIN_HFI:g} = {root_d / MIN_HFI:.6g}] m "
+        "(thinner rims bend as rings, outside the fillet-foundation model)",
+    )
+    require_positive("youngs_modulus", youngs_modulus)
+    require_range("poisson_ratio", poisson_ratio, 0.0, 0.5, inclusive=False)
+    if n_points is not None:  # None: teeth only (design_teeth), no phase grid
+        require(
+            _is_int(n_points) and n_points >= 16, "n_points", n_points, "must be an integer ≥ 16"
+        )
     e1, nu1 = float(youngs_modulus), float(poisson_ratio)
     e2 = e1 if youngs_modulus2 is None else youngs_modulus2
     nu2 = nu1 if poisson_ratio2 is None else poisson_ratio2
@@ -899,7 +936,7 @@ def mesh_stiffness(
             r_full,
             f"must lie in (0, thread_crest_radius = {r_crest:.6g}) m",
         )
-        width1 = _WidthLaw(
+        width1 = WidthLaw(
             face_width,
             threaded=True,
             reading=thread_reading,
@@ -908,8 +945,8 @@ def mesh_stiffness(
             crest_radius=r_crest,
         )
     else:
-        width1 = _WidthLaw(face_width)
-    width2 = _WidthLaw(face_width)
+        width1 = WidthLaw(face_width)
+    width2 = WidthLaw(face_width)
 
     rf1 = rp1 - hf * m
     # A bore smaller than r_f/SOLID_BODY_HFI acts like a solid body (see SOLID_BODY_HFI).
@@ -932,13 +969,34 @@ def mesh_stiffness(
         )
 
     pinion = ToothGeometry(
-        z1, m, alpha, ha, hf, internal=False, width=width1, E=e1, G=g1, h_fi=hfi1
+        z1, m, alpha, ha, hf, internal=False, width=width1, E=e1, G=g1, h_fi=hfi1, nu=nu1
     )
     gear = ToothGeometry(
-        z2, m, alpha, ha, hf, internal=internal, width=width2, E=e2, G=g2, h_fi=hfi2, tip_ha=ha2
+        z2,
+        m,
+        alpha,
+        ha,
+        hf,
+        internal=internal,
+        width=width2,
+        E=e2,
+        G=g2,
+        h_fi=hfi2,
+        tip_ha=ha2,
+        nu=nu2,
     )
     _check_tooth_tip(pinion, "z1")
     _check_tooth_tip(gear, "z2")
+
+    return pinion, gear
+
+
+def _pair_stiffness(pinion, gear, n_points, pinion_damage, gear_damage) -> MeshStiffness:
+    """The mesh stiffness of the teeth :func:`_mesh_teeth` built."""
+    require(_is_int(n_points) and n_points >= 16, "n_points", n_points, "must be an integer ≥ 16")
+    z1, z2, m, alpha, internal = pinion.z, gear.z, pinion.m, pinion.alpha, gear.internal
+    e1, nu1, e2, nu2, width1 = pinion.E, pinion.nu, gear.E, gear.nu, pinion.width
+    ha, ha2 = pinion.tip_ha, gear.tip_ha
 
     # Line of action, s measured from the pinion's tangent point N1 towards the pitch point.
     p_b = math.pi * m * math.cos(alpha)
@@ -979,11 +1037,11 @@ def mesh_stiffness(
 
     kb1, ks1, ka1, kf1 = pinion.compliances(t1, pinion_damage)
     kb2, ks2, ka2, kf2 = gear.compliances(t2, gear_damage)
-    r1 = pinion._radius(t1)
+    r1 = pinion.radius(t1)
     contact_width = width1(r1)
     for tooth, damage, t in ((pinion, pinion_damage, t1), (gear, gear_damage, t2)):
         if damage is not None:
-            contact_width = contact_width * contact_share(damage, tooth, tooth._radius(t))
+            contact_width = contact_width * contact_share(damage, tooth, tooth.radius(t))
     kh = hertz_compliance(contact_width, e1, nu1, e2, nu2)
     comp = {
         "hertz": kh,
@@ -1013,7 +1071,7 @@ def mesh_stiffness(
         single,
         xi * p_b,
         r1,
-        gear._radius(t2),
+        gear.radius(t2),
         pairs,
         *comp.values(),
     ]
@@ -1076,6 +1134,25 @@ def design_mesh_stiffness(
     ----------
     Paper 01 §2.1 and its §3 parameter table (z2 = 65, module 0.5 mm, 20°).
     """
+    pinion, ring = design_teeth(
+        design,
+        threaded_tooth,
+        thread_reading=thread_reading,
+        thread_crest_fraction=thread_crest_fraction,
+    )
+    return _pair_stiffness(pinion, ring, n_points, roller_damage, ring_damage)
+
+
+def design_teeth(
+    design,
+    threaded: bool = True,
+    *,
+    thread_reading: str = "envelope",
+    thread_crest_fraction: float = THREAD_CREST_FRACTION,
+) -> tuple[ToothGeometry, ToothGeometry]:
+    """The roller-gear (pinion) and ring-gear teeth of a design, the teeth
+    :func:`design_mesh_stiffness` meshes; ``threaded`` is its ``threaded_tooth``, the other
+    parameters :func:`mesh_stiffness`'s. The pinion's ``width`` is the roller's width law."""
     gear = design.gear
     require(
         gear is not None,
@@ -1086,7 +1163,7 @@ def design_mesh_stiffness(
     r_r = design.roller_diameter / 2
     half_land_depth = design.pitch * math.tan(design.contact_angle) / 4
     roller, nut = design.roller_material, design.nut_material
-    return mesh_stiffness(
+    return _mesh_teeth(
         gear.roller_teeth,
         gear.ring_teeth,
         gear.module,
@@ -1094,22 +1171,22 @@ def design_mesh_stiffness(
         gear.face_width,
         internal=True,
         bore_diameter=0.0,
+        gear_bore_diameter=0.0,
         youngs_modulus=roller.youngs_modulus,
         poisson_ratio=roller.poisson_ratio,
         shear_modulus=roller.G,
         youngs_modulus2=nut.youngs_modulus,
         poisson_ratio2=nut.poisson_ratio,
         shear_modulus2=nut.G,
-        threaded_tooth=threaded_tooth,
-        n_points=n_points,
+        threaded_tooth=threaded,
+        n_points=None,
         addendum_coefficient=gear.addendum_coefficient,
         dedendum_coefficient=gear.dedendum_coefficient,
+        gear_addendum_coefficient=None,
         thread_reading=thread_reading,
         thread_crest_fraction=thread_crest_fraction,
         thread_full_radius=r_r - half_land_depth,
         thread_crest_radius=r_r + half_land_depth,
-        pinion_damage=roller_damage,
-        gear_damage=ring_damage,
     )
 
 

@@ -51,7 +51,7 @@ def root_half_thickness(tooth) -> float:
     """Half thickness of a tooth at its root [m] (fillet root of an external tooth, root circle
     of a ring tooth)."""
     if tooth.internal:
-        return float(tooth._involute(tooth.t_root)[1])
+        return float(tooth.involute(tooth.t_root)[1])
     return float(np.max(tooth._fillet_sections()[1]))
 
 
@@ -66,7 +66,7 @@ def crack_section(tooth, h, w, depth: float, angle: float):
 def _zeta_of_radius(tooth, r: float) -> float:
     """Distance from the root along the centreline of the flank point at radius r [m]."""
     t = math.sqrt(max((r / tooth.rb) ** 2 - 1.0, 0.0))
-    y = float(tooth._involute(t)[0])
+    y = float(tooth.involute(t)[0])
     return tooth.y_root - y if tooth.internal else y - tooth.y_root
 
 

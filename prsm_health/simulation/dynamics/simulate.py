@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -179,11 +180,11 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     n_settle = int(round(options.settle_time / h))
     y = initial_state(model, -n_settle * h)
     if n_settle:
-        _integrate(settling_model(model), y, h, n_settle, False, t0=-n_settle * h, record=False)
+        integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
         y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
             0.0  # energy book starts at t = 0
         )
-    truth_raw = _truth_from_record(_integrate(model, y, h, n_steps, progress))
+    truth_raw = _truth_from_record(integrate(model, y, h, n_steps, progress=progress))
     channels = instrumentation.measure(
         truth_raw,
         1.0 / h,
@@ -221,15 +222,47 @@ def _truth_from_record(raw: np.ndarray) -> dict[str, np.ndarray]:
     return {name: raw[:, k] for k, name in enumerate(TRUTH_NAMES)}
 
 
-def _integrate(
+def integrate(
     model: Model,
     y: np.ndarray,
     h: float,
     n_steps: int,
-    progress: bool,
+    *,
     t0: float = 0.0,
     record: bool = True,
+    progress: bool = False,
 ) -> np.ndarray:
+    """Advance the state ``y`` of ``model`` in place by ``n_steps`` RK4 steps of ``h`` [s] from
+    ``t0`` [s] — the integration :func:`simulate` runs (the numba kernel, called on 20 ms of
+    simulated time at a time).
+
+    Parameters
+    ----------
+    model : Model
+        :func:`~prsm_health.simulation.dynamics.model.build_model`'s parameters.
+    y : ndarray
+        State (:func:`~prsm_health.simulation.dynamics.model.initial_state`), updated in place.
+    h : float [s]
+        Step; no stability check here (:func:`max_stable_step` gives the bound).
+    n_steps : int
+    t0 : float [s]
+        Time of the first step.
+    record : bool
+        Record the truth signals at every step; False: nothing recorded (settling).
+    progress : bool
+        Show a progress bar (tqdm).
+
+    Returns
+    -------
+    ndarray
+        ``(n_steps, N_CHANNELS)`` record, columns in the layout's ``C_*`` order (the truth
+        signals in contract order); one unspecified row when ``record`` is False.
+
+    Raises
+    ------
+    SimulationError
+        The state became non-finite (the step is too large for the contact stiffness).
+    """
     raw = np.empty((n_steps if record else 1, L.N_CHANNELS))
     work = [np.empty(model.n_state) for _ in range(5)]
     aux = np.zeros(L.n_aux(model.n_rollers))
@@ -276,3 +309,32 @@ def _integrate(
     if bar is not None:
         bar.close()
     return raw
+
+
+def right_hand_side(model: Model) -> Callable[[float, np.ndarray], np.ndarray]:
+    """The model's state derivative as ``f(t, y) → dy/dt``, for a general ODE solver
+    (``scipy.integrate.solve_ivp``): the numba kernel's right-hand side, evaluated on a copy of
+    ``y`` whose prescribed motor angle and speed (and the screw's, when rigidly coupled to the
+    motor) are first set from the motion at ``t``, the rule the RK4 kernel applies at each
+    step. ``y`` is not modified; each call returns a new array."""
+    args = (
+        model.params,
+        model.rollers,
+        model.mesh_table,
+        model.motion,
+        model.load_knots,
+        model.errors,
+    )
+    prescribed = model.params[L.P_DRIVE_MODE] == L.DRIVE_PRESCRIBED
+    nq = model.n_coordinates
+    aux = np.zeros(L.n_aux(model.n_rollers))
+
+    def f(t: float, y: np.ndarray) -> np.ndarray:
+        y = np.array(y, dtype=np.float64)
+        if prescribed:
+            _kernels._hold_prescribed(y, float(t), model.params, model.motion, nq)
+        dy = np.empty_like(y)
+        _kernels.rhs(float(t), y, *args, dy, aux)
+        return dy
+
+    return f

@@ -150,7 +150,7 @@ def _rack_penetration(tooth, r, theta, n_phi=40001):
 def test_undercut_limit_matches_brute_force_generation(z):
     m = 1e-3
     tooth = gm.ToothGeometry(
-        z, m, DEG20, 1.0, 1.25, internal=False, width=gm._WidthLaw(1.0), E=1, G=1, h_fi=3
+        z, m, DEG20, 1.0, 1.25, internal=False, width=gm.WidthLaw(1.0), E=1, G=1, h_fi=3
     )
     assert tooth.undercut
     # Involute points just below the computed limit are cut away by the rack, points just
@@ -211,10 +211,10 @@ def test_involute_integrals_match_tian_closed_form():
     z, m, L = 25, 2e-3, 10e-3
     G = E / (2 * (1 + NU))
     tooth = gm.ToothGeometry(
-        z, m, DEG20, 1.0, 1.25, internal=False, width=gm._WidthLaw(L), E=E, G=G, h_fi=3
+        z, m, DEG20, 1.0, 1.25, internal=False, width=gm.WidthLaw(L), E=E, G=G, h_fi=3
     )
     a2 = tooth.a2
-    y0 = float(tooth._involute(0.0)[0])
+    y0 = float(tooth.involute(0.0)[0])
     for t_c in (0.2, 0.35, 0.5):
         a1 = t_c - a2
 
@@ -238,9 +238,9 @@ def test_involute_integrals_match_tian_closed_form():
                 / (E * L * (math.sin(a) + (a2 - a) * math.cos(a)))
             )
 
-        y_c, h_c, _ = (float(v) for v in tooth._involute(t_c))
+        y_c, h_c, _ = (float(v) for v in tooth.involute(t_c))
         nodes, weights = gm._panel_nodes(0.0, t_c)
-        y, h, dy = tooth._involute(nodes)
+        y, h, dy = tooth.involute(nodes)
         arm = ((y_c - y0) - (y - y0)) * math.cos(a1) - h_c * math.sin(a1)
         mine_b = float(np.sum(arm**2 * 12 / (E * L * (2 * h) ** 3) * dy * weights))
         mine_s = float(np.sum(1.2 * math.cos(a1) ** 2 / (G * 2 * h * L) * dy * weights))
@@ -258,7 +258,7 @@ def test_fixed_quadrature_matches_adaptive_quad(threaded):
     half = design.pitch * math.tan(design.contact_angle) / 4
     r_r = design.roller_diameter / 2
     width = (
-        gm._WidthLaw(
+        gm.WidthLaw(
             g.face_width,
             threaded=True,
             crest_fraction=0.125,
@@ -266,14 +266,14 @@ def test_fixed_quadrature_matches_adaptive_quad(threaded):
             crest_radius=r_r + half,
         )
         if threaded
-        else gm._WidthLaw(g.face_width)
+        else gm.WidthLaw(g.face_width)
     )
     G = E / (2 * (1 + NU))
     pinion = gm.ToothGeometry(
         13, 0.5e-3, DEG20, 1.0, 1.25, internal=False, width=width, E=E, G=G, h_fi=3
     )
     ring = gm.ToothGeometry(
-        65, 0.5e-3, DEG20, 1.0, 1.25, internal=True, width=gm._WidthLaw(3e-3), E=E, G=G, h_fi=3
+        65, 0.5e-3, DEG20, 1.0, 1.25, internal=True, width=gm.WidthLaw(3e-3), E=E, G=G, h_fi=3
     )
     for tooth, t_values in (
         (pinion, (pinion.t_usable + 1e-3, 0.35, pinion.t_tip)),
@@ -281,7 +281,7 @@ def test_fixed_quadrature_matches_adaptive_quad(threaded):
     ):
         kb, ks, ka, _ = tooth.compliances(np.array(t_values))
         for i, t_c in enumerate(t_values):
-            y_c, h_c, _ = (float(v) for v in tooth._involute(t_c))
+            y_c, h_c, _ = (float(v) for v in tooth.involute(t_c))
             zeta_c = (tooth.y_root - y_c) if tooth.internal else (y_c - tooth.y_root)
             a1 = float(tooth.load_angle(t_c))
 
@@ -296,12 +296,12 @@ def test_fixed_quadrature_matches_adaptive_quad(threaded):
                 return 1.2 * math.cos(a1) ** 2 / (G * 2 * h * w)
 
             def inv_sec(t, f, tooth=tooth):
-                y, h, dy = (float(v) for v in tooth._involute(t))
+                y, h, dy = (float(v) for v in tooth.involute(t))
                 zeta = (tooth.y_root - y) if tooth.internal else (y - tooth.y_root)
-                return f(zeta, h, float(tooth.width(tooth._radius(t)))) * dy
+                return f(zeta, h, float(tooth.width(tooth.radius(t)))) * dy
 
             def fil_sec(gam, f, tooth=tooth):
-                y, h, dy, r = (float(v) for v in tooth._fillet(gam))
+                y, h, dy, r = (float(v) for v in tooth.fillet(gam))
                 return f(y - tooth.y_root, h, float(tooth.width(r))) * -dy
 
             ref = {}
@@ -311,7 +311,7 @@ def test_fixed_quadrature_matches_adaptive_quad(threaded):
                         inv_sec, t_c, tooth.t_root, args=(f,), epsabs=0, epsrel=1e-12, limit=400
                     )[0]
                 else:
-                    kinks = [tooth._t_of_radius(r) for r in tooth.width.kinks if r > tooth.rb]
+                    kinks = [tooth.t_of_radius(r) for r in tooth.width.kinks if r > tooth.rb]
                     pts = [t for t in kinks if tooth.t_usable < t < t_c] or None
                     ref[name] = quad(
                         inv_sec,
@@ -342,9 +342,9 @@ def test_fixed_quadrature_matches_adaptive_quad(threaded):
 def _fillet_kinks(tooth):
     from scipy.optimize import brentq
 
-    r_top = float(tooth._fillet(tooth.g_junction)[3])
+    r_top = float(tooth.fillet(tooth.g_junction)[3])
     return [
-        brentq(lambda g, rk=rk: float(tooth._fillet(g)[3]) - rk, tooth.g_junction, math.pi / 2)
+        brentq(lambda g, rk=rk: float(tooth.fillet(g)[3]) - rk, tooth.g_junction, math.pi / 2)
         for rk in tooth.width.kinks
         if tooth.rf < rk < r_top
     ]
@@ -391,7 +391,7 @@ def test_load_angle_matches_mesh_geometry(z1, z2, internal):
     u = np.array([math.cos(DEG20), -math.sin(DEG20)])
     n1 = p0 - (p0 @ u) * u
     toward_p0 = u if (p0 - n1) @ u > 0 else -u
-    width = gm._WidthLaw(1.0)
+    width = gm.WidthLaw(1.0)
     pinion = gm.ToothGeometry(z1, m, DEG20, 1, 1.25, internal=False, width=width, E=1, G=1, h_fi=3)
     gear = gm.ToothGeometry(z2, m, DEG20, 1, 1.25, internal=internal, width=width, E=1, G=1, h_fi=3)
     for s in (0.3, 1.0, 1.5):
@@ -439,10 +439,10 @@ def test_width_laws_follow_paper01_formula():
     # L_a(x) = L·(x − x_B)/(x_A − x_B) for the literal reading, regularised by f_c; the
     # envelope reading runs the other way. Radii: x_B = 2.75 mm, x_A = 3.75 mm.
     L, fc, xb, xa = 3e-3, 0.125, 2.75e-3, 3.75e-3
-    lit = gm._WidthLaw(
+    lit = gm.WidthLaw(
         L, threaded=True, reading="literal", crest_fraction=fc, full_radius=xb, crest_radius=xa
     )
-    env = gm._WidthLaw(
+    env = gm.WidthLaw(
         L, threaded=True, reading="envelope", crest_fraction=fc, full_radius=xb, crest_radius=xa
     )
     x = np.array([2.6e-3, xb, 3.0e-3, 3.25e-3, xa])

@@ -257,14 +257,14 @@ def test_blow_up_is_reported_with_its_time():
     # Bypass the guard with a step 20× beyond the stable limit: the run must stop with an error
     # naming the time, not return NaNs.
     from prsm_health.simulation.dynamics.model import initial_state
-    from prsm_health.simulation.dynamics.simulate import _integrate
+    from prsm_health.simulation.dynamics.simulate import integrate
 
     model = build_model(
         preset("paper01"), HealthState(), OperatingProfile(), SimulationOptions(), 0
     )
     h = 20 * max_stable_step(model)[0]
     with pytest.raises(SimulationError, match=r"non-finite at t = [0-9.e-]+ s"):
-        _integrate(model, initial_state(model), h, 20_000, False)
+        integrate(model, initial_state(model), h, 20_000)
 
 
 def test_friction_torque_is_paper02_reduction():
