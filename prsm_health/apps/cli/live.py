@@ -21,6 +21,9 @@ def play_live(source, args, bundle, window: float, *, rate: float | None) -> int
             "authentication; anyone who reaches this address sees the recording",
             file=sys.stderr,
         )
+    # Ctrl-C stops the server even when a script started this command in the background (a
+    # non-interactive shell starts background jobs with SIGINT ignored), as `serve` does.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     live = None
     try:
         live = LivePlayer(
