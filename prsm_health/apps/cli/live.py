@@ -21,9 +21,11 @@ def play_live(source, args, bundle, window: float, *, rate: float | None) -> int
             "authentication; anyone who reaches this address sees the recording",
             file=sys.stderr,
         )
-    # Ctrl-C stops the server even when a script started this command in the background (a
-    # non-interactive shell starts background jobs with SIGINT ignored), as `serve` does.
+    # Ctrl-C stops the server whatever this process inherited: a non-interactive shell starts
+    # background jobs with SIGINT ignored, and a launcher may leave it blocked (`serve` too
+    # installs its own handler).
     signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     live = None
     try:
         live = LivePlayer(
