@@ -22,8 +22,8 @@ MAX_LINES = 800
 
 #: Modules over MAX_LINES that each do one job, and which.
 ONE_JOB = {
-    "physics/stiffness/gear_mesh.py": "potential-energy mesh stiffness of one gear pair "
-    "(tooth geometry, compliances, the mesh cycle), one model from one family of papers",
+    "physics/stiffness/gear_mesh.py": "potential-energy mesh stiffness of one gear pair (its "
+    "checked parameters, contact path and mesh cycle; the tooth is in gear_tooth.py)",
     "physics/stiffness/cylinder.py": "paper 05's electric-cylinder deformation model",
     "simulation/instrumentation.py": "the sensor models of an instrumentation profile",
     "actuator/design.py": "the PRSM design dataclasses, their validation and the presets",

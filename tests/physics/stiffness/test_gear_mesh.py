@@ -10,6 +10,7 @@ from scipy.integrate import quad
 from prsm_health.actuator.design import preset
 from prsm_health.core.errors import ParameterError
 from prsm_health.physics.stiffness import gear_mesh as gm
+from prsm_health.physics.stiffness import gear_tooth
 from prsm_health.physics.stiffness.gear_mesh import (
     design_mesh_stiffness,
     mesh_stiffness,
@@ -239,7 +240,7 @@ def test_involute_integrals_match_tian_closed_form():
             )
 
         y_c, h_c, _ = (float(v) for v in tooth.involute(t_c))
-        nodes, weights = gm._panel_nodes(0.0, t_c)
+        nodes, weights = gear_tooth._panel_nodes(0.0, t_c)
         y, h, dy = tooth.involute(nodes)
         arm = ((y_c - y0) - (y - y0)) * math.cos(a1) - h_c * math.sin(a1)
         mine_b = float(np.sum(arm**2 * 12 / (E * L * (2 * h) ** 3) * dy * weights))
