@@ -118,6 +118,15 @@ def load_design(design: str | Path | dict | PRSMDesign, *, base: Path | None = N
     return PRSMDesign.from_dict(data)
 
 
+def design_reference(design: str | Path | dict | PRSMDesign, *, base: Path | None = None):
+    """How data carries a design (a recipe, a column map, a manifest): a preset name as is,
+    anything else — a design file, relative to ``base``, a dict, a PRSMDesign — as the checked
+    design's dict form, so the data holds the design itself, never a path."""
+    if isinstance(design, str) and design in PRESETS:
+        return design
+    return load_design(design, base=base).to_dict()
+
+
 def design_to_toml(design: PRSMDesign, *, comments: bool = True) -> str:
     """TOML text that :func:`load_design` reads back to an equal design.
 
@@ -242,6 +251,19 @@ def same_design(a: str | Path | dict | PRSMDesign, b: str | Path | dict | PRSMDe
     return canonical_design(a) == canonical_design(b)
 
 
+def labelled_same_design(
+    name: str | None, fingerprint: str | None, other_name: str | None, other_fingerprint: str | None
+) -> bool | None:
+    """Whether two things labelled with a design (a recording, a history, a model) are of one
+    design: by fingerprint where both carry one — the name is for people and may be reused —
+    else by name; None when either names no design at all (nothing to compare)."""
+    if fingerprint is not None and other_fingerprint is not None:
+        return fingerprint == other_fingerprint
+    if name is None or other_name is None:
+        return None
+    return name == other_name
+
+
 def design_of(source, labels: Mapping | None = None) -> PRSMDesign | None:
     """The design of a run: its scenario's design, else a preset named in its labels, else None.
 
@@ -285,9 +307,11 @@ __all__ = [
     "canonical_design",
     "design_fingerprint",
     "design_of",
+    "design_reference",
     "design_rows",
     "design_to_toml",
     "field_info",
+    "labelled_same_design",
     "load_design",
     "same_design",
 ]

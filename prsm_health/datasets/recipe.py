@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from prsm_health.actuator.design import PRESETS, PRSMDesign
-from prsm_health.actuator.design_files import design_fingerprint, load_design
+from prsm_health.actuator.design_files import design_fingerprint, design_reference, load_design
 from prsm_health.actuator.faults import (
     FaultThresholds,
     fault_as_dict,
@@ -627,10 +627,8 @@ def load_recipe(path: str | Path) -> Recipe:
 
 def _recipe_design(design, base: Path | None) -> str | dict:
     """A preset name as is; a design file or dict as the validated design's dict form."""
-    if isinstance(design, str) and design in PRESETS:
-        return design
     try:
-        return load_design(design, base=base).to_dict()
+        return design_reference(design, base=base)
     except ParameterError as exc:
         raise RecipeError(f"recipe: {exc}") from None
     except PRSMHealthError as exc:

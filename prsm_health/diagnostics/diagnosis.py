@@ -30,13 +30,17 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from prsm_health.actuator.design import PRSMDesign
-from prsm_health.actuator.design_files import design_fingerprint, load_design
+from prsm_health.actuator.design_files import (
+    design_fingerprint,
+    labelled_same_design,
+    load_design,
+)
 from prsm_health.core.channels import MEASURED_TOPICS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import finite_or_none
@@ -108,7 +112,7 @@ class ModelBundle:
     def design_name(self) -> str:
         return self.design.name if self.design is not None else NO_DESIGN
 
-    @property
+    @cached_property  # a hash of the whole design: once per loaded model, not per recording
     def design_fingerprint(self) -> str | None:
         """The identity of the design the model was trained on (None: a rig without one)."""
         return None if self.design is None else design_fingerprint(self.design)
@@ -121,13 +125,12 @@ class ModelBundle:
         if self.design is None:
             return None
         fingerprint, name = labels.get("design_fingerprint"), labels.get("design")
-        if fingerprint is not None:
-            same = fingerprint == self.design_fingerprint
-        elif isinstance(name, str) and name != NO_DESIGN:
-            same = name == self.design.name
-        else:
-            return None
-        if same:
+        if name == NO_DESIGN:
+            name = None
+        if labelled_same_design(name, fingerprint, self.design.name, self.design_fingerprint) in (
+            True,
+            None,
+        ):
             return None
         shown = name if fingerprint is None else f"{name} ({fingerprint})"
         return (

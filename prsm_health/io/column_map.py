@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from prsm_health.actuator.design import PRESETS, PRSMDesign
-from prsm_health.actuator.design_files import design_fingerprint, load_design
+from prsm_health.actuator.design_files import design_fingerprint, design_reference, load_design
 from prsm_health.core.channels import CHANNEL_NAMES
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
@@ -266,7 +266,7 @@ def _map_design(design, where: str, base: Path | None) -> str | dict | None:
     elif not design.endswith(".toml"):
         raise PRSMHealthError(f"{where}: design = {design!r} must be {usage}")
     try:
-        return load_design(design, base=base).to_dict()
+        return design_reference(design, base=base)
     except PRSMHealthError as exc:
         raise PRSMHealthError(f"{where}: design: {exc}") from None
 

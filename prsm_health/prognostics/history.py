@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from prsm_health.actuator.design import PRESETS
-from prsm_health.actuator.design_files import design_fingerprint
+from prsm_health.actuator.design_files import design_fingerprint, labelled_same_design
 from prsm_health.core.errors import (
     ParameterError,
     PRSMHealthError,
@@ -234,21 +234,21 @@ def _check_design(history: pd.DataFrame, model) -> None:
     if model is None:
         return
     model_name, model_fingerprint = model.design_id
+    if labelled_same_design(name, fingerprint, model_name, model_fingerprint) is not False:
+        return
     if fingerprint is not None and model_fingerprint is not None:
-        if fingerprint != model_fingerprint:
-            shown = f"{name!r} " if name is not None else ""
-            raise HistoryError(
-                f"history is of design {shown}(fingerprint {fingerprint}), the prognostics "
-                f"model of {model_name!r} (fingerprint {model_fingerprint}): another design",
-                field="history.design_fingerprint",
-                value=fingerprint,
-            )
-    elif name is not None and name != model_name:
+        shown = f"{name!r} " if name is not None else ""
         raise HistoryError(
-            f"history is of design {name!r}, the prognostics model of {model_name!r}",
-            field="history.design",
-            value=name,
+            f"history is of design {shown}(fingerprint {fingerprint}), the prognostics "
+            f"model of {model_name!r} (fingerprint {model_fingerprint}): another design",
+            field="history.design_fingerprint",
+            value=fingerprint,
         )
+    raise HistoryError(
+        f"history is of design {name!r}, the prognostics model of {model_name!r}",
+        field="history.design",
+        value=name,
+    )
 
 
 def history_arrays(history: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
