@@ -304,8 +304,8 @@ def _add_simulate(command) -> None:
     s.add_argument(
         "--max-step",
         type=step,
-        default=5e-6,
-        help='largest RK4 step [s], or "auto": 0.6 of the stable step, at most 10 µs',
+        default="auto",
+        help='largest RK4 step [s], or "auto" (default): 0.6 of the stable step, at most 10 µs',
     )
     s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
     s.add_argument("--seed", type=int, default=0, help="seed of variation, wear and noise")

@@ -95,7 +95,7 @@ class SimulationOptions:
     ----------
     max_step : float [s] or "auto"
         Largest RK4 step; the step used is the largest 1/(m·f_s) below it, refused when above
-        the model's stable step. ``"auto"``: the largest 1/(m·f_s) below both
+        the model's stable step. ``"auto"`` (default): the largest 1/(m·f_s) below both
         :data:`AUTO_STABLE_FRACTION` of the stable step
         (:func:`~prsm_health.simulation.dynamics.simulate.max_stable_step`) and :data:`AUTO_MAX_STEP` — as fast as the model allows, and it survives stiff damping
         (docs/performance.md: the indicators it gives against a 0.5 µs reference).
@@ -143,7 +143,7 @@ class SimulationOptions:
         (at least 20 N, so an unloaded run keeps a finite stiffness).
     """
 
-    max_step: float | str = 5e-6
+    max_step: float | str = "auto"
     settle_time: float = 0.03
     contact_law: str = "linear"
     variation: ManufacturingVariation = field(default_factory=ManufacturingVariation)
