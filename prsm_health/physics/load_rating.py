@@ -47,7 +47,10 @@ surfaces hardened bearing steel (≥ 58 HRC, ISO 3408-5's precondition: no hardn
 The reference pressure and cycles (p_ref = 4.2 GPa, N_ref = 4·10⁶) are the wear module's
 defaults (:class:`~.wear.WearParameters`), an order-of-magnitude calibration; Lundberg–Palmgren's
 stressed-volume term (which turns C ∝ size² into ISO's D_w^1.8) is not in that law, so
-geometrically similar designs scale as size² here.
+geometrically similar designs scale as size² here. Cross-check against catalogues:
+docs/load-ratings.md (no commercial standard-PRSM table could be read; the one catalogue figure
+available, a Rollvis value quoted by paper 03 §4.3, is met by paper03's C_0a within 12 %; at fixed
+geometry C_a ∝ N_ref^⅓·p_ref³, so a catalogue C_a recalibrates the fatigue law, not a factor).
 
 References
 ----------
