@@ -17,18 +17,21 @@ BIN := $(VENV)/bin
 DEMO := build/demo-run
 
 # The main job: validate the physics against the papers, generate the demo dataset, train a
-# model on it, simulate a new worn-actuator recording to MCAP, diagnose it, replay it.
+# model on it, simulate a new worn-actuator recording to MCAP and its health check to Parquet,
+# diagnose the recording, replay it.
 demo: $(STAMP)
 	mkdir -p $(DEMO)
 	$(BIN)/prsm-health validate > $(DEMO)/validation.txt && tail -n 1 $(DEMO)/validation.txt
 	$(BIN)/prsm-health generate datasets/demo.toml --out $(DEMO)/dataset
 	$(BIN)/prsm-health train $(DEMO)/dataset --out $(DEMO)/model.skops --cv 3
-	$(BIN)/prsm-health simulate --clearance 22e-6 --speed 90 --load 50 --load-profile reversing \
-		--load-amplitude 300 --load-frequency 10 --accel-time 0.002 --contact-law hertz \
+	$(BIN)/prsm-health simulate --clearance 22e-6 --speed 90 --load 0 --load-profile reversing \
+		--load-amplitude 20%C_a --load-frequency 10 --accel-time 0.002 --contact-law hertz \
 		--duration 2 --seed 99 --out $(DEMO)/recording.mcap --plot $(DEMO)/recording.png
+	$(BIN)/prsm-health simulate --profile health-check --clearance 22e-6 --seed 99 \
+		--out $(DEMO)/check.parquet --plot $(DEMO)/check.png
 	$(BIN)/prsm-health diagnose $(DEMO)/recording.mcap --model $(DEMO)/model.skops --plot $(DEMO)/diagnosis.png
 	$(BIN)/prsm-health replay $(DEMO)/recording.mcap --model $(DEMO)/model.skops --out $(DEMO)/recording-diagnosed.mcap
-	@echo "demo outputs in $(DEMO)/ (validation.txt, recording.png, diagnosis.png, recording-diagnosed.mcap)"
+	@echo "demo outputs in $(DEMO)/ (validation.txt, recording.png, check.png, diagnosis.png, recording-diagnosed.mcap)"
 
 # The dashboard's browser test (tests/service/test_dashboard_browser.py) drives Debian's
 # Chromium: installed here when missing (apt-get, as root). Without it that test fails;

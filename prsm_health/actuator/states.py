@@ -12,19 +12,41 @@ extending actuator). Reversing load profiles swing it through zero.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-from prsm_health.core.errors import require, require_known_keys, require_positive, require_range
+from prsm_health.core.errors import (
+    ParameterError,
+    require,
+    require_known_keys,
+    require_positive,
+    require_range,
+)
+from prsm_health.core.quantities import ForceSpec, parse_force
 from prsm_health.core.tomlfile import read_toml
 
 from .faults import fault_as_dict, fault_from_dict
+from .health_check import HealthCheck, load_check
 
 MOTIONS = ("constant", "ramp", "trapezoid", "reversing")
 LOADS = ("constant", "sinusoidal", "reversing")
 DRIVES = ("prescribed", "speed_loop", "position_loop")
 RAMP_SHAPES = ("linear", "cosine")
+
+#: The mean axial load of a run when none is given: 20 % of the design's basic dynamic axial
+#: load rating C_a. Engineering estimate: electromechanical actuators run at roughly 10–40 % of
+#: C_a (docs/formats.md → Loads; the ratings: docs/load-ratings.md), and a PRSM sized so that
+#: its mean cubic load is 20 % of C_a has an L10 of (C_a/F_m)³·10⁶ = 1.25·10⁸ screw revolutions
+#: (ISO 3408-5:2006 §5.2, the life law of ISO 281), ≈ 2200 h in motion at 100 rad/s — the order
+#: of a flight-control EMA's life between overhauls. Light loads (1–3 % C_a) are run by giving
+#: them.
+DEFAULT_LOAD_SHARE = 0.2
+#: :data:`DEFAULT_LOAD_SHARE` as the force the profile holds until a design resolves it.
+DEFAULT_LOAD = ForceSpec(DEFAULT_LOAD_SHARE, "C_a")
+#: A share of a rating is at most this many times the rating (the scenario refuses anything
+#: above the static rating C_0a anyway; this only catches a percentage written as a fraction).
+_MAX_SHARE = 100.0
 
 
 @dataclass(frozen=True)
@@ -176,11 +198,19 @@ class OperatingProfile:
     motion_period : float [s]
         Period of the reversing motion.
     load_profile : {"constant", "sinusoidal", "reversing"}
-    load : float [N]
-        Mean resisting axial load on the nut (see module docstring for the sign).
-    load_amplitude : float [N]
+    load : float [N], str or ForceSpec
+        Mean resisting axial load on the nut (see module docstring for the sign), in any form
+        of :mod:`prsm_health.core.quantities`: newtons (``4400``), a unit (``"4.4 kN"``) or a
+        share of the design's load rating (``"20 % C_a"``, ``"0.05 C_0a"``). Newtons are kept
+        as a float; a share is kept as a :class:`~prsm_health.core.quantities.ForceSpec` until
+        :meth:`resolved` turns it into newtons with the design's ratings (the
+        :class:`~prsm_health.simulation.scenario.Scenario` does that on construction).
+        Default :data:`DEFAULT_LOAD`, 20 % of C_a: an ``OperatingProfile()`` alone holds no
+        design, so its default load is that share, resolved when a design is given.
+    load_amplitude : float [N], str or ForceSpec
         Sinusoidal: amplitude around ``load``; reversing: the load swings ±``load_amplitude``
-        around ``load`` as a trapezoidal wave with ``accel_time`` transitions.
+        around ``load`` as a trapezoidal wave with ``accel_time`` transitions. The same forms
+        as ``load``; ≥ 0.
     load_frequency : float [Hz]
         Frequency of the sinusoidal or reversing load.
     load_ramp_time : float or None [s]
@@ -199,6 +229,11 @@ class OperatingProfile:
         Motor torque limit of the speed loop.
     temperature : float [K]
         Lubricant temperature at the thread contacts (sets its viscosity; 223–473 K).
+    check : HealthCheck, str, dict or None
+        A health check (:mod:`prsm_health.actuator.health_check`): a built-in name
+        (``"health-check"``), a check TOML file, its table or a HealthCheck. When given, the
+        motion and the load are the check's (``motion``, ``speed``, ``load*`` … are not used
+        for the knots) and ``duration`` is the check's (another explicit duration is refused).
     """
 
     duration: float = 0.2
@@ -207,8 +242,8 @@ class OperatingProfile:
     accel_time: float = 0.02
     motion_period: float = 0.1
     load_profile: str = "constant"
-    load: float = 100.0
-    load_amplitude: float = 0.0
+    load: float | str | ForceSpec = DEFAULT_LOAD
+    load_amplitude: float | str | ForceSpec = 0.0
     load_frequency: float = 20.0
     load_ramp_time: float | None = None
     load_ramp_shape: str = "linear"
@@ -217,8 +252,10 @@ class OperatingProfile:
     position_loop_gain: float = 60.0
     torque_limit: float = 50.0
     temperature: float = 313.15
+    check: HealthCheck | None = None
 
     def __post_init__(self):
+        self._set_check()
         require_range("profile.duration", self.duration, 1e-4, 3600.0, unit="s")
         require(
             self.motion in MOTIONS,
@@ -253,8 +290,8 @@ class OperatingProfile:
                 self.accel_time,
                 f"must be < duration/2 = {self.duration / 2:g} s for a trapezoid",
             )
-        require_range("profile.load", self.load, -1e6, 1e6, unit="N")
-        require_range("profile.load_amplitude", self.load_amplitude, 0.0, 1e6, unit="N")
+        self._set_force("load", low=-1e6)
+        self._set_force("load_amplitude", low=0.0)
         require_range("profile.load_frequency", self.load_frequency, 0.0, 1e4, unit="Hz")
         require_positive("profile.speed_loop_bandwidth", self.speed_loop_bandwidth)
         require_range("profile.position_loop_gain", self.position_loop_gain, 0.0, 1e4, unit="1/s")
@@ -269,9 +306,108 @@ class OperatingProfile:
         require_positive("profile.torque_limit", self.torque_limit)
         require_range("profile.temperature", self.temperature, 223.15, 473.15, unit="K")
 
+    def _set_check(self) -> None:
+        """Convert ``check`` (name, file, table) to a HealthCheck and take its duration: the
+        default duration is replaced, another one refused."""
+        if self.check is None:
+            return
+        check = load_check(self.check)
+        object.__setattr__(self, "check", check)
+        default = next(f.default for f in fields(self) if f.name == "duration")
+        require(
+            self.duration in (default, check.duration)
+            or math.isclose(self.duration, check.duration, rel_tol=1e-9),
+            "profile.duration",
+            self.duration,
+            f"must be the health check's own ({check.duration:g} s for {check.name!r}) or "
+            "left out: a check lasts as long as its phases",
+        )
+        object.__setattr__(self, "duration", check.duration)
+
+    def _set_force(self, name: str, *, low: float) -> None:
+        """Parse a load field (any form of :mod:`prsm_health.core.quantities`): newtons are
+        kept as a float in [low, 1e6] N, a share of a rating as its ForceSpec."""
+        field = f"profile.{name}"
+        spec = parse_force(getattr(self, name), field)
+        if spec.of is None:
+            require_range(field, spec.value, low, 1e6, unit="N")
+            object.__setattr__(self, name, spec.value)
+            return
+        lowest = -_MAX_SHARE if low < 0 else 0.0
+        require(
+            lowest <= spec.value <= _MAX_SHARE,
+            field,
+            spec.text(),
+            f"a share of {spec.of} must lie in [{lowest:g}, {_MAX_SHARE:g}] × {spec.of}",
+        )
+        object.__setattr__(self, name, spec)
+
+    # ------------------------------------------------------------------ loads against a design
+    @property
+    def is_resolved(self) -> bool:
+        """True when ``load`` and ``load_amplitude`` are newtons (no share of a rating left)."""
+        return not isinstance(self.load, ForceSpec) and not isinstance(
+            self.load_amplitude, ForceSpec
+        )
+
+    def resolved(self, ratings) -> OperatingProfile:
+        """This profile with ``load`` and ``load_amplitude`` in newtons.
+
+        Parameters
+        ----------
+        ratings : dict or LoadRatings
+            ``{"C_a": …, "C_0a": …}`` [N], or the
+            :class:`~prsm_health.physics.load_rating.LoadRatings` of the design
+            (``dynamic`` = C_a, ``static`` = C_0a).
+        """
+        ratings = rating_table(ratings)
+        out = replace(
+            self,
+            load=parse_force(self.load, "profile.load").newtons(ratings, "profile.load"),
+            load_amplitude=parse_force(self.load_amplitude, "profile.load_amplitude").newtons(
+                ratings, "profile.load_amplitude"
+            ),
+        )
+        check = getattr(out, "check", None)
+        if check is not None:  # a health check's phases may give their loads as shares too
+            out = replace(out, check=check.resolved(ratings))
+        return out
+
+    @property
+    def peak_load(self) -> float:
+        """Largest |axial load| of the run [N], from the load the kernel is given: |load|, plus
+        the amplitude where the load swings (sinusoidal or reversing); a health check's
+        highest phase load."""
+        knots, amplitude, _ = self.load_knots()
+        return float(np.max(np.abs(knots[1]))) + amplitude
+
+    @property
+    def rms_load(self) -> float:
+        """RMS axial load over the run [N] (the knots sampled finely, plus a sinusoid's
+        amplitude/√2): what heats a motor, against its continuous torque."""
+        knots, amplitude, _ = self.load_knots()
+        times = np.linspace(knots[0, 0], knots[0, -1], 4096)
+        values = np.interp(times, knots[0], knots[1])
+        return float(np.sqrt(np.mean(values**2) + 0.5 * amplitude**2))
+
+    def _require_resolved(self, what: str) -> None:
+        if self.is_resolved:
+            return
+        given = self.load if isinstance(self.load, ForceSpec) else self.load_amplitude
+        name = "profile.load" if isinstance(self.load, ForceSpec) else "profile.load_amplitude"
+        raise ParameterError(
+            name,
+            given.text(),
+            f"a share of {given.of} needs the design's load ratings before the profile gives "
+            f"its {what}: call profile.resolved(ratings), or build a Scenario (it resolves the "
+            "profile against its design)",
+        )
+
     # ------------------------------------------------------------------ knots for the kernel
     def motion_knots(self) -> np.ndarray:
         """Piecewise-linear screw speed as a (3, K) array: times [s], speeds [rad/s], angles [rad]."""
+        if self.check is not None:
+            return self.check.motion_knots()
         w, ta, T = self.speed, self.accel_time, self.duration
         if self.motion == "constant" or (self.motion == "ramp" and ta == 0):
             times, speeds = [0.0, T], [w, w]
@@ -298,7 +434,11 @@ class OperatingProfile:
         return np.vstack([times, speeds, angles])
 
     def load_knots(self) -> tuple[np.ndarray, float, float]:
-        """Axial load as (2, K) knots [s, N] plus sinusoid amplitude [N] and frequency [Hz]."""
+        """Axial load as (2, K) knots [s, N] plus sinusoid amplitude [N] and frequency [Hz]
+        (a resolved profile only: :meth:`resolved`)."""
+        if self.check is not None:
+            return self.check.load_knots()
+        self._require_resolved("load knots")
         T, F = self.duration, self.load
         if self.load_profile == "constant":
             return np.array([[0.0, T], [F, F]]), 0.0, 0.0
@@ -329,13 +469,39 @@ class OperatingProfile:
     @property
     def has_reversals(self) -> bool:
         """True when the motion or the load changes sign during the run."""
-        return self.motion == "reversing" or (
-            self.load_profile in ("sinusoidal", "reversing")
-            and self.load_amplitude > abs(self.load)
+        if self.motion == "reversing":
+            return True
+        self._require_resolved("reversals")
+        return self.load_profile in ("sinusoidal", "reversing") and self.load_amplitude > abs(
+            self.load
         )
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        """The fields as plain values; a load still given as a share is its text
+        (``"20 % C_a"``), which :class:`OperatingProfile` reads back."""
+        out = asdict(self)
+        for name in ("load", "load_amplitude"):
+            value = getattr(self, name)
+            if isinstance(value, ForceSpec):
+                out[name] = value.text()
+        if self.check is not None:
+            out["check"] = self.check.as_dict()
+        return out
+
+
+def rating_table(ratings) -> dict[str, float]:
+    """``{"C_a": …, "C_0a": …}`` [N] from such a dict or from a
+    :class:`~prsm_health.physics.load_rating.LoadRatings` (``dynamic``, ``static``)."""
+    if isinstance(ratings, dict):
+        return ratings
+    dynamic, static = getattr(ratings, "dynamic", None), getattr(ratings, "static", None)
+    require(
+        dynamic is not None and static is not None,
+        "ratings",
+        type(ratings).__name__,
+        'must be {"C_a": …, "C_0a": …} [N] or the design\'s LoadRatings',
+    )
+    return {"C_a": float(dynamic), "C_0a": float(static)}
 
 
 #: ISO 3408-3 lead-deviation tolerances by grade: (v_300p, v_2πp) [m] — travel variation within
@@ -382,6 +548,15 @@ class ManufacturingVariation:
     flank_waviness : float [m]
         RMS waviness of the screw and nut flanks along the contact path, wavelengths 0.3–3 mm
         (shorter waves are averaged out by the contact ellipse), 6 components per flank.
+    rolling_radius_error : float [m]
+        Deviation of each roller's thread pitch (rolling) radius from the radius its gear's
+        tooth count implies (σ, per roller), and of the nut thread's from its ring gear's (σ,
+        one draw per unit). With its gear in mesh a roller rolling on the nut is
+        over-constrained: the relative mismatch, ≈ Δr_nut/r_nut − Δr_roller/r_roller, loads the
+        gears or makes the roller slip on the nut (Jones & Velinsky, J. Mech. Des. 134(6)
+        061006, 2012). Engineering estimate: the rollers of one nut are ground and matched as a
+        set, as the balls of a bearing are sorted (ISO 3290-1:2014 grade G16 allows 0.8 µm lot
+        diameter variation), so 1 µm on the radius — ε ≈ 3·10⁻⁴ on a 3.25 mm roller.
     """
 
     pitch_error: float = 2e-6
@@ -396,6 +571,7 @@ class ManufacturingVariation:
     gear_pitch_error: float = 11e-6
     gear_profile_error: float = 5e-6
     flank_waviness: float = 0.25e-6
+    rolling_radius_error: float = 1e-6
 
     def __post_init__(self):
         for name, high in (
@@ -411,6 +587,7 @@ class ManufacturingVariation:
             ("gear_pitch_error", 1e-4),
             ("gear_profile_error", 1e-4),
             ("flank_waviness", 1e-5),
+            ("rolling_radius_error", 1e-4),
         ):
             require_range(f"variation.{name}", getattr(self, name), 0.0, high)
 

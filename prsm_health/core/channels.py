@@ -38,6 +38,17 @@ TOPIC_DIAGNOSIS = "/prsm/diagnosis"
 #: Prefix of a truth signal's column name in Parquet and CSV files.
 TRUTH_PREFIX = "truth_"
 
+#: Column of the health-check phase of every sample (:mod:`prsm_health.actuator.health_check`):
+#: the index of the phase the drive was commanding, −1 outside any phase (the ramps between
+#: phases, a run that is no check). Measured side: the controller knows what it commands, so
+#: it is not a truth signal; it is not a sensor channel either (no features read it as one).
+CHECK_PHASE = "check_phase"
+#: MCAP topic of the check phase: one message per phase change, ``{"index": int, "name": str}``.
+TOPIC_CHECK_PHASE = "/health_check/phase"
+#: Name of the check's record (check name, phase names and boundaries) in file metadata: the
+#: MCAP Metadata record, and ``prsm_health.health_check`` in Parquet schema metadata.
+CHECK_METADATA = "health_check"
+
 
 @dataclass(frozen=True)
 class Channel:
@@ -84,8 +95,8 @@ CHANNELS: tuple[Channel, ...] = (
     _measured(
         "screw_angle",
         "rad",
-        "drive angle as the motor angle sensor reads it",
-        "motor encoder or resolver",
+        "gearbox output angle as the drive reports it: the motor sensor's reading / N",
+        "motor encoder or resolver (on the motor: its errors are N times finer on the screw)",
         TOPIC_DRIVE,
     ),
     _measured(
@@ -137,7 +148,7 @@ CHANNELS: tuple[Channel, ...] = (
     _measured(
         "drive_torque",
         "N*m",
-        "motor torque as the drive reports it",
+        "MOTOR torque k_t·i as the drive reports it (screw torque ≈ N·η times it when driving)",
         "phase current times the nominal torque constant",
         TOPIC_DRIVE,
     ),
@@ -146,6 +157,14 @@ CHANNELS: tuple[Channel, ...] = (
         "N",
         "force of the linkage on the nut (positive resisting)",
         "load cell in the linkage, where fitted",
+        TOPIC_DRIVE,
+    ),
+    # slow (the probe's time constant), logged at the signals' rate with the drive's signals
+    _measured(
+        "housing_temperature",
+        "K",
+        "actuator housing temperature at the nut",
+        "platinum RTD (Pt100/Pt1000) on the nut housing, where fitted",
         TOPIC_DRIVE,
     ),
 )
@@ -248,6 +267,15 @@ TRUTH_CHANNELS: tuple[Channel, ...] = (
         "external force applied to the payload (the load profile)",
         "acts on the payload, not in the linkage: the load cell reads axial_load",
     ),
+    # Not a kernel record column: the simulator derives it from the profile's contact
+    # temperature and the run's friction power (prsm_health.simulation.thermal), after them.
+    _truth(
+        "housing_temperature",
+        "K",
+        "housing temperature at the probe: the thread-contact lubricant temperature less the "
+        "steady contact-to-housing rise of the run's friction power",
+        "true value; measured channel housing_temperature is its sensor reading",
+    ),
 )
 
 #: Measured channel names in contract order (the keys a :class:`Run`'s channels may have).
@@ -263,12 +291,13 @@ def truth_column(name: str) -> str:
     return TRUTH_PREFIX + name
 
 
-#: SI unit of every file column: ``time``, the measured channels, and the truth signals under
-#: their column names ``truth_<name>`` (a truth signal and the measured channel of the same
+#: SI unit of every file column: ``time``, the measured channels, the check phase, and the
+#: truth signals under their column names ``truth_<name>`` (a truth signal and the measured channel of the same
 #: name are different columns).
 UNITS: dict[str, str] = {
     "time": "s",
     **{c.name: c.unit for c in CHANNELS},
+    CHECK_PHASE: "1",  # a phase index: dimensionless
     **{truth_column(c.name): c.unit for c in TRUTH_CHANNELS},
 }
 #: Nut housing accelerometer channels.

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .channels import CHANNEL_NAMES, TRUTH_NAMES, truth_column
+from .channels import CHANNEL_NAMES, CHECK_PHASE, TRUTH_NAMES, truth_column
 from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
 
 #: Fewest samples a recording or window needs: below it the spectra have too few bins for the
@@ -48,6 +48,13 @@ class Run:
         Truth signals of a simulated run (:data:`~prsm_health.core.channels.TRUTH_NAMES`, without
         the ``truth_`` prefix), SI, on the same time axis, free of sensor errors — empty for
         recordings. Never an input of the diagnosis.
+    check_phase : ndarray of int or None
+        Health-check phase of every sample (index into ``check["phases"]``, −1 outside any
+        phase), None when the run is no check. Known to the controller (it commands the
+        phases), so a recording from hardware may have it too.
+    check : dict
+        The check's ``name`` and ``phases`` (each ``index``, ``name``, ``start``, ``end`` [s]);
+        empty when the run is no check.
     """
 
     time: np.ndarray
@@ -57,6 +64,8 @@ class Run:
     scenario: dict = field(default_factory=dict)
     energy: dict = field(default_factory=dict)
     truth: dict[str, np.ndarray] = field(default_factory=dict)
+    check_phase: np.ndarray | None = None
+    check: dict = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name in self.truth and name not in self.channels:
@@ -147,17 +156,28 @@ class Run:
                 )
             if not np.all(np.isfinite(values)):
                 raise RecordingError(f"{what}: truth {name} contains NaN or infinite values")
+        if self.check_phase is not None and len(self.check_phase) != n:
+            raise RecordingError(
+                f"{what}: {CHECK_PHASE} has {len(self.check_phase)} samples, time has {n}"
+            )
         return self
 
     def without_truth(self) -> Run:
         """The same recording with the measured channels only (arrays shared, not copied)."""
         return Run(
-            self.time, self.channels, self.sample_rate, self.labels, self.scenario, self.energy
+            self.time,
+            self.channels,
+            self.sample_rate,
+            self.labels,
+            self.scenario,
+            self.energy,
+            check_phase=self.check_phase,
+            check=self.check,
         )
 
     def slice(self, start: int, stop: int) -> Run:
-        """Samples ``[start, stop)`` as a run (views): channels, truth, labels and scenario; no
-        energy book (it is the whole run's)."""
+        """Samples ``[start, stop)`` as a run (views): channels, truth, check phase, labels and
+        scenario; no energy book (it is the whole run's)."""
         sl = slice(start, stop)
         return Run(
             self.time[sl],
@@ -166,6 +186,8 @@ class Run:
             self.labels,
             self.scenario,
             truth={k: v[sl] for k, v in self.truth.items()},
+            check_phase=None if self.check_phase is None else self.check_phase[sl],
+            check=self.check,
         )
 
     def windows(
@@ -229,11 +251,28 @@ class Run:
             )
         return parts, notes
 
+    def phases(self) -> dict[str, Run]:
+        """The samples of each health-check phase as a run (views), by phase name, in check
+        order (the ramps between phases, ``check_phase`` −1, are in none); empty when the run
+        is no check. A phase is one contiguous span of samples (:meth:`slice`)."""
+        if self.check_phase is None:
+            return {}
+        phase = np.asarray(self.check_phase)
+        names = {int(p["index"]): p["name"] for p in self.check.get("phases", [])}
+        out = {}
+        for index in np.unique(phase[phase >= 0]):
+            where = np.flatnonzero(phase == index)
+            out[names.get(int(index), str(int(index)))] = self.slice(where[0], where[-1] + 1)
+        return out
+
     def columns(self) -> dict[str, np.ndarray]:
-        """The run as file columns (contract): ``time``, the measured channels, then
-        ``truth_<name>`` for each truth signal, in contract order."""
+        """The run as file columns (contract): ``time``, the measured channels, ``check_phase``
+        (int16, when the run is a check), then ``truth_<name>`` for each truth signal, in
+        contract order."""
         data = {"time": self.time}
         data.update({name: self.channels[name] for name in CHANNEL_NAMES if name in self.channels})
+        if self.check_phase is not None:
+            data[CHECK_PHASE] = np.asarray(self.check_phase, dtype=np.int16)
         data.update({truth_column(n): self.truth[n] for n in TRUTH_NAMES if n in self.truth})
         return data
 
@@ -242,6 +281,18 @@ class Run:
         import pandas as pd
 
         return pd.DataFrame(self.columns())
+
+
+def phase_of_samples(time, phases) -> np.ndarray:
+    """Health-check phase index of each sample time [s]: the ``index`` of the phase whose
+    ``start`` ≤ t < ``end`` (``phases`` as in :attr:`Run.check`), −1 outside any; int16.
+    The one rule that turns phase boundaries into the ``check_phase`` column (the simulator
+    and the file readers use it)."""
+    time = np.asarray(time, dtype=float)
+    out = np.full(time.shape, -1, dtype=np.int16)
+    for p in phases:
+        out[(time >= float(p["start"])) & (time < float(p["end"]))] = int(p["index"])
+    return out
 
 
 def window_span(

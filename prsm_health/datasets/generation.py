@@ -22,7 +22,7 @@ from prsm_health.actuator.faults import (
     FAULT_CLASSES,
     FaultThresholds,
 )
-from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_PREFIX, UNITS
+from prsm_health.core.channels import CHANNEL_NAMES, CHECK_PHASE, TRUTH_PREFIX, UNITS
 from prsm_health.core.errors import (
     PRSMHealthError,
     require,
@@ -52,6 +52,8 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
         spec = specs[run_id]
         run = spec.scenario().simulate()
         label = spec.labels(run)
+        if run.check:  # a check's phase names and boundaries, one JSON cell per run
+            label["check"] = json.dumps(run.check)
         run.labels = dict(run.labels, **label)
         if formats in ("mcap", "both"):
             from prsm_health.io.mcap import write_mcap
@@ -60,8 +62,9 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
                 write_mcap(run, tmp)
         columns = {"run_id": pa.array(np.full(len(run), run_id, np.int32))}
         for name, values in run.columns().items():
-            # time stays float64: float32 would round the sample times
-            columns[name] = pa.array(values if name == "time" else values.astype(dtype))
+            # time stays float64: float32 would round the sample times; the phase stays int16
+            exact = name in ("time", CHECK_PHASE)
+            columns[name] = pa.array(values if exact else values.astype(dtype))
         tables.append(pa.table(columns))
         labels.append(label)
     # One shard per batch, one row group per run; the labels ride in the footer so a shard and

@@ -9,9 +9,11 @@ import json
 from collections.abc import Iterable
 from pathlib import Path
 
+import numpy as np
+
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.design_files import load_design
-from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_PREFIX
+from prsm_health.core.channels import CHANNEL_NAMES, CHECK_PHASE, TRUTH_PREFIX
 from prsm_health.core.errors import (
     PRSMHealthError,
     StorageError,
@@ -106,6 +108,12 @@ class Dataset:
             for k, v in row.items()
             if k not in ("shard", "row_group")
         }
+        check = {}
+        if CHECK_PHASE in names:  # a health-check run: its phases, as the generator stored them
+            check = {
+                "check_phase": table.column(CHECK_PHASE).to_numpy().astype(np.int16),
+                "check": json.loads(labels.get("check") or "{}"),
+            }
         return Run(
             table.column("time").to_numpy(),
             channels,
@@ -114,6 +122,7 @@ class Dataset:
             # the design as a simulated run's scenario holds it (a preset name or the dict)
             {"recipe": self.manifest["recipe"], "design": self.manifest["recipe"].get("design")},
             truth=signals,
+            **check,
         )
 
     def iter_runs(self, run_ids: Iterable[int] | None = None):

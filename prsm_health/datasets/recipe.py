@@ -5,6 +5,12 @@ life recipes, the fleet — and the one run each index stands for (:class:`RunSp
 
 Run i always gets the same parameters and seed (derived from the recipe seed and i), whatever
 the worker count or scheduler (docs/formats.md).
+
+Loads — the swept ``load`` and ``load_amplitude`` (lists, ranges, ``{uniform = [min, max]}``) and
+the ``[profile]`` table's — may be newtons, a number with a unit or a share of the design's load
+rating (``load = ["5 % C_a", "40 % C_a"]``; :mod:`prsm_health.core.quantities`). A recipe has one
+design: its sweep is resolved against that design's ratings (a range of shares is a range of
+newtons between the resolved ends), the ``[profile]`` loads by each run's scenario.
 """
 
 from __future__ import annotations
@@ -33,6 +39,7 @@ from prsm_health.core.errors import (
     RecipeError,
     require_known_keys,
 )
+from prsm_health.core.quantities import parse_force
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml
 from prsm_health.simulation.instrumentation import (
@@ -40,7 +47,7 @@ from prsm_health.simulation.instrumentation import (
     list_profiles,
     load_instrumentation,
 )
-from prsm_health.simulation.scenario import Scenario
+from prsm_health.simulation.scenario import Scenario, design_ratings
 
 FORMATS = ("parquet", "mcap", "both")
 SWEEP_MODES = ("grid", "random", "lhs")
@@ -51,8 +58,8 @@ SWEPT = {
     "clearance_nut": "m",
     "clearance_gear": "m",
     "speed": "rad/s",
-    "load": "N",
-    "load_amplitude": "N",
+    "load": "N, kN or a share of C_a / C_0a",
+    "load_amplitude": "N, kN or a share of C_a / C_0a",
     "friction_scale": "-",
     "wear_spread": "-",
     "preload": "m",
@@ -68,6 +75,9 @@ SWEPT = {
 #: (``options.variation.pitch_error``, ``instrumentation.nut_axial_accel.noise_density_ug``).
 #: Units are the group's (docs/formats.md); the scenario validates every drawn value.
 SWEPT_GROUPS = ("profile", "options", "drive_train", "instrumentation")
+#: Swept keys that are forces: any form of :mod:`prsm_health.core.quantities`, resolved to
+#: newtons against the recipe's design (:attr:`Recipe.resolved_sweep`).
+FORCE_KEYS = ("load", "load_amplitude", "profile.load", "profile.load_amplitude")
 #: Swept by name: a list of ``fault_cases`` names (drawn uniformly in random and lhs mode).
 FAULT_CASE_KEY = "fault_case"
 NO_FAULT = "none"
@@ -224,7 +234,7 @@ class Recipe:
             value = sweep[key]
             unit = SWEPT.get(key, "the group's unit")
             if mode == "grid" and isinstance(value, dict):
-                ok = set(value) == {"uniform"} and _is_range(value["uniform"])
+                ok = set(value) == {"uniform"} and _is_range(value["uniform"], key)
                 check(
                     ok,
                     f"sweep.{key}",
@@ -232,24 +242,16 @@ class Recipe:
                     f"a drawn value must be {{uniform = [min, max]}} [{unit}]",
                 )
             elif mode == "grid":
-                ok = (
-                    isinstance(value, list)
-                    and value
-                    and all(isinstance(v, (int, float)) for v in value)
-                )
+                ok = isinstance(value, list) and value and all(_is_value(key, v) for v in value)
                 check(
                     ok,
                     f"sweep.{key}",
                     value,
-                    f"must be a non-empty list of numbers [{unit}], or {{uniform = [min, max]}}, in grid mode",
+                    f"must be a non-empty list of {'forces' if key in FORCE_KEYS else 'numbers'} "
+                    f"[{unit}], or {{uniform = [min, max]}}, in grid mode",
                 )
             else:
-                ok = (
-                    isinstance(value, list)
-                    and len(value) == 2
-                    and all(isinstance(v, (int, float)) for v in value)
-                    and value[0] <= value[1]
-                )
+                ok = _is_range(value, key)
                 check(
                     ok,
                     f"sweep.{key}",
@@ -264,12 +266,74 @@ class Recipe:
                 samples,
                 f"must be an integer ≥ 1 in {mode} mode",
             )
+        self._validate_forces(check)
         if self.life:
             self._validate_life(check, mode)
         # Build every run's scenario once (≈ 0.2 ms each), so a bad value anywhere in a sweep
         # fails now, naming the run, not later in a worker.
         for spec in self.runs():
             spec.scenario()
+
+    def _validate_forces(self, check) -> None:
+        """Each swept force parses (the error names the key and the accepted forms) and each
+        range is ordered once resolved against the design's ratings."""
+        for key in _swept_keys(self.sweep):
+            if key not in FORCE_KEYS:
+                continue
+            for v in _values(self.sweep[key]):
+                try:
+                    newtons = self._newtons(key, v)
+                except ParameterError as exc:
+                    raise RecipeError(f"recipe: {exc}") from None
+                # one value alone above the static rating: named here, not as run k's peak
+                check(
+                    abs(newtons) <= self.ratings["C_0a"],
+                    f"sweep.{key}",
+                    v,
+                    f"is {newtons:.4g} N, above the static load rating C_0a = "
+                    f"{self.ratings['C_0a']:.4g} N of the design",
+                )
+        try:
+            resolved = self.resolved_sweep
+        except ParameterError as exc:
+            raise RecipeError(f"recipe: {exc}") from None
+        for key in FORCE_KEYS:
+            value = resolved.get(key)
+            if value is None:
+                continue
+            pair = value.get("uniform") if isinstance(value, dict) else value
+            if isinstance(value, dict) or self.sweep.get("mode", "grid") != "grid":
+                check(
+                    pair[0] <= pair[1],
+                    f"sweep.{key}",
+                    self.sweep[key],
+                    f"a range [min, max] must have min ≤ max (here {pair[0]:g} N > "
+                    f"{pair[1]:g} N with the design's ratings)",
+                )
+
+    @cached_property
+    def ratings(self) -> dict[str, float]:
+        """``{"C_a": …, "C_0a": …}`` [N]: the design's basic axial load ratings, which the
+        loads given as shares are shares of."""
+        return design_ratings(self.prsm_design)
+
+    @cached_property
+    def resolved_sweep(self) -> dict:
+        """The sweep with every force (:data:`FORCE_KEYS`) in newtons against the design's
+        ratings: what the runs draw from."""
+        out = dict(self.sweep)
+        for key in FORCE_KEYS:
+            if key not in out:
+                continue
+            value = out[key]
+            if isinstance(value, dict):
+                out[key] = {"uniform": [self._newtons(key, v) for v in value["uniform"]]}
+            else:
+                out[key] = [self._newtons(key, v) for v in value]
+        return out
+
+    def _newtons(self, key: str, value) -> float:
+        return parse_force(value, f"sweep.{key}").newtons(self.ratings, f"sweep.{key}")
 
     def _validate_life(self, check, mode: str) -> None:
         try:
@@ -373,7 +437,8 @@ class Recipe:
         n_total = len(points) * repeats
         test = _test_set(n_total, self.test_fraction, self.seed)
         run_id = 0
-        drawn = {k: v["uniform"] for k, v in self.sweep.items() if isinstance(v, dict)}
+        sweep = self.resolved_sweep
+        drawn = {k: v["uniform"] for k, v in sweep.items() if isinstance(v, dict)}
         for point in points:
             for _ in range(repeats):
                 seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
@@ -397,13 +462,14 @@ class Recipe:
         spec = self.life_spec
         test_units = _test_set(spec.units, self.test_fraction, self.seed)
         keys = _swept_keys(self.sweep)
+        sweep = self.resolved_sweep
         specs = []
         for unit in self.fleet():
             for k, age in enumerate(unit.snapshot_ages(spec.snapshots)):
                 run_id = unit.unit_id * spec.snapshots + k
                 unit_draw = np.random.default_rng([self.seed, run_id, 0x534E4150]).random(len(keys))
                 point = {
-                    key: float(self.sweep[key][0] + u * (self.sweep[key][1] - self.sweep[key][0]))
+                    key: float(sweep[key][0] + u * (sweep[key][1] - sweep[key][0]))
                     for u, key in zip(unit_draw, keys)
                 }
                 point.update(unit_id=unit.unit_id, age_hours=float(age))
@@ -413,16 +479,17 @@ class Recipe:
         return specs
 
     def _points(self) -> list[dict]:
-        keys = _swept_keys(self.sweep)
-        mode = self.sweep.get("mode", "grid")
-        cases = self.sweep.get(FAULT_CASE_KEY)
+        sweep = self.resolved_sweep
+        keys = _swept_keys(sweep)
+        mode = sweep.get("mode", "grid")
+        cases = sweep.get(FAULT_CASE_KEY)
         if mode == "grid":
-            keys = [k for k in keys if not isinstance(self.sweep[k], dict)]
+            keys = [k for k in keys if not isinstance(sweep[k], dict)]
             if cases:
                 keys.append(FAULT_CASE_KEY)
-            values = [self.sweep[k] for k in keys]
+            values = [sweep[k] for k in keys]
             return [dict(zip(keys, combo)) for combo in itertools.product(*values)]
-        n = self.sweep["samples"]
+        n = sweep["samples"]
         if mode == "random":
             unit = np.random.default_rng([self.seed, 0x5357]).random((n, len(keys)))
         else:
@@ -435,7 +502,7 @@ class Recipe:
         for row in unit:
             point = {}
             for j, k in enumerate(keys):
-                lo, hi = self.sweep[k]
+                lo, hi = sweep[k]
                 point[k] = float(lo + row[j] * (hi - lo))
             if cases:  # a categorical draw from its own stream, so the numeric draws stay put
                 pick = np.random.default_rng([self.seed, len(out), 0x46434153]).integers(len(cases))
@@ -481,13 +548,27 @@ def _set_path(target: dict, path: list[str], value) -> None:
     target[path[-1]] = value
 
 
-def _is_range(value) -> bool:
-    return (
-        isinstance(value, list)
-        and len(value) == 2
-        and all(isinstance(v, (int, float)) for v in value)
-        and value[0] <= value[1]
-    )
+def _is_value(key: str, value) -> bool:
+    """A number, or for a force (:data:`FORCE_KEYS`) any of its written forms: a string; it is
+    parsed (with its own error) by ``Recipe._validate_forces``."""
+    if isinstance(value, bool):
+        return False
+    return isinstance(value, (int, float)) or (key in FORCE_KEYS and isinstance(value, str))
+
+
+def _is_range(value, key: str = "") -> bool:
+    """[min, max]; ordered when numbers (a force range is ordered once resolved)."""
+    if not (isinstance(value, list) and len(value) == 2 and all(_is_value(key, v) for v in value)):
+        return False
+    numbers = all(isinstance(v, (int, float)) for v in value)
+    return not numbers or value[0] <= value[1]
+
+
+def _values(value) -> list:
+    """The written values of a sweep entry (a list, or ``{uniform = [min, max]}``)."""
+    if isinstance(value, dict):
+        return list(value.get("uniform", []))
+    return list(value) if isinstance(value, list) else [value]
 
 
 def _test_set(n: int, fraction: float, seed: int) -> set[int]:
@@ -522,13 +603,10 @@ class RunSpec:
         )
         health.update({k: p[k] for k in health_keys if k in p})
         health["faults"] = self.faults()
-        profile = {
-            "duration": r.duration,
-            "speed": p.get("speed", 100.0),
-            "load": p.get("load", 100.0),
-        }
+        # no swept or [profile] load: the scenario's default share of the design's rating
+        profile = {"duration": r.duration, "speed": p.get("speed", 100.0)}
         profile.update(r.profile)
-        for key in ("load_amplitude", "temperature"):
+        for key in ("load", "load_amplitude", "temperature"):
             if key in p:
                 profile[key] = p[key]
         return self._build(health, profile, seed=self.seed)
@@ -573,11 +651,10 @@ class RunSpec:
         profile = {
             "duration": r.duration,
             "speed": p.get("speed", 100.0),
-            "load": p.get("load", 100.0),
             "temperature": unit.temperature,
         }
         profile.update(r.profile)
-        for key in ("load_amplitude", "temperature"):
+        for key in ("load", "load_amplitude", "temperature"):
             if key in p:
                 profile[key] = p[key]
         return self._build(health, profile, seed=unit.seed, sensor_seed=self.seed)

@@ -21,7 +21,7 @@ from prsm_health.core.channels import UNITS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 
-from .columns import contract_channels, rate_from_time, run_table, truth_columns
+from .columns import check_columns, contract_channels, rate_from_time, run_table, truth_columns
 
 #: Media type of an Arrow IPC stream (IANA registration).
 ARROW_STREAM_MEDIA_TYPE = "application/vnd.apache.arrow.stream"
@@ -167,7 +167,7 @@ def _run_from_table(table, name: str) -> Run:
         raise PRSMHealthError(f"{name}: unreadable prsm_health schema metadata ({exc})") from None
     if not isinstance(labels, dict) or not isinstance(scenario, dict):
         raise PRSMHealthError(f"{name}: prsm_health.labels and .scenario must be JSON objects")
-    return Run(time, channels, rate, labels, scenario, truth=truth)
+    return Run(time, channels, rate, labels, scenario, truth=truth, **check_columns(table))
 
 
 # ----------------------------------------------------------------------------- flatbuffers

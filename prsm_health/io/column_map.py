@@ -39,6 +39,7 @@ QUANTITY = {
     "nut_radial_y_accel": "acceleration",
     "drive_torque": "torque",
     "axial_load": "force",
+    "housing_temperature": "temperature",
     "motor_current": "current",
 }
 _G = 9.80665
@@ -75,7 +76,12 @@ UNITS: dict[str, tuple[str, float]] = {
     "mm/s^2": ("acceleration", 1e-3),
     "mm/s²": ("acceleration", 1e-3),
     "g": ("acceleration", _G),
+    "K": ("temperature", 1.0),
+    "degC": ("temperature", 1.0),
+    "°C": ("temperature", 1.0),
 }
+#: Unit spelling → offset added after the factor (temperatures in Celsius → kelvin).
+OFFSETS = {"degC": 273.15, "°C": 273.15}
 MAP_KEYS = ("columns", "units", "sample_rate", "design", "lead", "torque_constant")
 #: Largest accepted deviation of a time step from the median step (a fraction of it).
 UNIFORM_TOLERANCE = 0.01
@@ -287,7 +293,8 @@ def apply_column_map(frame, spec: ColumnMap, where: str) -> Run:
         )
     values = {}
     for name, column in spec.columns.items():
-        values[name] = frame_column(frame, column, where) * UNITS[spec.units.get(column, "s")][1]
+        unit = spec.units.get(column, "s")
+        values[name] = frame_column(frame, column, where) * UNITS[unit][1] + OFFSETS.get(unit, 0.0)
     n = len(frame)
     if "time" in values:
         time = values.pop("time")

@@ -10,15 +10,23 @@ from pathlib import Path
 
 import numpy as np
 
-from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_NAMES, TRUTH_PREFIX, UNITS, truth_column
+from prsm_health.core.channels import (
+    CHANNEL_NAMES,
+    CHECK_METADATA,
+    CHECK_PHASE,
+    TRUTH_NAMES,
+    TRUTH_PREFIX,
+    UNITS,
+    truth_column,
+)
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps
 
 
 def run_table(run):
-    """``run`` as a pyarrow Table (``time``, channels, ``truth_<name>``) whose schema carries
-    the units and sample rate (:func:`with_units`), the labels and the scenario (what the
-    Parquet and Arrow writers store)."""
+    """``run`` as a pyarrow Table (``time``, channels, ``check_phase``, ``truth_<name>``) whose
+    schema carries the units and sample rate (:func:`with_units`), the labels, the scenario and
+    a health check's phases (what the Parquet and Arrow writers store)."""
     import pyarrow as pa
 
     table = with_units(pa.Table.from_pandas(run.to_frame(), preserve_index=False), run.sample_rate)
@@ -26,6 +34,8 @@ def run_table(run):
         b"prsm_health.labels": dumps(run.labels).encode(),
         b"prsm_health.scenario": dumps(run.scenario).encode(),
     }
+    if run.check:
+        meta[CHECK_KEY] = dumps(run.check).encode()
     return table.replace_schema_metadata({**table.schema.metadata, **meta})
 
 
@@ -110,3 +120,21 @@ def rate_from_time(path: Path, time: np.ndarray) -> float:
     if len(time) < 2 or not np.all(np.diff(time) > 0):
         raise PRSMHealthError(f"{path}: 'time' must increase strictly (and hold 2 samples or more)")
     return 1.0 / float(np.median(np.diff(time)))
+
+
+#: Schema-metadata key of a health check's name and phase boundaries (JSON).
+CHECK_KEY = f"prsm_health.{CHECK_METADATA}".encode()
+
+
+def check_columns(table) -> dict:
+    """``check_phase`` (int16) and ``check`` (name, boundaries) of a run table, as ``Run``
+    keywords: none when the table is no check recording (docs/formats.md)."""
+    if CHECK_PHASE not in table.column_names:
+        return {}
+    meta = table.schema.metadata or {}
+    try:
+        check = json.loads(meta.get(CHECK_KEY, b"{}"))
+    except ValueError as exc:
+        raise PRSMHealthError(f"unreadable {CHECK_KEY.decode()} metadata ({exc})") from None
+    phase = table.column(CHECK_PHASE).to_numpy().astype(np.int16)
+    return {"check_phase": phase, "check": check if isinstance(check, dict) else {}}

@@ -1,6 +1,8 @@
-"""One run as a single Parquet file: ``time``, the measured channels, then ``truth_<name>`` for
-each truth signal as columns, with the units, sample rate, labels and scenario in the schema
-metadata (docs/formats.md), so pandas, pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.datasets`.
+"""One run as a single Parquet file: ``time``, the measured channels, ``check_phase`` (a health
+check's phase of every sample, int16, −1 between phases) then ``truth_<name>`` for each truth
+signal as columns, with the units, sample rate, labels, scenario and the check's phase names and
+boundaries (``prsm_health.health_check``) in the schema metadata (docs/formats.md), so pandas,
+pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.datasets`.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from pathlib import Path
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 
-from .columns import contract_channels, rate_from_time, run_table, truth_columns
+from .columns import check_columns, contract_channels, rate_from_time, run_table, truth_columns
 
 
 def write_run_parquet(run: Run, path: str | Path) -> Path:
@@ -57,4 +59,4 @@ def read_run_parquet(path: str | Path | bytes, *, name: str | None = None) -> Ru
         rate = rate_from_time(path, time)
     labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
     scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
-    return Run(time, channels, rate, labels, scenario, truth=truth)
+    return Run(time, channels, rate, labels, scenario, truth=truth, **check_columns(table))

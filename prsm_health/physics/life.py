@@ -37,7 +37,9 @@ from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.faults import Spall
 from prsm_health.actuator.states import HealthState
 from prsm_health.core.errors import require, require_known_keys, require_positive, require_range
+from prsm_health.core.quantities import ForceSpec, parse_force
 
+from .load_rating import load_ratings
 from .lubrication import DEFAULT_LUBRICANT, asperity_share, lubricant, stribeck_curve
 from .wear import (
     SURFACES,
@@ -57,6 +59,17 @@ FAILURE_MODES = ("wear", "spall")
 _DEGRADATION_GRID = np.linspace(0.0, 1.0, 101)
 #: Steps of the age grid a unit's wear is accumulated on (up to 4× its expected life).
 _AGE_STEPS = 2000
+#: The duty cycle's default load spectrum, as shares of the design's basic dynamic axial load
+#: rating C_a, and the share of motion time at each. The same duty as the recordings of
+#: datasets/fleet.toml and datasets/flight-ema-reference.toml (a reversing load of mean
+#: ±5 % C_a swinging by 2–30 % C_a, drawn per recording): the |load| those recordings see,
+#: split at its 50th and 85th percentiles, has the cubic means 10.5, 21 and 29 % C_a — so the
+#: life model wears and fatigues a unit under the loads it is recorded at (tests/physics/
+#: test_life.py checks it). Engineering estimate of a flight EMA's service (10–40 % of C_a,
+#: docs/load-ratings.md); its mean cubic load, 19 % C_a, gives an ISO 281 L10 of 1.4·10⁸ screw
+#: revolutions.
+DEFAULT_DUTY_LOADS = ("10 % C_a", "20 % C_a", "30 % C_a")
+DEFAULT_DUTY_SHARES = (0.5, 0.35, 0.15)
 
 
 def _pair(table: str, name: str, value, lo: float, hi: float, unit: str = "-") -> tuple:
@@ -82,8 +95,11 @@ class DutyCycle:
         Screw speed while it moves.
     stroke : float [m]
         Travel of the reciprocating stroke (spreads the screw's wear track).
-    loads : tuple of float [N]
-        Axial load spectrum: the loads the unit carries while it moves …
+    loads : tuple of float [N] or str
+        Axial load spectrum: the loads the unit carries while it moves, in any form of
+        :mod:`prsm_health.core.quantities` — newtons, ``"1.5 kN"``, or a share of the
+        design's rating (``"20 % C_a"``), resolved against the design by :meth:`resolved`
+        (:func:`unit_life` does). Default :data:`DEFAULT_DUTY_LOADS` …
     shares : tuple of float [-]
         … and the share of motion time at each (sum 1).
     motion_fraction : float [-]
@@ -96,14 +112,20 @@ class DutyCycle:
 
     speed: float = 100.0
     stroke: float = 0.05
-    loads: tuple = (500.0, 1500.0, 3000.0)
-    shares: tuple = (0.5, 0.35, 0.15)
+    loads: tuple = DEFAULT_DUTY_LOADS
+    shares: tuple = DEFAULT_DUTY_SHARES
     motion_fraction: float = 0.3
     temperature: float = 323.15
     lubricant_life: float = 2000.0
 
     def __post_init__(self):
-        object.__setattr__(self, "loads", tuple(float(v) for v in self.loads))
+        require(
+            isinstance(self.loads, (list, tuple)),
+            "life.duty.loads",
+            self.loads,
+            "must be a list of loads (N, '1.5 kN' or '20 % C_a')",
+        )
+        object.__setattr__(self, "loads", tuple(_duty_load(v) for v in self.loads))
         object.__setattr__(self, "shares", tuple(float(v) for v in self.shares))
         require_range("life.duty.speed", self.speed, 1e-3, 2000.0, unit="rad/s")
         require_range("life.duty.stroke", self.stroke, 0.0, 5.0, unit="m")
@@ -114,7 +136,15 @@ class DutyCycle:
             f"needs one share per load ({len(self.loads)} loads)",
         )
         for value in self.loads:
-            require_range("life.duty.loads", value, -1e6, 1e6, unit="N")
+            if isinstance(value, ForceSpec):
+                require(
+                    abs(value.value) <= 100.0,
+                    "life.duty.loads",
+                    value.text(),
+                    f"a share of {value.of} must lie in [-100, 100] × {value.of}",
+                )
+            else:
+                require_range("life.duty.loads", value, -1e6, 1e6, unit="N")
         require(
             all(s >= 0 for s in self.shares) and abs(sum(self.shares) - 1.0) < 1e-6,
             "life.duty.shares",
@@ -124,6 +154,40 @@ class DutyCycle:
         require_range("life.duty.motion_fraction", self.motion_fraction, 1e-4, 1.0)
         require_range("life.duty.temperature", self.temperature, 223.15, 473.15, unit="K")
         require_range("life.duty.lubricant_life", self.lubricant_life, 1.0, 1e7, unit="h")
+
+    @property
+    def is_resolved(self) -> bool:
+        """True when every load is in newtons."""
+        return not any(isinstance(v, ForceSpec) for v in self.loads)
+
+    def resolved(self, ratings) -> DutyCycle:
+        """This duty with its loads in newtons against ``ratings`` (``{"C_a": …, "C_0a": …}``
+        [N], or the design's :class:`~prsm_health.physics.load_rating.LoadRatings`); a load
+        above the static rating C_0a is refused."""
+        if not isinstance(ratings, dict):
+            ratings = {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)}
+        loads = tuple(parse_force(v).newtons(ratings, "life.duty.loads") for v in self.loads)
+        for given, value in zip(self.loads, loads):
+            require(
+                "C_0a" not in ratings or abs(value) <= ratings["C_0a"],
+                "life.duty.loads",
+                given.text() if isinstance(given, ForceSpec) else given,
+                f"is {value:.4g} N, above the design's static load rating C_0a = "
+                f"{ratings['C_0a']:.4g} N (permanent deformation of the threads: ISO 76)",
+            )
+        return replace(self, loads=loads)
+
+    def as_dict(self) -> dict:
+        """The fields as plain values; a load given as a share is its text (``"20 % C_a"``)."""
+        out = asdict(self)
+        out["loads"] = [v.text() if isinstance(v, ForceSpec) else v for v in self.loads]
+        return out
+
+
+def _duty_load(value):
+    """A duty load: newtons as a float, a share of a rating as its ForceSpec."""
+    spec = parse_force(value, "life.duty.loads")
+    return spec.value if spec.of is None else spec
 
 
 @dataclass(frozen=True)
@@ -253,7 +317,7 @@ class LifeSpec:
         return cls(**values)
 
     def as_dict(self) -> dict:
-        return asdict(self)
+        return {**asdict(self), "duty": self.duty.as_dict()}
 
 
 @dataclass(frozen=True)
@@ -355,12 +419,20 @@ def _with_length(spall: Spall, length: float) -> Spall:
 
 
 def unit_life(
-    design: PRSMDesign, spec: LifeSpec, unit_id: int, fleet_seed: int, geometry=None
+    design: PRSMDesign,
+    spec: LifeSpec,
+    unit_id: int,
+    fleet_seed: int,
+    geometry=None,
+    ratings: dict | None = None,
 ) -> UnitLife:
-    """Simulate one unit's life (deterministic in ``fleet_seed`` and ``unit_id``)."""
+    """Simulate one unit's life (deterministic in ``fleet_seed`` and ``unit_id``); the duty's
+    loads given as shares are shares of ``ratings`` (default: the design's,
+    :func:`~prsm_health.physics.load_rating.load_ratings`)."""
     geometry = geometry or PartGeometry.of(design)
     rng = np.random.default_rng([fleet_seed, unit_id, 0x4C494645])  # "LIFE"
-    sc, duty, wear = spec.scatter, spec.duty, spec.wear
+    sc, wear = spec.scatter, spec.wear
+    duty = spec.duty.resolved(ratings or load_ratings(design))
     draws = rng.random(5)
     b0 = sc.initial_clearance[0] + draws[0] * (sc.initial_clearance[1] - sc.initial_clearance[0])
     load_scale = sc.load_scale[0] + draws[1] * (sc.load_scale[1] - sc.load_scale[0])
@@ -581,4 +653,6 @@ def _spall_on(surface: str, design: PRSMDesign, duty: DutyCycle, wear, rng) -> S
 def fleet_lives(design: PRSMDesign, spec: LifeSpec, fleet_seed: int) -> list[UnitLife]:
     """Every unit of the fleet (deterministic in ``fleet_seed``)."""
     geometry = PartGeometry.of(design)
-    return [unit_life(design, spec, u, fleet_seed, geometry) for u in range(spec.units)]
+    ratings = load_ratings(design)
+    ratings = {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)}
+    return [unit_life(design, spec, u, fleet_seed, geometry, ratings) for u in range(spec.units)]

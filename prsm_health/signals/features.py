@@ -136,6 +136,7 @@ def _feature_table() -> dict[str, str]:
             "load_mean": "N",
             "load_range": "N",
             "reversal": "-",
+            "housing_temperature_mean": "K",
         }
     )
     return units
@@ -167,7 +168,7 @@ GROUPS = {
     "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
     "lost_motion": ["lost_motion"],
     "torque_rattle": ["torque_rattle_rate"],
-    "operating": ["speed_mean", "load_mean", "load_range", "reversal"],
+    "operating": ["speed_mean", "load_mean", "load_range", "reversal", "housing_temperature_mean"],
 }
 
 
@@ -198,7 +199,7 @@ GROUP_CHANNELS: dict[str, Needs] = {
     "torque": Needs(("drive_torque",)),
     "lost_motion": Needs(("nut_position", "screw_angle")),
     "torque_rattle": Needs(("drive_torque",)),
-    "operating": Needs(any_of=("screw_speed", "axial_load", "drive_torque")),
+    "operating": Needs(any_of=("screw_speed", "axial_load", "drive_torque", "housing_temperature")),
 }
 
 
@@ -495,6 +496,10 @@ def _operating(run: Run, out: dict) -> None:
     if load is not None:
         out["load_mean"] = float(np.mean(load))
         out["load_range"] = float(np.ptp(load))
+    # the measured housing temperature: the lubricant's confounder (docs/faults.md)
+    temperature = run.channels.get("housing_temperature")
+    if temperature is not None:
+        out["housing_temperature_mean"] = float(np.mean(temperature))
 
 
 def _carrier_frequency(run: Run, ratios) -> float:

@@ -11,7 +11,10 @@ the fitted channels at its sample rate f_s = f_int / m (m an integer):
 - ``nut_*_accel``: :class:`Accelerometer` reads the nut acceleration of its axis (and, through
   its transverse sensitivity, the two across it);
 - ``drive_torque``: :class:`TorqueEstimate` (phase current × nominal k_t) reads motor_torque;
-- ``axial_load``: :class:`LoadCell` reads axial_load.
+- ``axial_load``: :class:`LoadCell` reads axial_load;
+- ``housing_temperature``: :class:`TemperatureSensor` (an RTD on the nut housing) reads the truth
+  housing_temperature (prsm_health.simulation.thermal: the contact temperature less the
+  contact-to-housing rise).
 
 Order of operations inside every sensor: what the sensor does to the continuous signal —
 gain error, cross-axis coupling, nonlinearity, drift, bandwidth, mounting resonance,
@@ -141,6 +144,12 @@ def _truth(truth: dict, name: str, channel: str) -> np.ndarray:
         ) from None
 
 
+def _no_bound_keys(cls, table: dict, where: str) -> None:
+    """Refuse a key that is bound from the drive train (one declaration), naming the allowed."""
+    if "gear_ratio" in table:
+        raise UnknownKeyError(where, "gear_ratio", table["gear_ratio"], cls.allowed_keys())
+
+
 # ----------------------------------------------------------------------------- sensors
 @dataclass(frozen=True)
 class _Sensor:
@@ -263,7 +272,11 @@ class _Sensor:
 class AngleSensor(_Sensor):
     """Motor encoder or resolver with its converter → ``screw_angle`` (from ``motor_angle``).
 
-    measured = θ + Σ_k e_k·sin(k·p·θ + φ_k) + n, quantised to 2π/counts_per_rev, read at f_s.
+    measured = [θ + Σ_k e_k·sin(k·p·θ + φ_k) + n, quantised to 2π/counts_per_rev] / N, read at
+    f_s. The sensor sits on the motor, as in a real EMA; the drive reports the output angle, the
+    reading divided by the reduction N (``gear_ratio``, bound from the drive train by
+    :func:`bind_drive_train`, 1 for a direct drive), so every error of the sensor is N times
+    finer on the screw and its harmonics sit at orders of the motor's turn (N× the screw's).
     θ: motor angle; p: ``pole_pairs`` (speed of the resolver, 1X = 1; encoders 1), so the
     ``harmonic_orders`` are orders of its electrical angle p·θ; φ_k uniform per run (a unit's
     own error pattern); n: white noise. Resolver errors are mainly the 1st (offsets) and 2nd
@@ -280,6 +293,8 @@ class AngleSensor(_Sensor):
         Amplitude of each harmonic (alias ``harmonic_error_arcmin``).
     noise : float [rad]
         RMS white noise (alias ``noise_arcmin``).
+    gear_ratio : float [-]
+        Motor turns per screw turn; not a profile key: the drive train's, bound at run time.
     """
 
     KIND: ClassVar[str] = "angle sensor"
@@ -299,6 +314,7 @@ class AngleSensor(_Sensor):
     harmonic_orders: tuple[int, ...] = ()
     harmonic_error: tuple[float, ...] = ()
     noise: float = 0.0
+    gear_ratio: float = 1.0
 
     def __post_init__(self):
         self._validate()
@@ -306,6 +322,20 @@ class AngleSensor(_Sensor):
         self._integer("pole_pairs", 1, 64)
         self._harmonic_pairs("harmonic_orders", "harmonic_error", 0.1)
         self._range("noise", 0.0, 0.1)
+        self._range("gear_ratio", 1.0, 1000.0)
+
+    # The ratio is the drive train's (one declaration): not a profile key, not written back.
+    @classmethod
+    def allowed_keys(cls) -> list[str]:
+        return [k for k in super().allowed_keys() if k != "gear_ratio"]
+
+    @classmethod
+    def from_table(cls, table: dict, where: str, start=None):
+        _no_bound_keys(cls, table, where)
+        return super().from_table(table, where, start)
+
+    def to_dict(self) -> dict:
+        return {k: v for k, v in super().to_dict().items() if k != "gear_ratio"}
 
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         theta = decimate(_truth(truth, self.SOURCE, channel), factor)
@@ -316,7 +346,8 @@ class AngleSensor(_Sensor):
             )
         if self.noise:
             theta = theta + rng.normal(0.0, self.noise, theta.shape)
-        return _quantise(theta, 2 * np.pi / self.counts_per_rev if self.counts_per_rev else 0.0)
+        counts = _quantise(theta, 2 * np.pi / self.counts_per_rev if self.counts_per_rev else 0.0)
+        return counts / self.gear_ratio if self.gear_ratio != 1.0 else counts
 
 
 @dataclass(frozen=True)
@@ -332,8 +363,11 @@ class SpeedEstimate(_Sensor):
     bandwidth : float [Hz]
         Velocity filter corner (0: the raw difference).
     exact : bool
-        The truth motor speed, decimated, instead of an estimate (the ``ideal`` profile only:
-        no drive has it).
+        The truth motor speed / N, decimated, instead of an estimate (the ``ideal`` profile
+        only: no drive has it).
+    gear_ratio : float [-]
+        Motor turns per screw turn (the drive reports the output speed); bound from the drive
+        train like :class:`AngleSensor`'s, not a profile key.
     """
 
     KIND: ClassVar[str] = "speed estimate"
@@ -342,15 +376,30 @@ class SpeedEstimate(_Sensor):
 
     bandwidth: float = 0.0
     exact: bool = False
+    gear_ratio: float = 1.0
 
     def __post_init__(self):
         self._validate()
         self._range("bandwidth", 0.0, 1e6)
         require(isinstance(self.exact, bool), "exact", self.exact, "must be true or false")
+        self._range("gear_ratio", 1.0, 1000.0)
+
+    @classmethod
+    def allowed_keys(cls) -> list[str]:
+        return [k for k in super().allowed_keys() if k != "gear_ratio"]
+
+    @classmethod
+    def from_table(cls, table: dict, where: str, start=None):
+        _no_bound_keys(cls, table, where)
+        return super().from_table(table, where, start)
+
+    def to_dict(self) -> dict:
+        return {k: v for k, v in super().to_dict().items() if k != "gear_ratio"}
 
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         if self.exact:
-            return decimate(_truth(truth, self.SOURCE, channel), factor)
+            speed = decimate(_truth(truth, self.SOURCE, channel), factor)
+            return speed / self.gear_ratio if self.gear_ratio != 1.0 else speed
         angle = measured["screw_angle"]
         sample_rate = rate / factor
         speed = np.empty_like(angle)
@@ -362,6 +411,9 @@ class SpeedEstimate(_Sensor):
 @dataclass(frozen=True)
 class TorqueEstimate(_Sensor):
     """Phase current × nominal torque constant → ``drive_torque`` (from ``motor_torque``).
+
+    The MOTOR torque k_t·i, as a drive reports it: behind a reduction the screw gets N·η times
+    it when the motor drives (N/η when the load drives back), less the reduction's dynamics.
 
     measured = g·LP(τ) + τ_r(θ) + n, where g = k_t,nominal / k_t,actual = 1 + N(0, gain_sigma)
     per run (torque-constant tolerance: the drive scales the current with the nameplate k_t);
@@ -378,9 +430,12 @@ class TorqueEstimate(_Sensor):
     noise : float [N·m]
     bandwidth : float [Hz]
         Current-loop bandwidth (0: none).
-    rated_torque : float [N·m]
-        Reference of the ripple amplitudes.
-    pole_pairs : int
+    rated_torque : float [N·m] or None
+        Reference of the ripple amplitudes. None (the built-in profiles): the drive train's
+        motor's continuous torque, bound at run time (:func:`bind_drive_train`); a value given
+        here wins (a recording whose motor is not the simulated one).
+    pole_pairs : int or None
+        Motor pole pairs; None: the drive train's motor's, bound at run time; a value wins.
     ripple_orders : list of int
     ripple : list of float [-]
         Fractions of ``rated_torque`` (alias ``ripple_percent``).
@@ -403,39 +458,77 @@ class TorqueEstimate(_Sensor):
     gain_sigma: float = 0.0
     noise: float = 0.0
     bandwidth: float = 0.0
-    rated_torque: float = 0.0
-    pole_pairs: int = 1
+    rated_torque: float | None = None
+    pole_pairs: int | None = None
     ripple_orders: tuple[int, ...] = ()
     ripple: tuple[float, ...] = ()
+
+    #: Motor figures used while no drive train is bound (the direct drive's ~1 N·m, 4 pole pairs
+    #: motor: prsm_health.actuator.drive_train.DriveTrain.direct).
+    UNBOUND_RATED_TORQUE: ClassVar[float] = 1.0
+    UNBOUND_POLE_PAIRS: ClassVar[int] = 4
 
     def __post_init__(self):
         self._validate()
         self._range("gain_sigma", 0.0, 0.5)
         self._range("noise", 0.0, 1e3)
         self._range("bandwidth", 0.0, 1e6)
-        self._range("rated_torque", 0.0, 1e5)
-        self._integer("pole_pairs", 1, 64)
+        if self.rated_torque is not None:
+            self._range("rated_torque", 0.0, 1e5)
+            require(
+                self.rated_torque > 0 or not any(self.ripple),
+                "rated_torque",
+                self.rated_torque,
+                "must be > 0 when ripple is given (the ripple is a fraction of it)",
+            )
+        if self.pole_pairs is not None:
+            self._integer("pole_pairs", 1, 64)
         self._harmonic_pairs("ripple_orders", "ripple", 0.5)
-        require(
-            self.rated_torque > 0 or not any(self.ripple),
-            "rated_torque",
-            self.rated_torque,
-            "must be > 0 when ripple is given (the ripple is a fraction of it)",
-        )
+
+    def to_dict(self) -> dict:
+        # None (= the drive train's motor) has no TOML form: such keys are left out.
+        return {k: v for k, v in super().to_dict().items() if v is not None}
 
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         gain = 1.0 + rng.normal(0.0, self.gain_sigma)
         phases = rng.uniform(0.0, 2 * np.pi, len(self.ripple_orders))
         x = gain * _lowpass(_truth(truth, self.SOURCE, channel), self.bandwidth, rate)
         if self.ripple_orders:
-            electrical = self.pole_pairs * _truth(truth, "motor_angle", channel)
-            x = x + self.rated_torque * _harmonics(
-                electrical, self.ripple_orders, self.ripple, phases
+            rated = (
+                self.rated_torque if self.rated_torque is not None else self.UNBOUND_RATED_TORQUE
             )
+            pairs = self.pole_pairs if self.pole_pairs is not None else self.UNBOUND_POLE_PAIRS
+            electrical = pairs * _truth(truth, "motor_angle", channel)
+            x = x + rated * _harmonics(electrical, self.ripple_orders, self.ripple, phases)
         y = decimate(x, factor)
         if self.noise:
             y = y + rng.normal(0.0, self.noise, y.shape)
         return y
+
+
+def bind_drive_train(instrumentation, drive_train):
+    """The instrumentation with its drive sensors bound to ``drive_train`` (one declaration of
+    the motor and the reduction): the angle sensor and the speed estimate report the output
+    (reading / N); the torque estimate takes its ripple reference (the motor's continuous
+    torque, or :attr:`TorqueEstimate.UNBOUND_RATED_TORQUE` if the drive train gives none) and
+    pole pairs from the motor, unless the profile gives them. Unfitted sensors stay unfitted.
+    """
+    from dataclasses import replace
+
+    changes = {}
+    ratio = float(drive_train.gear_ratio)
+    for channel in ("screw_angle", "screw_speed"):
+        spec = getattr(instrumentation, channel, None)
+        if spec is not None:
+            changes[channel] = replace(spec, gear_ratio=ratio)
+    torque = getattr(instrumentation, "drive_torque", None)
+    if torque is not None:
+        rated = torque.rated_torque
+        if rated is None:
+            rated = drive_train.continuous_torque or TorqueEstimate.UNBOUND_RATED_TORQUE
+        pairs = torque.pole_pairs if torque.pole_pairs is not None else drive_train.pole_pairs
+        changes["drive_torque"] = replace(torque, rated_torque=rated, pole_pairs=pairs)
+    return replace(instrumentation, **changes) if changes else instrumentation
 
 
 @dataclass(frozen=True)
@@ -656,6 +749,102 @@ class Accelerometer(_Sensor):
         return y
 
 
+@dataclass(frozen=True)
+class TemperatureSensor(_Sensor):
+    """Platinum RTD (Pt100/Pt1000) on the nut housing with its converter → ``housing_temperature``.
+
+    measured = Q(H(L(T) + e_cal) + n): T the truth housing temperature, decimated; L a
+    first-order lag of ``time_constant`` τ (the probe's thermal response: a probe in a bore of
+    the housing follows it in seconds to minutes, whatever the logging rate), exact for the
+    sampled signal (y[n] = y[n−1] + (1 − e^(−Δt/τ))·(x[n] − y[n−1])), started in steady state
+    at the first sample; e_cal the per-run calibration error, uniform in ±(``tolerance`` +
+    ``tolerance_slope``·|t|) with t the first truth sample in °C (the IEC 60751 class limit of
+    the element: a class is an acceptance bound, uniform spreads the units over it) plus
+    uniform in ±``converter_error`` (the conditioner's stated accuracy); H the converter's
+    sample-and-hold: one conversion every ``update_interval`` (first at a uniform random phase)
+    held until the next, each with its own noise n (RMS ``noise``); Q quantisation to
+    ``resolution``. A simulated run is short against τ and its housing temperature is constant,
+    so in a run the lag leaves the reading unchanged; it acts on a truth that changes.
+
+    Parameters
+    ----------
+    tolerance : float [K]
+        Constant term of the element's tolerance class (IEC 60751: 0.15 class A, 0.3 class B).
+    tolerance_slope : float [-]
+        Coefficient of |t| [°C] in the class limit (0.002 class A, 0.005 class B).
+    converter_error : float [K]
+        Bound of the conditioner/ADC error (0: calibrated with the element).
+    time_constant : float [s]
+        First-order thermal time constant of the mounted probe (0: none).
+    noise : float [K]
+        RMS noise of one conversion.
+    resolution : float [K]
+        Converter LSB (0: not quantised).
+    update_interval : float [s]
+        Time between conversions (0: a new value at every logged sample).
+    """
+
+    KIND: ClassVar[str] = "temperature sensor"
+    UNITS: ClassVar[dict[str, str]] = {
+        "tolerance": "K",
+        "tolerance_slope": "-",
+        "converter_error": "K",
+        "time_constant": "s",
+        "noise": "K",
+        "resolution": "K",
+        "update_interval": "s",
+    }
+    SOURCE: ClassVar[str] = "housing_temperature"
+    #: 0 °C [K]: the class limit is a function of the Celsius temperature.
+    ZERO_CELSIUS: ClassVar[float] = 273.15
+
+    tolerance: float = 0.0
+    tolerance_slope: float = 0.0
+    converter_error: float = 0.0
+    time_constant: float = 0.0
+    noise: float = 0.0
+    resolution: float = 0.0
+    update_interval: float = 0.0
+
+    def __post_init__(self):
+        self._validate()
+        self._range("tolerance", 0.0, 10.0)
+        self._range("tolerance_slope", 0.0, 0.05)
+        self._range("converter_error", 0.0, 10.0)
+        self._range("time_constant", 0.0, 3600.0)
+        self._range("noise", 0.0, 10.0)
+        self._range("resolution", 0.0, 10.0)
+        self._range("update_interval", 0.0, 60.0)
+
+    def limit(self, temperature: float) -> float:
+        """The class limit [K] of the element at ``temperature`` [K]."""
+        return self.tolerance + self.tolerance_slope * abs(temperature - self.ZERO_CELSIUS)
+
+    def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
+        # every draw is made whatever the fields, so changing one leaves the others' draws
+        u_element, u_converter, phase = rng.uniform(-1.0, 1.0, 3)
+        x = decimate(_truth(truth, self.SOURCE, channel), factor)
+        if x.size == 0:
+            return x
+        sample_rate = rate / factor
+        if self.time_constant > 0:
+            # the probe's lag runs at the logged rate: its band (≪ 1 Hz) lies far below the
+            # anti-alias filter, so it commutes with the decimation and is better conditioned
+            a = math.exp(-1.0 / (sample_rate * self.time_constant))
+            x = signal.lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])[0]
+        x = x + u_element * self.limit(float(x[0])) + u_converter * self.converter_error
+        held = int(round(self.update_interval * sample_rate))
+        if held > 1:
+            # conversion k covers the samples from start k; the first starts at a random phase
+            offset = int((0.5 * (phase + 1.0)) * held) % held
+            starts = np.r_[0, np.arange(held - offset if offset else held, x.size, held)]
+            values = x[starts] + (rng.normal(0.0, self.noise, starts.size) if self.noise else 0)
+            x = np.repeat(values, np.diff(np.r_[starts, x.size]))
+        elif self.noise:
+            x = x + rng.normal(0.0, self.noise, x.shape)
+        return _quantise(x, self.resolution)
+
+
 # ----------------------------------------------------------------------------- profile
 #: Sensor class of every measured channel, in measuring order (the angle before the speed
 #: estimate that differentiates it). The channel set is the contract's measured channels.
@@ -669,6 +858,8 @@ SENSOR_CLASSES: dict[str, type[_Sensor]] = {
     "nut_radial_y_accel": Accelerometer,
     "drive_torque": TorqueEstimate,
     "axial_load": LoadCell,
+    # last: a new entry takes the next child stream, so the others' draws are unchanged
+    "housing_temperature": TemperatureSensor,
 }
 _TOP_KEYS = ("name", "description", "sample_rate")
 
@@ -692,6 +883,7 @@ class Instrumentation:
         Accelerometer or None
     drive_torque : TorqueEstimate or None
     axial_load : LoadCell or None
+    housing_temperature : TemperatureSensor or None
     """
 
     name: str = "custom"
@@ -706,6 +898,7 @@ class Instrumentation:
     nut_radial_y_accel: Accelerometer | None = None
     drive_torque: TorqueEstimate | None = None
     axial_load: LoadCell | None = None
+    housing_temperature: TemperatureSensor | None = None
 
     def __post_init__(self):
         require(
@@ -945,6 +1138,7 @@ __all__ = [
     "PositionSensor",
     "SENSOR_CLASSES",
     "SpeedEstimate",
+    "TemperatureSensor",
     "TorqueEstimate",
     "instrumentation_ref",
     "list_profiles",

@@ -15,7 +15,7 @@ The dict form (and the TOML form, the same tables)::
     seed = 3
     [health]   clearance = 20e-6             # shorthand for screw, nut and gear; or each field
     [[health.faults]]  kind = "spall", location = "screw", depth = 20e-6   (prsm_health.actuator.faults)
-    [profile]  duration = 0.5, speed = 100.0, load = 100.0, …   (OperatingProfile fields)
+    [profile]  duration = 0.5, speed = 100.0, load = "20 % C_a", …   (OperatingProfile fields)
     [options]  contact_law = "hertz", ideal = true, …           (SimulationOptions fields)
     [drive_train]  payload_mass = 25.0, …                       (DriveTrain fields)
 
@@ -23,11 +23,20 @@ The ``[instrumentation]`` table holds ``profile = "flight-ema"`` plus overrides 
 ``[instrumentation.nut_axial_accel] noise_density_ug = 40``, ``fitted = false``), or a complete
 profile (:func:`prsm_health.simulation.instrumentation.load_instrumentation`). TOML cannot give
 ``instrumentation`` both as a string and as a table.
+
+Loads (``[profile] load``, ``load_amplitude``) are newtons, a number with a unit (``"4.4 kN"``)
+or a share of the design's basic axial load ratings (``"20 % C_a"``, ``"5 % C_0a"``;
+:mod:`prsm_health.core.quantities`, :mod:`prsm_health.physics.load_rating`). A scenario resolves
+them against its design on construction — its ``profile`` holds newtons — and refuses a peak load
+(|load| plus the swing) above the static rating C_0a. Without a load the run is at
+:data:`~prsm_health.actuator.states.DEFAULT_LOAD_SHARE` of C_a (20 %, a service load of an
+electromechanical actuator); a light-load run gives its load (``load = "2 % C_a"``).
 """
 
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
@@ -35,12 +44,13 @@ import numpy as np
 
 from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS, PRSMDesign, preset
 from prsm_health.actuator.design_files import design_fingerprint, design_toml_tables, load_design
-from prsm_health.actuator.drive_train import DriveTrain
+from prsm_health.actuator.drive_train import DriveTrain, duty_check, load_drive_train
 from prsm_health.actuator.faults import fault_as_dict
 from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
 from prsm_health.core.errors import ParameterError, require, require_known_keys
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml, toml_value
+from prsm_health.physics.load_rating import load_ratings
 
 from .dynamics.model import SimulationOptions
 from .dynamics.simulate import simulate_scenario
@@ -51,6 +61,28 @@ from .instrumentation import (
     list_profiles,
     load_instrumentation,
 )
+
+#: The ratings of the designs met in this process, by design (a design is a frozen, hashable
+#: dataclass): computing them takes ≈ 20 ms, a scenario's construction ≈ 0.2 ms otherwise, and a
+#: recipe builds one scenario per run.
+_RATINGS: dict = {}
+
+
+def design_ratings(design: PRSMDesign) -> dict[str, float]:
+    """``{"C_a": …, "C_0a": …}`` [N]: the basic dynamic and static axial load ratings of
+    ``design`` (:func:`~prsm_health.physics.load_rating.load_ratings`), computed once per
+    design and process."""
+    try:
+        key = hash(design)
+    except TypeError:  # a design holding an unhashable value: its fingerprint instead
+        key = design_fingerprint(design)
+    found = _RATINGS.get(key)
+    if found is None or found[0] != design:
+        ratings = load_ratings(design)
+        found = (design, {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)})
+        _RATINGS[key] = found
+    return dict(found[1])
+
 
 _GROUPS = {
     "health": HealthState,
@@ -69,6 +101,9 @@ class Scenario:
     design : PRSMDesign, preset name, design TOML file or dict form, default "paper01"
     health : HealthState
     profile : OperatingProfile
+        Resolved against the design's load ratings on construction: ``scenario.profile`` holds
+        its loads in newtons. Default: ``OperatingProfile()``, whose load is
+        :data:`~prsm_health.actuator.states.DEFAULT_LOAD_SHARE` (20 %) of C_a.
     instrumentation : Instrumentation, profile name, profile file or dict form, default "flight-ema"
     options : SimulationOptions
     seed : int
@@ -114,6 +149,39 @@ class Scenario:
             self.sensor_seed,
             "must be an integer ≥ 0 (or absent: the seed's)",
         )
+        self._resolve_loads()
+
+    def _resolve_loads(self) -> None:
+        """The profile's loads in newtons against the design's ratings; a peak above C_0a
+        refused; the duty checked against the drive train's motor (torque and speed)."""
+        require(
+            isinstance(self.profile, OperatingProfile),
+            "profile",
+            type(self.profile).__name__,
+            "must be an OperatingProfile (or, in the dict form, a [profile] table)",
+        )
+        ratings = design_ratings(self.design)
+        profile = self.profile.resolved(ratings)
+        peak = profile.peak_load
+        if peak > ratings["C_0a"]:
+            given = self.profile.load
+            text = given.text() if hasattr(given, "text") else f"{given:g} N"
+            raise ParameterError(
+                "profile.load",
+                text,
+                f"the peak axial load (|load| + load_amplitude) is {peak:.4g} N, above the "
+                f"static load rating C_0a = {ratings['C_0a']:.4g} N of design "
+                f"'{self.design.name}' (permanent deformation of the threads: ISO 76); lower "
+                "the load or its swing",
+            )
+        object.__setattr__(self, "profile", profile)
+        # The duty against the drive train's motor (torque, speed): a duty beyond the motor's
+        # continuous torque is a warning, one it cannot run at all an error (the user's).
+        top_speed = float(np.max(np.abs(profile.motion_knots()[1])))
+        for message in duty_check(
+            self.drive_train, self.design, peak, top_speed, continuous_load=profile.rms_load
+        ):
+            warnings.warn(message, stacklevel=3)
 
     @property
     def sensors_seed(self) -> int:
@@ -239,6 +307,8 @@ class Scenario:
             "screw_speed": p.speed,
             "axial_load": p.load,
             "load_amplitude": p.load_amplitude,
+            # the peak load as a share of the design's dynamic rating: how hard the run works
+            "load_share": p.peak_load / design_ratings(self.design)["C_a"],
             "motion": p.motion,
             "load_profile": p.load_profile,
             "duration": p.duration,
@@ -258,6 +328,8 @@ def _group(name: str, kind: type, values) -> object:
         return values
     if kind is HealthState:
         return HealthState.from_dict(values, name)
+    if kind is DriveTrain:  # a name, a drive-train file or a table of fields
+        return load_drive_train(values)
     if not isinstance(values, dict):
         raise ParameterError(name, values, "must be a table of parameters")
     values = dict(values)
@@ -293,6 +365,8 @@ def simulate(
     design : PRSMDesign or preset name, default "paper01"
     health : HealthState, default HealthState()
     profile : OperatingProfile, default OperatingProfile()
+        Its loads may be shares of the design's ratings (``load="20 % C_a"``); the default
+        runs at :data:`~prsm_health.actuator.states.DEFAULT_LOAD_SHARE` (20 %) of C_a.
     instrumentation : Instrumentation, profile name or profile TOML file, default "flight-ema"
         The sensors fitted and the sample rate (:mod:`prsm_health.simulation.instrumentation`).
     seed : int
@@ -318,7 +392,8 @@ def simulate(
         When the requested step is beyond the RK4 stability limit of the model, or the state
         becomes non-finite (the error names the time).
     ParameterError
-        For any invalid input.
+        For any invalid input, a load share without a rating, or a peak load above the
+        design's static rating C_0a.
     """
     require(
         isinstance(seed, (int, np.integer)) and seed >= 0, "seed", seed, "must be an integer ≥ 0"

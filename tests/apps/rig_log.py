@@ -13,12 +13,14 @@ screw_angle = "motor_deg"
 nut_axial_accel = "acc_g"
 drive_torque = "torque_Nm"
 nut_position = "pos_mm"
+housing_temperature = "housing_C"
 [units]
 t_s = "s"
 motor_deg = "deg"
 acc_g = "g"
 torque_Nm = "N*m"
 pos_mm = "mm"
+housing_C = "degC"
 """
 
 
@@ -31,5 +33,6 @@ def write_rig_csv(path, run) -> None:
             "acc_g": run.channels["nut_axial_accel"] / 9.80665,
             "torque_Nm": run.channels["drive_torque"],
             "pos_mm": 1e3 * run.channels["nut_position"],
+            "housing_C": run.channels["housing_temperature"] - 273.15,
         }
     ).to_csv(path, index=False)

@@ -164,6 +164,7 @@ def test_instrumentation_list_and_show(capsys, tmp_path):
         "nut_position",
         "nut_axial_accel",
         "drive_torque",
+        "housing_temperature",
     }
     code, out, _ = run(capsys, "instrumentation", "show", "lab-rig")
     assert code == 0 and "noise_density" in out and "m/s^2/sqrt(Hz)" in out

@@ -81,7 +81,9 @@ def test_simulated_truth_is_the_physics_without_sensor_errors(run):
     # sits pushed back on its thrust bearing.
     assert list(run.truth) == list(TRUTH_NAMES)
     assert "carrier_speed" not in run.channels and "friction_torque" not in run.channels
-    assert np.array_equal(run.truth["motor_angle"], run.channels["screw_angle"])
+    # the resolver is on the motor: the drive reports the screw angle as its reading / N
+    ratio = run.scenario["drive_train"]["gear_ratio"]
+    assert np.allclose(run.truth["motor_angle"] / ratio, run.channels["screw_angle"], rtol=1e-12)
     assert np.array_equal(run.truth["motor_torque"], run.channels["drive_torque"])
     assert np.array_equal(run.truth["axial_load"], run.channels["axial_load"])
     assert not np.array_equal(run.truth["motor_angle"], run.truth["screw_angle"])  # coupling

@@ -11,6 +11,7 @@ from scipy import stats
 from prsm_health.actuator.design import preset
 from prsm_health.core.errors import ParameterError
 from prsm_health.physics.life import FleetScatter, LifeSpec, fleet_lives, unit_life
+from prsm_health.physics.load_rating import load_ratings
 from prsm_health.physics.lubrication import asperity_share, stribeck_curve
 from prsm_health.physics.wear import (
     WEIBULL_SLOPE,
@@ -23,6 +24,9 @@ from prsm_health.physics.wear import (
 DESIGN = preset("paper01")
 GEOMETRY = PartGeometry.of(DESIGN)
 SPEC = LifeSpec(units=8)
+#: The duty's loads are shares of the design's ratings; the independent recomputations below
+#: work in newtons.
+RATINGS = load_ratings(DESIGN)
 
 
 @pytest.fixture(scope="module")
@@ -96,7 +100,7 @@ def test_clearance_and_rul_bookkeeping(fleet):
 def _mean_wear_rate(spec, unit, degradation):
     """(ḃ_screw + ḃ_nut)/2 [m/h] of the unit's duty cycle at lubricant degradation d, from the
     wear laws (prsm_health.physics.wear, tested on their own) and the Stribeck film."""
-    duty, total = spec.duty, np.zeros_like(degradation)
+    duty, total = spec.duty.resolved(RATINGS), np.zeros_like(degradation)
     for load, share in zip(duty.loads, duty.shares):
         load *= unit.load_scale
         seconds_per_hour = share * duty.motion_fraction * 3600.0
@@ -210,7 +214,7 @@ def _system_l10_hours():
     cycles per second at the most-cycled point (screw: n_R contacts on 2πr_s for the share of a
     stroke under the rollers; roller: one on 2πr_r; nut: n_R on 2πr_n), L10 = N_ref·(p_ref/p₀)⁹
     (the roller's flanks at the higher of its two contact pressures), combined as Σ D_i^e."""
-    duty, wear = SPALL_SPEC.duty, SPALL_SPEC.wear
+    duty, wear = SPALL_SPEC.duty.resolved(RATINGS), SPALL_SPEC.wear
     r_s, r_r, r_n = (
         d / 2 for d in (DESIGN.screw_diameter, DESIGN.roller_diameter, DESIGN.nut_diameter)
     )
@@ -282,6 +286,9 @@ def test_spalled_units_fail_by_the_spall(spall_fleet):
         ({"wear": {"fatigue_pressure": 1e11}}, "wear.fatigue_pressure"),
         ({"wear": {"pitting": 1}}, "life.wear.pitting"),
         ({"duty": 3}, "life.duty"),
+        ({"duty": {"loads": ["20 % C_x"], "shares": [1.0]}}, "life.duty.loads"),
+        ({"duty": {"loads": ["4 lbf"], "shares": [1.0]}}, "life.duty.loads"),
+        ({"duty": {"loads": "20 % C_a", "shares": [1.0]}}, "life.duty.loads"),
     ],
 )
 def test_bad_life_tables_name_the_field(table, field):
@@ -301,3 +308,57 @@ def test_a_unit_that_outlives_max_age_is_refused():
     with pytest.raises(ParameterError) as err:
         unit_life(DESIGN, spec, 0, 1)
     assert err.value.field == "life.max_age"
+
+
+# ---------------------------------------------------------------------- loads as rating shares
+def test_duty_loads_take_every_written_form_and_resolve_against_the_ratings():
+    duty = LifeSpec.from_dict(
+        {"duty": {"loads": [1500, "2.5 kN", "20 % C_a", "0.1 C_0a"], "shares": [0.25] * 4}}
+    ).duty
+    assert not duty.is_resolved and duty.loads[:2] == (1500.0, 2500.0)
+    resolved = duty.resolved({"C_a": 10e3, "C_0a": 20e3})
+    assert resolved.is_resolved and resolved.loads == (1500.0, 2500.0, 2000.0, 2000.0)
+    # the LoadRatings of a design do as well as the dict
+    by_design = duty.resolved(RATINGS).loads
+    assert by_design[2] == pytest.approx(0.2 * RATINGS.dynamic, rel=1e-12)
+    assert duty.as_dict()["loads"] == [1500.0, 2500.0, "20 % C_a", "10 % C_0a"]
+
+
+def test_a_duty_load_above_the_static_rating_is_refused():
+    spec = LifeSpec.from_dict({"units": 1, "duty": {"loads": ["120 % C_0a"], "shares": [1.0]}})
+    with pytest.raises(ParameterError, match="C_0a") as err:
+        unit_life(DESIGN, spec, 0, 1)
+    assert err.value.field == "life.duty.loads"
+
+
+def test_a_fleet_in_newtons_equals_the_fleet_in_shares():
+    # The default duty written in newtons of paper01's rating gives the same lives, bit for bit
+    # up to the rounding of the shares' products.
+    shares = LifeSpec(units=2)
+    newtons = LifeSpec(units=2, duty=shares.duty.resolved(RATINGS))
+    a, b = fleet_lives(DESIGN, shares, 4), fleet_lives(DESIGN, newtons, 4)
+    assert [u.failure_age for u in a] == pytest.approx([u.failure_age for u in b], rel=1e-12)
+
+
+def test_the_life_duty_is_the_duty_the_fleet_records():
+    # datasets/fleet.toml records each snapshot under a reversing load (mean and swing drawn
+    # uniformly, trapezoidal wave: half the time at |F + A|, half at |F − A|); its [life.duty] is
+    # meant to be that |load| distribution in three levels. Compare what wear and fatigue see:
+    # the mean load (Archard wear ∝ load) and the cubic mean (ISO 281 life ∝ load⁻³), from 200k
+    # draws (sampling error < 0.3 %); 5 % allows for the three-level rounding.
+    from pathlib import Path
+
+    from prsm_health.datasets import load_recipe
+
+    recipe = load_recipe(Path(__file__).resolve().parents[2] / "datasets" / "fleet.toml")
+    duty = recipe.life_spec.duty.resolved(recipe.ratings)
+    assert duty == LifeSpec().duty.resolved(recipe.ratings)  # the library's default duty too
+    rng = np.random.default_rng(0)
+    mean = rng.uniform(*recipe.resolved_sweep["load"], 200_000)
+    swing = rng.uniform(*recipe.resolved_sweep["load_amplitude"], 200_000)
+    recorded = np.abs(np.concatenate([mean + swing, mean - swing]))
+    loads, shares = np.array(duty.loads), np.array(duty.shares)
+    assert shares @ loads == pytest.approx(recorded.mean(), rel=0.05)
+    assert (shares @ loads**3) ** (1 / 3) == pytest.approx(
+        np.mean(recorded**3) ** (1 / 3), rel=0.05
+    )

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from prsm_health import HealthState, OperatingProfile, SimulationOptions, preset, simulate
+from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.core.errors import ParameterError
 from prsm_health.physics.friction import (
     FrictionParameters,
@@ -113,6 +114,7 @@ def test_dynamics_friction_torque_follows_the_regime():
             "ideal",
             1,
             options=options,
+            drive_train=DriveTrain.direct(),  # 300 rad/s: beyond the sized motor's top speed
         )
         return float(np.mean(run.truth["friction_torque"])), run.energy
 

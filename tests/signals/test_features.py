@@ -39,6 +39,7 @@ def synthetic(n=20_000, speed=100.0, extra=None, load=None):
         "nut_radial_y_accel": np.zeros(n),
         "drive_torque": np.full(n, 0.2),
         "axial_load": np.full(n, 100.0) if load is None else load(t),
+        "housing_temperature": np.full(n, 313.15),
     }
     ch.update(extra or {})
     truth = {

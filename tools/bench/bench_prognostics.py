@@ -27,6 +27,7 @@ from prsm_health.actuator.design_files import load_design
 from prsm_health.datasets import Dataset, load_recipe
 from prsm_health.diagnostics.diagnosis import diagnose, diagnose_runs, load_bundle
 from prsm_health.physics.life import fleet_lives
+from prsm_health.physics.load_rating import load_ratings
 from prsm_health.physics.lubrication import asperity_share, stribeck_curve
 from prsm_health.physics.wear import PartGeometry, clearance_growth_rate, contact_states
 from prsm_health.prognostics import load_prognostics_model, prognose
@@ -37,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def stepping_life(design, spec, unit, geometry) -> float:
     """The loop a user would write: step the age by 1 h, ask the film at the current
     degradation, add the wear (no usage variation); returns the failure age [h]."""
-    duty, wear = spec.duty, spec.wear
+    duty, wear = spec.duty.resolved(load_ratings(design)), spec.wear
     b = unit.initial_clearance
     age = 0.0
     contacts = [

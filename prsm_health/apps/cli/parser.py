@@ -17,7 +17,10 @@ import argparse
 
 from prsm_health import __version__
 from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS
-from prsm_health.actuator.states import DRIVES, LOADS, MOTIONS, RAMP_SHAPES
+from prsm_health.actuator.health_check import BUILT_IN as BUILT_IN_CHECKS
+from prsm_health.actuator.states import DEFAULT_LOAD, DRIVES, LOADS, MOTIONS, RAMP_SHAPES
+from prsm_health.core.errors import ParameterError
+from prsm_health.core.quantities import parse_force
 
 from .options import (
     HelpFormatter,
@@ -188,6 +191,29 @@ def _add_physics(command) -> None:
 
 
 # ----------------------------------------------------------------------------- simulate
+#: How a load may be written on the command line (prsm_health.core.quantities).
+FORCE_FORMS = (
+    "newtons, a unit ('4.4kN') or a share of the design's rating ('20 %% C_a', '5 %% C_0a')"
+)
+
+
+def force(text: str):
+    """``--load``: any form of :mod:`prsm_health.core.quantities` (resolved by the scenario
+    against the design's ratings); a bad unit or rating is one line naming the forms."""
+    try:
+        return parse_force(text, "--load")
+    except ParameterError as exc:
+        raise argparse.ArgumentTypeError(f"{text!r}: {exc.allowed}") from None
+
+
+def force_swing(text: str):
+    """``--load-amplitude``: as :func:`force`, and not negative."""
+    spec = force(text)
+    if spec.value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: a swing must be ≥ 0")
+    return spec
+
+
 def _add_simulate(command) -> None:
     s = command("simulate", "simulate a PRSM run (paper 01 dynamics) and write it")
     s.add_argument("--design", type=design, default=DEFAULT_PRESET, help=DESIGN_HELP)
@@ -238,8 +264,28 @@ def _add_simulate(command) -> None:
         help="friction multiplier [-]",
     )
     s.add_argument("--speed", type=finite_float, default=100.0, help="screw speed [rad/s]")
-    s.add_argument("--load", type=finite_float, default=100.0, help="resisting axial load [N]")
-    s.add_argument("--profile", choices=MOTIONS, default="constant", help="screw motion profile")
+    s.add_argument(
+        "--load",
+        type=force,
+        default=DEFAULT_LOAD,
+        default_text=DEFAULT_LOAD.text(),
+        help=f"mean resisting axial load: {FORCE_FORMS} (docs/load-ratings.md)",
+    )
+    s.add_argument(
+        "--profile",
+        choices=(*MOTIONS, *BUILT_IN_CHECKS),
+        default="constant",
+        help="screw motion profile, or a built-in health check (the phases set motion, speed, "
+        "load and duration: docs/formats.md)",
+    )
+    s.add_argument(
+        "--check",
+        default=None,
+        metavar="FILE",
+        default_text="none",
+        help="a health check of your own: TOML with [check] name and [[check.phases]] "
+        "(motion, speed, load, duration, ramp_time, reversal_shape, reversal_period)",
+    )
     s.add_argument(
         "--accel-time", type=finite_float, default=0.02, help="speed ramp and load edge [s]"
     )
@@ -273,7 +319,10 @@ def _add_simulate(command) -> None:
         "fields (docs/formats.md)",
     )
     s.add_argument(
-        "--load-amplitude", type=finite_float, default=0.0, help="load swing around --load [N]"
+        "--load-amplitude",
+        type=force_swing,
+        default=0.0,
+        help=f"load swing around --load: {FORCE_FORMS}",
     )
     s.add_argument(
         "--load-frequency", type=finite_float, default=20.0, help="load swing frequency [Hz]"
@@ -305,7 +354,7 @@ def _add_simulate(command) -> None:
         "--max-step",
         type=step,
         default="auto",
-        help='largest RK4 step [s], or "auto" (default): 0.6 of the stable step, at most 10 µs',
+        help='largest RK4 step [s], or "auto": 0.6 of the stable step, at most 10 µs',
     )
     s.add_argument("--ideal", action="store_true", help="no manufacturing variation")
     s.add_argument("--seed", type=int, default=0, help="seed of variation, wear and noise")

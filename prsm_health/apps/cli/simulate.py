@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from prsm_health.actuator.drive_train import load_drive_train
+from prsm_health.actuator.health_check import BUILT_IN as BUILT_IN_CHECKS
 from prsm_health.actuator.states import HealthState
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.tomlfile import read_toml
@@ -46,15 +47,29 @@ def health_state(args) -> HealthState:
     return HealthState.from_dict(flags, "health", base=table)
 
 
+def _check(args) -> str | None:
+    """The health check asked for: ``--check FILE`` or ``--profile <built-in check>``."""
+    built_in = args.profile if args.profile in BUILT_IN_CHECKS else None
+    if args.check is not None and built_in is not None:
+        raise PRSMHealthError(f"give --check or --profile {built_in}, not both")
+    if args.check is not None and args.profile != "constant":
+        raise PRSMHealthError(f"--check sets the motion: drop --profile {args.profile}")
+    return args.check if args.check is not None else built_in
+
+
 def scenario_from_args(args) -> Scenario:
     """The :class:`Scenario` the command line describes (validated; nothing simulated)."""
+    check = _check(args)
+    # a check brings its motion, load and duration; the profile's other fields stay as given
+    with_check = {} if check is None else {"check": check}
     return Scenario.from_dict(
         {
             "design": args.design,
             "health": health_state(args),
-            "profile": {
+            "profile": with_check
+            | {
                 "duration": args.duration,
-                "motion": args.profile,
+                "motion": "constant" if check is not None else args.profile,
                 "speed": args.speed,
                 "accel_time": args.accel_time,
                 "motion_period": args.period,
@@ -123,6 +138,7 @@ def simulate(args) -> int:
                 "integration_step": run.scenario["integration_step"],
                 "highest_natural_frequency": run.scenario["highest_natural_frequency"],
                 "energy": run.energy,
+                "check": run.check or None,
                 "labels": run.labels,
             }
         )
@@ -133,6 +149,13 @@ def simulate(args) -> int:
                 ("instrumentation", scenario.instrumentation.name, ""),
                 ("channels", ", ".join(run.channels), ""),
                 ("samples", len(run), f"at {run.sample_rate:g} Hz"),
+                # the load as resolved against the design's rating (a share given, or the default)
+                ("axial load", scenario.profile.load, "N, mean"),
+                ("peak load", 100.0 * run.labels["load_share"], "% of C_a"),
+                *[
+                    (f"check {run.check['name']}", p["name"], f"{p['start']:.3f}–{p['end']:.3f} s")
+                    for p in run.check.get("phases", [])
+                ],
                 ("gear mesh frequency", mesh, "Hz"),
                 ("integration step", run.scenario["integration_step"], "s"),
                 ("drive energy", run.energy["drive"], "J"),

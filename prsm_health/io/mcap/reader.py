@@ -6,9 +6,9 @@ import json
 import os
 import warnings
 
-from prsm_health.core.channels import TOPIC_FIELDS
+from prsm_health.core.channels import CHECK_METADATA, TOPIC_FIELDS
 from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
-from prsm_health.core.run import Run
+from prsm_health.core.run import Run, phase_of_samples
 
 from ._samples import _align, _Batch, _merge_topic, _sample_rate, _start_ns, _times
 from ._scan import _chunk_batches, _Source, _unchunked_batches
@@ -33,7 +33,10 @@ def read_mcap(path: str | os.PathLike) -> Run:
         Measured channels of the topics present, truth signals of ``/prsm/truth`` (if any) in
         ``Run.truth``; labels from the ``labels`` metadata, scenario from its
         attachment, sample rate and energy from the ``prsm_health`` metadata (the sample rate
-        is estimated from the log-time spacing when that record is missing).
+        is estimated from the log-time spacing when that record is missing); a health check's
+        name and boundaries from the ``health_check`` metadata in ``Run.check``, and
+        ``Run.check_phase`` rebuilt from those boundaries on the time axis (the rule the
+        writer's phase topic was made with, :func:`~prsm_health.core.run.phase_of_samples`).
 
     Warns
     -----
@@ -75,7 +78,18 @@ def read_mcap(path: str | os.PathLike) -> Run:
             energy = json.loads(info.get("energy", "{}"))
         except ValueError:
             energy = {}
-        run = Run(time, channels, rate, source.labels(), source.scenario(), energy, truth)
+        check = _check_record(source.metadata.get(CHECK_METADATA))
+        run = Run(
+            time,
+            channels,
+            rate,
+            source.labels(),
+            source.scenario(),
+            energy,
+            truth,
+            check_phase=phase_of_samples(time, check["phases"]) if check else None,
+            check=check,
+        )
         if source.damage:
             warnings.warn(
                 f"{source.path}: {source.damage}; read {len(time)} samples "
@@ -84,3 +98,29 @@ def read_mcap(path: str | os.PathLike) -> Run:
                 stacklevel=2,
             )
         return run
+
+
+def _check_record(record: dict | None) -> dict:
+    """``{"name", "phases"}`` of the ``health_check`` metadata record; {} when absent or
+    unreadable (a recording without a check)."""
+    if not record or "phases" not in record:
+        return {}
+    try:
+        phases = json.loads(record["phases"])
+        phases = [
+            {
+                "index": int(p["index"]),
+                "name": str(p["name"]),
+                "start": float(p["start"]),
+                "end": float(p["end"]),
+            }
+            for p in phases
+        ]
+    except (ValueError, TypeError, KeyError):
+        warnings.warn(
+            "health_check metadata is not readable; check phases left out",
+            UserWarning,
+            stacklevel=3,
+        )
+        return {}
+    return {"name": record.get("name", ""), "phases": phases}

@@ -35,11 +35,13 @@ from prsm_health.core.channels import (
 from prsm_health.core.jsonable import dumps
 
 __all__ = [
+    "CHECK_PHASE_SCHEMA_NAME",
     "DIAGNOSIS_SCHEMA_NAME",
     "FORMAT_VERSION",
     "INFO_METADATA",
     "LABELS_METADATA",
     "SCHEMA_NAMES",
+    "check_phase_schema",
     "decode_metadata_value",
     "diagnosis_schema",
     "encode_metadata_value",
@@ -62,6 +64,8 @@ SCHEMA_NAMES = {
 }
 #: Schema name of the diagnosis topic.
 DIAGNOSIS_SCHEMA_NAME = "prsm_health.Diagnosis"
+#: Schema name of the health-check phase topic.
+CHECK_PHASE_SCHEMA_NAME = "prsm_health.CheckPhase"
 
 _DRAFT_07 = "http://json-schema.org/draft-07/schema#"
 # Units of the numbers under a diagnosis' "clearance" object.
@@ -94,6 +98,25 @@ def topic_schema(topic: str, pairs: list[tuple[str, str]]) -> dict:
         "type": "object",
         "properties": properties,
         "required": [field for field, _ in pairs],
+    }
+
+
+def check_phase_schema() -> dict:
+    """JSON schema of the health-check phase topic: one message per phase change."""
+    return {
+        "$schema": _DRAFT_07,
+        "title": CHECK_PHASE_SCHEMA_NAME,
+        "description": "The health-check phase from this message's log time on, until the "
+        "next message (prsm_health MCAP contract)",
+        "type": "object",
+        "properties": {
+            "index": {
+                "type": "integer",
+                "description": "phase index in the check (-1: outside any phase, a ramp)",
+            },
+            "name": {"type": "string", "description": "phase name (empty outside any phase)"},
+        },
+        "required": ["index", "name"],
     }
 
 

@@ -1,7 +1,10 @@
 """Run → MCAP recording (:func:`write_mcap`).
 
 One JSON message per sample and topic, interleaved sample by sample as a live recorder would
-write them. Payloads are written with :func:`repr` of each float (shortest string that parses
+write them. A health check's phase (``run.check_phase``) goes to
+:data:`~prsm_health.core.channels.TOPIC_CHECK_PHASE`, one message per phase change (at the
+first sample and wherever the phase changes), and the check's name and phase boundaries to the
+Metadata record :data:`~prsm_health.core.channels.CHECK_METADATA`. Payloads are written with :func:`repr` of each float (shortest string that parses
 back to the same double) — byte for byte what ``json.dumps(..., separators=(",", ":"))`` writes
 for finite values. JSON has no NaN or infinity: non-finite samples are written as ``null`` (and
 read back as NaN).
@@ -16,7 +19,16 @@ from pathlib import Path
 
 import numpy as np
 
-from prsm_health.core.channels import CHANNEL_NAMES, TOPIC_FIELDS, TOPIC_TRUTH, TRUTH_NAMES, UNITS
+from prsm_health.core.channels import (
+    CHANNEL_NAMES,
+    CHECK_METADATA,
+    CHECK_PHASE,
+    TOPIC_CHECK_PHASE,
+    TOPIC_FIELDS,
+    TOPIC_TRUTH,
+    TRUTH_NAMES,
+    UNITS,
+)
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps
 from prsm_health.core.run import Run
@@ -24,10 +36,12 @@ from prsm_health.core.run import Run
 from ._container import DEFAULT_CHUNK_SIZE, _AtomicFile, _FileWriter, _library, _MessageBlock
 from ._samples import _require_positive, _to_ns
 from .schema import (
+    CHECK_PHASE_SCHEMA_NAME,
     FORMAT_VERSION,
     INFO_METADATA,
     LABELS_METADATA,
     SCHEMA_NAMES,
+    check_phase_schema,
     encode_metadata_value,
     encode_schema,
     topic_schema,
@@ -53,6 +67,24 @@ def sample_payloads(fields: list[str], columns: list[np.ndarray]) -> list[bytes]
     return [
         (template % tuple(repr(v) if finite(v) else "null" for v in row)).encode() for row in rows
     ]
+
+
+def _phase_messages(run: Run, n: int) -> tuple[np.ndarray | None, list[bytes]]:
+    """Sample indices where the check phase changes (the first sample included) and the
+    message of each, ``{"index": k, "name": …}`` (name "" outside any phase); (None, []) when
+    the run is no check."""
+    if run.check_phase is None:
+        return None, []
+    phase = np.asarray(run.check_phase)
+    if phase.shape != (n,):
+        raise PRSMHealthError(f"{CHECK_PHASE} has shape {phase.shape}; expected ({n},) like time")
+    names = {int(p["index"]): str(p["name"]) for p in run.check.get("phases", [])}
+    changes = np.flatnonzero(np.concatenate(([True], phase[1:] != phase[:-1])))
+    payloads = [
+        dumps({"index": int(phase[i]), "name": names.get(int(phase[i]), "")}).encode()
+        for i in changes
+    ]
+    return changes, payloads
 
 
 def write_mcap(
@@ -134,6 +166,7 @@ def write_mcap(
             f"run has none of the contract channels ({', '.join(CHANNEL_NAMES)}); nothing to write"
         )
 
+    phase_changes, phase_payloads = _phase_messages(run, n)
     log_time = start_time_ns + _to_ns(time)
     columns = {
         topic: [np.asarray(source(topic)[name], dtype=np.float64) for _, name in pairs]
@@ -151,6 +184,11 @@ def write_mcap(
         }
         scenario = dumps(run.scenario, indent=1).encode()
         labels = {str(k): encode_metadata_value(v) for k, v in run.labels.items()}
+        check = (
+            {"name": str(run.check.get("name", "")), "phases": dumps(run.check.get("phases", []))}
+            if run.check
+            else None
+        )
     except (TypeError, ValueError) as exc:
         raise PRSMHealthError(
             f"run labels, scenario or energy not JSON-serialisable: {exc}"
@@ -165,8 +203,15 @@ def write_mcap(
             schema = encode_schema(topic_schema(topic, pairs))
             schema_id = writer.add_schema(SCHEMA_NAMES[topic], "jsonschema", schema)
             channel_ids.append(writer.add_channel(topic, "json", schema_id))
+        phase_id = None
+        if phase_changes is not None:
+            schema = encode_schema(check_phase_schema())
+            schema_id = writer.add_schema(CHECK_PHASE_SCHEMA_NAME, "jsonschema", schema)
+            phase_id = writer.add_channel(TOPIC_CHECK_PHASE, "json", schema_id)
         writer.add_metadata(LABELS_METADATA, labels)
         writer.add_metadata(INFO_METADATA, info)
+        if check is not None:
+            writer.add_metadata(CHECK_METADATA, check)
         writer.add_attachment(
             scenario_name, "application/json", scenario, log_time=int(start_time_ns)
         )
@@ -180,12 +225,23 @@ def write_mcap(
                 sample_payloads([name for name, _ in pairs], [c[a:b] for c in columns[t]])
                 for t, pairs in topics.items()
             ]
+            ids = np.tile(np.asarray(channel_ids), b - a)
+            samples = np.repeat(np.arange(a, b), k)
+            messages = list(chain.from_iterable(zip(*payloads)))
+            here = (
+                np.flatnonzero((phase_changes >= a) & (phase_changes < b))
+                if phase_id is not None
+                else ()
+            )
+            if len(here):
+                # the phase messages of this block after the samples they belong to
+                order = np.argsort(np.concatenate([samples, phase_changes[here]]), kind="stable")
+                ids = np.concatenate([ids, np.full(here.size, phase_id)])[order]
+                samples = np.concatenate([samples, phase_changes[here]])[order]
+                messages += [phase_payloads[i] for i in here]
+                messages = [messages[i] for i in order]
             block = _MessageBlock.from_payloads(
-                np.tile(np.asarray(channel_ids), b - a),
-                np.repeat(np.arange(a, b), k),
-                np.repeat(log_time[a:b], k),
-                np.repeat(log_time[a:b], k),
-                list(chain.from_iterable(zip(*payloads))),
+                ids, samples, log_time[samples], log_time[samples], messages
             )
             writer.add_messages(block, more=True)
         writer.finish()

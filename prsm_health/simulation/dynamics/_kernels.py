@@ -206,6 +206,26 @@ def _clamped(errors, kind, x):
     return a + (errors[kind, 2 + i0] - a) * (pos - i0)
 
 
+@njit(cache=True, inline="always")
+def _traction(slip, v, cap, k, c, decay):
+    # One rolling contact's tangential traction: the elastic displacement `slip` of a Mindlin
+    # stiffness k sticks up to the Coulomb limit `cap` and slides beyond it (reset integrator,
+    # Haessig & Friedland 1991); while it sticks, rolling carries the strained material out of
+    # the contact, so the displacement relaxes at `decay` = rolling speed / relaxation length
+    # (steady creep ξ then gives Kalker's linear creep force k·L·ξ). Returns the force on the
+    # roller, d(slip)/dt and the dissipated power (friction work less the stored energy's rate).
+    if cap <= 0.0:  # no normal load, no traction (the clamp resets the displacement)
+        return 0.0, 0.0, 0.0
+    f_stick = k * slip
+    if f_stick > cap or f_stick < -cap:
+        f = cap if f_stick > 0.0 else -cap
+        if f_stick * v < 0.0:  # unloading back into stick
+            rate = v - decay * slip
+            return f, rate, f * v - f_stick * rate
+        return f, 0.0, f * v
+    return f_stick + c * v, v - decay * slip, c * v * v + f_stick * decay * slip
+
+
 @njit(cache=True)
 def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     """dy/dt of the full state at time t; auxiliary outputs (torques, powers) into ``aux``.
@@ -215,7 +235,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     n_rollers = rollers.shape[0]
     nq = L.Q_ROLLER0 + L.ROLLER_DOF * n_rollers
     v0 = nq  # offset of velocities; generalised forces are accumulated at dy[v0 + j]
-    for j in range(2 * nq + L.N_EXTRA + n_rollers):
+    for j in range(2 * nq + L.N_EXTRA + L.N_TRACTION * n_rollers):
         dy[j] = 0.0
     for j in range(nq):
         dy[j] = y[v0 + j]
@@ -225,7 +245,11 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     coupled = p[L.P_COUPLED] == 1.0
     axial_free = p[L.P_AXIAL_FREE] == 1.0
     on_payload = p[L.P_ON_PAYLOAD] == 1.0
+    geared = p[L.P_GEARED] == 1.0
+    ratio = p[L.P_RATIO]
     th_ref, w_ref, alpha_ref = screw_motion(t, motion)
+    if geared:  # the motion knots are the screw's: the motor turns N times as far
+        th_ref, w_ref, alpha_ref = ratio * th_ref, ratio * w_ref, ratio * alpha_ref
     if prescribed:
         th_m, w_m = th_ref, w_ref
         dy[L.Q_THM] = w_ref
@@ -233,6 +257,9 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         th_m, w_m = y[L.Q_THM], y[v0 + L.Q_THM]
     if coupled:
         th_s, w_s = y[L.Q_THS], y[v0 + L.Q_THS]
+    elif geared:  # screw rigid on the output of a rigid reduction
+        th_s, w_s = th_m / ratio, w_m / ratio
+        dy[L.Q_THS] = w_s
     else:  # screw rigid on the motor shaft
         th_s, w_s = th_m, w_m
         dy[L.Q_THS] = w_m
@@ -250,7 +277,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     lead_s, lead_r, lead_n = p[L.P_LEAD_S], p[L.P_LEAD_R], p[L.P_LEAD_N]
     rb_ring, rb_roller = p[L.P_RB_RING], p[L.P_RB_ROLLER]
     cos_a0, sin_a0 = p[L.P_COS_A0], p[L.P_SIN_A0]
-    r_s, r_r = p[L.P_R_SCREW], p[L.P_R_ROLLER]
+    r_s, r_n = p[L.P_R_SCREW], p[L.P_R_NUT]
     k_ts, k_tn = p[L.P_K_THREAD_S], p[L.P_K_THREAD_N]
     c_ts, c_tn, c_mesh = p[L.P_C_THREAD_S], p[L.P_C_THREAD_N], p[L.P_C_MESH]
     expo = p[L.P_EXPONENT]
@@ -264,7 +291,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     spalled = p[L.P_HAS_SPALLS] == 1.0
     toothed = p[L.P_HAS_TOOTH_DAMAGE] == 1.0
     stribeck = p[L.P_STRIBECK] == 1.0
-    s0 = 2 * nq + L.N_EXTRA  # offset of the traction states
+    s0 = 2 * nq + L.N_EXTRA  # offset of the traction states (screw side, then nut side)
+    a0 = L.N_AUX  # offset of the per-roller auxiliary blocks
     z_ring = p[L.P_Z_RING]
 
     cos_p = math.cos(th_p)
@@ -356,28 +384,22 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         g_tan = (
             f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s + f_dh * dh - f_dhr * dh_r
         ) / orbit
-        # Screw–roller traction: elastic tangential compliance k_t (Mindlin) that sticks up to
-        # the Coulomb limit μN and slides beyond it (reset integrator, Haessig & Friedland
-        # 1991), plus viscous drag. v_slide = 0 is rolling at both pitch circles.
-        v_slide = r_s * (w_s - w_rev) + r_r * (w_c - w_rev)
+        # Screw–roller traction (_traction: Mindlin stick up to μN, rolling relaxation), plus
+        # viscous drag. v_slide = 0 is rolling at the screw's pitch circle and the roller's
+        # effective rolling radius r_rs on the screw.
+        r_rs = rollers[i, L.R_ROLL_S]
+        v_roll = r_rs * (w_c - w_rev)  # roller surface speed through the contact
+        v_slide = r_s * (w_s - w_rev) + v_roll
         if stribeck:  # the lubrication regime at this contact's entrainment speed
-            u_e = 0.5 * abs(r_s * (w_s - w_rev) - r_r * (w_c - w_rev))
+            u_e = 0.5 * abs(r_s * (w_s - w_rev) - v_roll)
             mu_c = _clamped(errors, L.ERR_COULOMB, u_e) * fscale
         cap = mu_c * (f_plus + f_minus) / sin_b
-        aux[L.N_AUX + i] = cap
-        slip = y[s0 + i]
-        f_stick = k_tan * slip
-        if f_stick > cap or f_stick < -cap:
-            f_fric = cap if f_stick > 0.0 else -cap
-            if f_stick * v_slide < 0.0:  # unloading back into stick
-                dy[s0 + i] = v_slide
-                p_fric += f_fric * v_slide - f_stick * v_slide
-            else:
-                p_fric += f_fric * v_slide
-        else:
-            f_fric = f_stick + c_tan * v_slide
-            dy[s0 + i] = v_slide
-            p_fric += c_tan * v_slide * v_slide
+        aux[a0 + i] = cap
+        f_fric, dy[s0 + i], pf = _traction(
+            y[s0 + i], v_slide, cap, k_tan, c_tan, abs(v_roll) * rollers[i, L.R_RELAX_S]
+        )
+        p_fric += pf
+        aux[a0 + L.AR_TRACTION_S * n_rollers + i] = f_fric
         f_fric += mu_v * v_slide
         p_fric += mu_v * v_slide * v_slide
         # Paper 02's steady losses: Coulomb friction μ2·N against the roller's axial sliding on
@@ -393,16 +415,17 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
         torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff - f_dh * dh
         force_screw_axial -= g1 * f_ax + f_axial + f_gate
-        # on the roller: radial push f_rad·e_r, helix reaction, traction and the reaction of the
-        # differential-sliding torque along e_t
-        tangential = g_tan + f_fric + m_diff / orbit
+        # on the roller: radial push f_rad·e_r, helix reaction, traction (through θ_rev, whose
+        # coefficient in v_slide is −(r_s + r_rs)) and the reaction of the differential-sliding
+        # torque along e_t
+        tangential = g_tan + f_fric * (r_s + r_rs) / orbit + m_diff / orbit
         fx_r = f_rad * c - tangential * s
         fy_r = f_rad * s + tangential * c
         dy[v0 + L.Q_XS] -= fx_r
         dy[v0 + L.Q_YS] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += f_ax * lead_r - r_r * f_fric - f_rad * ro_s + f_dhr * dh_r
+        dy[v0 + b + 2] += f_ax * lead_r - r_rs * f_fric - f_rad * ro_s + f_dhr * dh_r
         dy[v0 + b + 3] += g1 * f_ax + f_axial + f_gate
 
         # ---------------- roller–nut thread
@@ -459,16 +482,39 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
         g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s + f_dh * dh - f_dhr * dh_r) / orbit
+        # Roller–nut traction, the same law as the screw side's with the nut side's stiffness
+        # and normal load: the roller also rolls on the nut, so with its gear in mesh it is
+        # over-constrained, and a mismatch ε between the gear ratio and the threads' rolling
+        # ratio (r_rn = r_r/(1 + ε), model._roller_params) is shared between creep here and the
+        # gear's load (Jones & Velinsky 2012). v_nut is the nut surface's speed over the roller's.
+        r_rn = rollers[i, L.R_ROLL_N]
+        v_roll = r_rn * (w_c - w_rev)
+        v_nut = r_n * (w_n - w_rev) - v_roll
+        cap = mu_c * (f_plus + f_minus) / sin_b
+        aux[a0 + L.AR_CAP_N * n_rollers + i] = cap
+        f_tn, dy[s0 + n_rollers + i], pf = _traction(
+            y[s0 + n_rollers + i],
+            v_nut,
+            cap,
+            rollers[i, L.R_K_TAN_N],
+            rollers[i, L.R_C_TAN_N],
+            abs(v_roll) * rollers[i, L.R_RELAX_N],
+        )
+        p_fric += pf
+        aux[a0 + L.AR_TRACTION_N * n_rollers + i] = f_tn
+        # −∂v_nut/∂q̇ times f_tn: e_t of the roller through θ_rev (coefficient r_rn − r_n),
+        # its spin r_rn, the nut's rotation −r_n
+        g_tan += f_tn * (r_n - r_rn) / orbit
         fx_r = -f_rad * c + g_tan * (-s)
         fy_r = -f_rad * s + g_tan * c
         dy[v0 + L.Q_XN] -= fx_r
         dy[v0 + L.Q_YN] -= fy_r
         dy[v0 + b] += fx_r
         dy[v0 + b + 1] += fy_r
-        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s + f_dhr * dh_r
+        dy[v0 + b + 2] += -f_ax * lead_r + f_rad * ro_s + f_dhr * dh_r + r_rn * f_tn
         dy[v0 + b + 3] -= f_ax
         dy[v0 + L.Q_ZN] += f_ax
-        dy[v0 + L.Q_THN] += f_ax * lead_local - f_dh * dh
+        dy[v0 + L.Q_THN] += f_ax * lead_local - f_dh * dh - r_n * f_tn
 
         # ---------------- roller gear – ring gear mesh (line of action n = cos α0 e_t − sin α0 e_r)
         phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, L.R_MESH_PHASE]
@@ -498,6 +544,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         f_coast, d2 = _flank(-d_g - bg, -d_g_dot, k_mesh, c_mesh, 1.0)
         p_diss += d1 + d2
         f_g = f_drive - f_coast
+        aux[a0 + L.AR_GEAR * n_rollers + i] = f_g
         # −∂V/∂q with ∂d_g/∂(X, Y) = −n, ∂d_g/∂θ_N = r_bN − e', ∂d_g/∂θ_c = −r_br, ∂d_g/∂θ_p ∋ e'
         fx_r = f_g * (cos_a0 * (-s) - sin_a0 * c)
         fy_r = f_g * (cos_a0 * c - sin_a0 * s)
@@ -589,7 +636,36 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
 
     # ---------------- motor, coupling and drive
     j_m, j_s = p[L.P_J_M], p[L.P_J_S]
-    if coupled:
+    if geared:
+        # Reduction: output angle θ_m/N + e(θ_m), e the transmission error at the mesh order;
+        # gear mesh and coupling in series (one spring, P_K_COUP) with the gear's backlash as
+        # dead band. `transmitted` is the loss-free torque the output asks of the motor shaft.
+        if coupled:
+            order, te = p[L.P_MESH_ORDER], p[L.P_GEAR_TE]
+            gain = 1.0 / ratio + te * order * math.cos(order * th_m)  # ∂(output)/∂θ_m
+            twist = th_m / ratio + te * math.sin(order * th_m) - th_s
+            twist_rate = gain * w_m - w_s
+            play = p[L.P_GEAR_BACKLASH]
+            t_coup = 0.0
+            if twist > play or twist < -play:
+                edge = play if twist > 0.0 else -play
+                t_coup = p[L.P_K_COUP] * (twist - edge) + p[L.P_C_COUP] * twist_rate
+                p_diss += p[L.P_C_COUP] * twist_rate * twist_rate
+            dy[v0 + L.Q_THS] = (t_coup + torque_screw - p[L.P_C_SD] * w_s) / j_s
+            transmitted = t_coup * gain
+            j_drive = j_m
+        else:
+            transmitted = (-torque_screw + p[L.P_C_SD] * w_s) / ratio
+            j_drive = j_m + j_s / (ratio * ratio)
+        # Mesh loss ∝ transmitted torque (ISO/TR 14179-1's load-dependent loss): the motor
+        # gives T/η when it drives and receives T·η when driven back; always dissipated, its
+        # sign switch at zero motor speed regularised.
+        eta = p[L.P_GEAR_EFFICIENCY]
+        share = 1.0 / eta - 1.0 if transmitted * w_m > 0.0 else 1.0 - eta
+        loss = abs(transmitted) * share * math.tanh(w_m / p[L.P_W_GEAR])
+        p_diss += loss * w_m
+        load_torque = transmitted + loss
+    elif coupled:
         t_coup = p[L.P_K_COUP] * (th_m - th_s) + p[L.P_C_COUP] * (w_m - w_s)
         p_diss += p[L.P_C_COUP] * (w_m - w_s) ** 2
         dy[v0 + L.Q_THS] = (t_coup + torque_screw - p[L.P_C_SD] * w_s) / j_s
@@ -615,7 +691,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         dy[2 * nq + L.X_SPEED_INT] = w_cmd - w_m
     dy[v0 + L.Q_THM] = alpha_m
     if not coupled:
-        dy[v0 + L.Q_THS] = alpha_m
+        dy[v0 + L.Q_THS] = alpha_m / ratio if geared else alpha_m
 
     # ---------------- accelerations
     m_s, m_n, m_p, m_c = p[L.P_M_S], p[L.P_M_N], p[L.P_M_P], p[L.P_M_C]
@@ -674,29 +750,44 @@ def _record(y, dy, aux, p, nq, out_row):
     out_row[L.C_LOAD_FORCE] = aux[L.A_LOAD_FORCE]
 
 
-@njit(cache=True)
-def _clamp_traction(y, p, nq, aux, n_rollers):
+@njit(cache=True, inline="always")
+def _clamp_one(y, j, cap, k, e0):
     # A stuck contact cannot hold more than its Coulomb limit: when the normal load drops, the
     # elastic tangential displacement resets to the limit and its released energy is dissipated.
-    k_tan = p[L.P_K_TAN]
+    limit = cap / k
+    slip = y[j]
+    if slip > limit or slip < -limit:
+        new = limit if slip > 0.0 else -limit
+        released = 0.5 * k * (slip * slip - new * new)
+        y[j] = new
+        y[e0 + L.X_W_DISS] += released
+        y[e0 + L.X_W_FRIC] += released
+
+
+@njit(cache=True)
+def _clamp_traction(y, p, rollers, nq, aux):
+    # Both traction states of every roller: screw side (stiffness P_K_TAN), nut side (R_K_TAN_N).
+    n = rollers.shape[0]
     s0 = 2 * nq + L.N_EXTRA
-    for i in range(n_rollers):
-        limit = aux[L.N_AUX + i] / k_tan
-        slip = y[s0 + i]
-        if slip > limit or slip < -limit:
-            new = limit if slip > 0.0 else -limit
-            released = 0.5 * k_tan * (slip * slip - new * new)
-            y[s0 + i] = new
-            y[2 * nq + L.X_W_DISS] += released
-            y[2 * nq + L.X_W_FRIC] += released
+    k_tan = p[L.P_K_TAN]
+    for i in range(n):
+        _clamp_one(y, s0 + i, aux[L.N_AUX + L.AR_CAP_S * n + i], k_tan, 2 * nq)
+        _clamp_one(
+            y, s0 + n + i, aux[L.N_AUX + L.AR_CAP_N * n + i], rollers[i, L.R_K_TAN_N], 2 * nq
+        )
 
 
 @njit(cache=True, inline="always")
 def _hold_prescribed(y, t, p, motion, nq):
     # The prescribed angle is not integrated: set it (and the rigidly coupled screw) exactly.
+    # The knots are the screw's: through a reduction the motor turns N times as far.
     th, w, _ = screw_motion(t, motion)
-    y[L.Q_THM] = th
-    y[nq + L.Q_THM] = w
+    if p[L.P_GEARED] == 1.0:
+        y[L.Q_THM] = p[L.P_RATIO] * th
+        y[nq + L.Q_THM] = p[L.P_RATIO] * w
+    else:
+        y[L.Q_THM] = th
+        y[nq + L.Q_THM] = w
     if p[L.P_COUPLED] != 1.0:
         y[L.Q_THS] = th
         y[nq + L.Q_THS] = w
@@ -760,7 +851,7 @@ def integrate(
         rhs(t + h, tmp, p, rollers, mesh_table, motion, load_knots, errors, k4, aux)
         for j in range(n_state):
             y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
-        _clamp_traction(y, p, nq, aux, rollers.shape[0])
+        _clamp_traction(y, p, rollers, nq, aux)
     if prescribed:
         _hold_prescribed(y, t0 + n_steps * h, p, motion, nq)
     for j in range(2 * nq):

@@ -23,14 +23,17 @@ def n_coordinates(n_rollers: int) -> int:
 
 
 # Extra integrated quantities appended after [q, q̇]: cumulative energies [J] for the power
-# balance and the speed-loop integrator state. After them, one traction state per roller:
-# the elastic tangential displacement s_i [m] of its screw–roller contact.
+# balance and the speed-loop integrator state. After them, two traction states per roller: the
+# elastic tangential displacements [m] of its screw–roller contacts (rollers 0…n−1), then of its
+# roller–nut contacts (n…2n−1).
 X_W_DRIVE, X_W_LOAD, X_W_DISS, X_W_FRIC, X_SPEED_INT = 0, 1, 2, 3, 4
 N_EXTRA = 5
+#: Traction states per roller: screw side, nut side.
+N_TRACTION = 2
 
 
 def n_state(n_rollers: int) -> int:
-    return 2 * n_coordinates(n_rollers) + N_EXTRA + n_rollers
+    return 2 * n_coordinates(n_rollers) + N_EXTRA + N_TRACTION * n_rollers
 
 
 # ----------------------------------------------------------------- scalar parameters p
@@ -84,7 +87,15 @@ P_STRIBECK = 74  # 1: the Coulomb coefficient follows the lubrication regime (ER
 # which flanks carry the screw and the nut spall (1/0 for the plus and the minus flank).
 P_SPALL_SHARE, P_SPALL_Z, P_SPALL_HALF, P_SPALL_RAMP = 75, 76, 77, 78
 P_SPALL_PLUS_S, P_SPALL_MINUS_S, P_SPALL_PLUS_N, P_SPALL_MINUS_N = 79, 80, 81, 82
-N_PARAMS = 83
+# Reduction between motor and screw (drive_train.gear_*): 1 when there is one (else the direct
+# drive's code path, unchanged); ratio N (motor turns per screw turn; 1.0 without one); mesh
+# efficiency η; half-backlash at the output [rad]; mesh cycles per motor revolution; amplitude of
+# the transmission error at that order as an output angle [rad]; regularisation speed of the
+# direction-dependent mesh loss [rad/s of the motor]. The gear's stiffness is in series with the
+# coupling's in P_K_COUP, its input inertia in P_J_M.
+P_GEARED, P_RATIO, P_GEAR_EFFICIENCY, P_GEAR_BACKLASH = 83, 84, 85, 86
+P_MESH_ORDER, P_GEAR_TE, P_W_GEAR = 87, 88, 89
+N_PARAMS = 90
 
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 
@@ -125,7 +136,15 @@ R_PSI = 11  # angular position of the pocket [rad]
 R_RUNOUT, R_RUNOUT_PHASE = 12, 13  # roller thread runout about its spin axis [m], phase [rad]
 R_SPALL = 14  # 1 for the roller carrying the roller-flank spall, else 0
 R_TOOTH = 15  # 1 for the roller whose gear carries the damaged tooth, else 0
-N_ROLLER_PARAMS = 16
+# Thread rolling (traction) of the roller on the screw and on the nut: the roller's effective
+# rolling radius at each contact [m] (the nut-side one carries the roller's pitch mismatch ε
+# against its gear: r_r/(1 + ε)); the nut-side tangential stiffness [N/m] and damping [N·s/m];
+# the inverse relaxation length of each side's traction [1/m]; ε itself [-] (a run label).
+R_ROLL_S, R_ROLL_N = 16, 17
+R_K_TAN_N, R_C_TAN_N = 18, 19
+R_RELAX_S, R_RELAX_N = 20, 21
+R_MISMATCH = 22
+N_ROLLER_PARAMS = 23
 
 # ----------------------------------------------------------------- recorded truth signals
 (
@@ -150,8 +169,11 @@ N_CHANNELS = 16
 # Names, units and meanings: prsm_health.core.channels.TRUTH_CHANNELS (same order); every measured
 # channel is a sensor's reading of one of them (prsm_health.simulation.instrumentation).
 
-# Auxiliary outputs of one right-hand-side evaluation; after them, per roller, the Coulomb
-# limit μ·N of its screw–roller traction [N].
+# Auxiliary outputs of one right-hand-side evaluation; after them, blocks of one value per
+# roller (block k at N_AUX + k·n_rollers + i): the Coulomb limit μ·N of its screw–roller
+# traction [N], of its roller–nut traction [N], its gear mesh force along the line of action
+# (> 0 on the drive flank) [N], its screw-side and nut-side traction forces on the roller
+# (along e_t) [N].
 (
     A_MOTOR_TORQUE,
     A_FRICTION_TORQUE,
@@ -165,5 +187,9 @@ N_CHANNELS = 16
 N_AUX = 8
 
 
+AR_CAP_S, AR_CAP_N, AR_GEAR, AR_TRACTION_S, AR_TRACTION_N = 0, 1, 2, 3, 4
+N_AUX_PER_ROLLER = 5
+
+
 def n_aux(n_rollers: int) -> int:
-    return N_AUX + n_rollers
+    return N_AUX + N_AUX_PER_ROLLER * n_rollers

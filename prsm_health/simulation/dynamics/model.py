@@ -24,8 +24,10 @@ Force laws (one energy function; kernel in :mod:`._kernels`):
   z_ring·(φ_i − θ_N)/2π — each roller at its geometric mesh phase — and backlash b_g.
 * **Friction** at the screw–roller contact: regularised Coulomb μ·N·tanh(v/v_reg) plus viscous
   μ_sc·v (paper 01 table: μ_sc = 25 N·s/m) on the sliding speed
-  v = r_s(ω_s − ω_rev) + r_r(ω_i − ω_rev), times the health state's friction scale. The
-  roller–nut contact is rolling (paper 01 §1.2.2).
+  v = r_s(ω_s − ω_rev) + r_r(ω_i − ω_rev), times the health state's friction scale. Both thread
+  contacts carry a creeping traction (Mindlin stiffness, relaxation length from Kalker's linear
+  theory, capped at μN); the gear takes the pitch mismatch between its ratio and the nut
+  thread's rolling ratio (:mod:`prsm_health.physics.rolling_mismatch`; Jones & Velinsky 2012).
 * **Supports** (paper 01 K_s, K_N, K_pN, K_cp; values not given — engineering defaults
   below), linear with damping set by damping ratios.
 * **Drive train** (:mod:`prsm_health.actuator.drive_train`, beyond paper 01): motor rotor θ_m driving
@@ -379,18 +381,22 @@ def build_model(
         "speed_loop": L.DRIVE_SPEED_LOOP,
         "position_loop": L.DRIVE_POSITION_LOOP,
     }[profile.drive]
-    # PI speed loop on the motor speed, gains from the inertia it drives (motor + screw)
-    j_drive = drive_train.motor_inertia + m.screw_inertia
+    # PI speed loop on the motor speed, gains from the inertia it drives: motor, reduction and
+    # the screw reflected to the motor (J_s/N²; J_m + J_s without a reduction).
+    j_drive = drive_train.reflected_inertia(m.screw_inertia)
     omega_bw = 2 * math.pi * profile.speed_loop_bandwidth
     p[L.P_KP] = j_drive * omega_bw * 2.0
     p[L.P_KI] = j_drive * omega_bw**2
     p[L.P_KP_POS] = profile.position_loop_gain
-    p[L.P_TORQUE_LIMIT] = profile.torque_limit
+    # Saturation of the speed loop: the motor's peak torque k_t·I_peak when the drive train
+    # gives its current limit (physics wins), else the profile's torque_limit (older scenarios).
+    p[L.P_TORQUE_LIMIT] = drive_train.peak_torque or profile.torque_limit
     p[L.P_LOAD_SIN_AMP], p[L.P_LOAD_SIN_FREQ] = amp, freq
     _drive_train_params(p, drive_train, design, k_axial, options.contact_restitution)
 
     rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
     rollers = _roller_params(design, health, options.variation, orbit, rng)
+    _rolling_params(rollers, design, options, rng, roller_load, tangents)
     errors, p[L.P_LEAD_SLOPE] = _error_terms(design, options.variation, rng, health.spalls)
     p[L.P_HAS_SPALLS] = _spall_params(p, design, health, profile, options)
     p[L.P_STRIBECK] = _coulomb_table(errors, design, health, profile, options)
@@ -417,11 +423,30 @@ def _drive_train_params(p, drive_train, design, k_axial, restitution) -> None:
     dt, m = drive_train, design.masses
     zeta_film = -math.log(restitution) / math.sqrt(math.pi**2 + math.log(restitution) ** 2)
     p[L.P_C_FILM] = 2 * zeta_film * math.sqrt(k_axial * m.nut_mass)
-    p[L.P_J_M] = dt.motor_inertia
     p[L.P_COUPLED] = 1.0 if dt.coupled else 0.0
-    p[L.P_K_COUP] = dt.coupling_stiffness
-    j_pair = dt.motor_inertia * m.screw_inertia / (dt.motor_inertia + m.screw_inertia)
-    p[L.P_C_COUP] = 2 * dt.coupling_damping_ratio * math.sqrt(dt.coupling_stiffness * j_pair)
+    p[L.P_RATIO] = 1.0
+    if dt.geared:
+        # The reduction's input inertia turns with the motor; its mesh stiffness is in series
+        # with the coupling (no inertia between them: the catalogue's J_1 is at the input).
+        p[L.P_GEARED] = 1.0
+        p[L.P_RATIO] = dt.gear_ratio
+        p[L.P_J_M] = dt.motor_inertia + dt.gear_inertia
+        k = dt.coupling_stiffness
+        if dt.gear_stiffness:
+            k = k * dt.gear_stiffness / (k + dt.gear_stiffness)
+        p[L.P_K_COUP] = k
+        p[L.P_GEAR_EFFICIENCY] = dt.gear_efficiency
+        p[L.P_GEAR_BACKLASH] = dt.gear_backlash
+        p[L.P_MESH_ORDER] = dt.mesh_order
+        p[L.P_GEAR_TE] = dt.transmission_error if dt.mesh_order else 0.0
+        # 1 rad/s at the motor: far below running speeds (the loss is then fully on), wide
+        # enough that the loss's sign change at a reversal is smooth for a µs step.
+        p[L.P_W_GEAR] = 1.0
+    else:
+        p[L.P_J_M] = dt.motor_inertia
+        p[L.P_K_COUP] = dt.coupling_stiffness
+    j_pair = dt.coupling_pair_inertia(m.screw_inertia)
+    p[L.P_C_COUP] = 2 * dt.coupling_damping_ratio * math.sqrt(p[L.P_K_COUP] * j_pair)
     p[L.P_AXIAL_FREE] = 0.0 if dt.rigid_thrust_bearing else 1.0
     p[L.P_K_BEAR] = dt.thrust_bearing_stiffness
     p[L.P_C_BEAR] = (
@@ -432,6 +457,25 @@ def _drive_train_params(p, drive_train, design, k_axial, restitution) -> None:
     p[L.P_M_L] = dt.payload_mass
     p[L.P_K_LINK] = dt.linkage_stiffness
     p[L.P_C_LINK] = 2 * dt.linkage_damping_ratio * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
+
+
+def geared_motor_state(model: Model, y: np.ndarray) -> None:
+    """Put the motor of a geared drive train on the kinematic solution, in place.
+
+    :func:`initial_state` sets the motor angle and speed as the gearbox output's (θ_s plus the
+    coupling twist, ω_s); through a reduction the motor turns N times as far, and a loaded
+    coupling takes up the gear's half-backlash first. No-op without a reduction.
+    """
+    p = model.params
+    if p[L.P_GEARED] != 1.0:
+        return
+    nq = model.n_coordinates
+    load0 = float(model.load_knots[1, 0])
+    output = y[L.Q_THM]
+    if p[L.P_COUPLED] == 1.0 and load0:
+        output += math.copysign(p[L.P_GEAR_BACKLASH], load0)
+    y[L.Q_THM] = p[L.P_RATIO] * output
+    y[nq + L.Q_THM] = p[L.P_RATIO] * y[nq + L.Q_THM]
 
 
 def _error_terms(design, variation, rng, spalls=()) -> tuple[np.ndarray, float]:
@@ -666,6 +710,41 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     return r
 
 
+def _rolling_params(rollers, design, options, rng, roller_load, tangents) -> None:
+    """Fill the thread-rolling columns (layout ``R_ROLL_*``, ``R_K_TAN_N``, ``R_C_TAN_N``,
+    ``R_RELAX_*``, ``R_MISMATCH``): each roller's rolling radii on screw and nut, the nut-side
+    traction and the pitch mismatch ε = nominal + tolerance + elastic
+    (:func:`prsm_health.physics.rolling_mismatch.rolling_mismatch_terms`)."""
+    from prsm_health.physics.rolling_mismatch import rolling_mismatch_terms
+
+    v = options.variation
+    n = design.n_rollers
+    r_r, r_n = design.roller_diameter / 2, design.nut_diameter / 2
+    # A stream of its own, jumped off the variation stream without advancing it, so the
+    # draws of every other tolerance stay what they were for a seed.
+    extra = np.random.Generator(rng.bit_generator.jumped())
+    z = extra.standard_normal(n + 1)
+    d_roller = v.rolling_radius_error * z[:n]  # each roller's rolling radius error [m]
+    d_nut = v.rolling_radius_error * z[n]  # the nut thread's, against its ring gear [m]
+    nominal, elastic, (l_screw, l_nut) = rolling_mismatch_terms(design, roller_load)
+    eps = nominal + d_nut / r_n - d_roller / r_r + elastic
+    sin_b = math.sin(design.contact_angle)
+    # The screw side: the roller's own radius error. The elastic shift there is common to all
+    # rollers and only moves the carrier speed (by ~1e-4): not modelled.
+    rollers[:, L.R_ROLL_S] = r_r + d_roller
+    rollers[:, L.R_ROLL_N] = r_r / (1.0 + eps)
+    k_tan_n = options.traction_stiffness_ratio * tangents[1] / sin_b**2
+    rollers[:, L.R_K_TAN_N] = k_tan_n
+    # as the screw side's P_C_TAN: the contact damping ratio on the roller's spin
+    m = design.masses
+    rollers[:, L.R_C_TAN_N] = (
+        2 * options.contact_damping_ratio * math.sqrt(k_tan_n * m.roller_inertia / r_r**2)
+    )
+    rollers[:, L.R_RELAX_S] = 1.0 / l_screw
+    rollers[:, L.R_RELAX_N] = 1.0 / l_nut
+    rollers[:, L.R_MISMATCH] = eps
+
+
 def realised_clearances(model: Model) -> dict[str, float]:
     """Run labels of the as-built half-clearances [m]: mean, min and max over the rollers of
     each engagement (uneven wear, the assembly's take-up of pitch errors and the preload
@@ -684,6 +763,31 @@ def static_closure(model: Model, side: int) -> float:
     if model.params[L.P_EXPONENT] == 1.0:
         return model.roller_load / k
     return (model.roller_load / k) ** (2.0 / 3.0)
+
+
+def _gear_flank_offset(model: Model, i: int, w_s: float, load0: float) -> float:
+    """Roller spin offset [rad] that puts roller i's gear on the flank it runs on in steady
+    state, at its steady force: in service the gear has long crossed its backlash (at ε = 3e-4
+    that takes ~0.2 s, longer than most runs), so a run starts there, not in the backlash.
+
+    Steady gear force (signed with the screw speed): the nut traction's creep force at the
+    pitch mismatch ε (Kalker's linear law, capped at μN) over cos α0, less the spin torque
+    μN·L_r/2π that the roller's axial sliding on the screw (paper 02's μ2 term) puts on it
+    through the helix (the gear, stiffer than the creeping threads, takes it)."""
+    p, r = model.params, model.rollers
+    if w_s == 0.0:
+        return 0.0
+    normal = p[L.P_MU_COUL] * p[L.P_FRICTION_SCALE] * abs(load0) / model.n_rollers
+    normal /= p[L.P_SIN_BETA]  # μN of one roller side
+    eps = r[i, L.R_MISMATCH]
+    creep = min(r[i, L.R_K_TAN_N] / r[i, L.R_RELAX_N] * abs(eps), normal) if eps else 0.0
+    force = math.copysign(creep, eps) / p[L.P_COS_A0] - normal * p[L.P_LEAD_R] / p[L.P_RB_ROLLER]
+    if force == 0.0:
+        return 0.0
+    direction = math.copysign(1.0, force * w_s)  # > 0: the drive flank, d_g > 0
+    k_mesh = float(np.mean(model.mesh_table)) * r[i, L.R_MESH_SCALE]
+    # d_g = … − r_br·θ_i: closing d_g to ±(b_g + F/k) turns the roller back by as much
+    return -direction * (r[i, L.R_B_G] + abs(force) / k_mesh) / p[L.P_RB_ROLLER]
 
 
 def initial_state(model: Model, t0: float = 0.0) -> np.ndarray:
@@ -738,6 +842,7 @@ def initial_state(model: Model, t0: float = 0.0) -> np.ndarray:
         d_s = sign * (r[i, L.R_B_S] + shape * static_closure(model, 0)) if load0 else 0.0
         # δ_s = −(z_i − z_s) + e_s (+ the rigid-body terms, zero on the kinematic solution)
         y[b + 3] = z_s - d_s + r[i, L.R_E_S] + ratios.nut * th_s
+        y[b + 2] += _gear_flank_offset(model, i, w_s, load0)
     z_c_mean = float(np.mean(y[L.Q_ROLLER0 + 3 : nq : L.ROLLER_DOF]))
     d_n_mean = (
         sign * (float(np.mean(r[:, L.R_B_N])) + shape * static_closure(model, 1)) if load0 else 0.0
@@ -746,4 +851,5 @@ def initial_state(model: Model, t0: float = 0.0) -> np.ndarray:
     y[L.Q_ZL] = y[L.Q_ZN]
     if p[L.P_ON_PAYLOAD] == 1.0:
         y[L.Q_ZL] -= load0 / p[L.P_K_LINK]
+    geared_motor_state(model, y)
     return y

@@ -16,6 +16,8 @@ from prsm_health.core.errors import SimulationError
 from prsm_health.core.run import Run
 
 from ..decimation import decimate
+from ..instrumentation import bind_drive_train
+from ..thermal import housing_temperature_signal
 from . import _kernels
 from . import layout as L
 from .model import (
@@ -57,8 +59,15 @@ def linearised_modes(model: Model) -> tuple[np.ndarray, np.ndarray, list[int]]:
     rollers[:, L.R_B_N] = np.minimum(rollers[:, L.R_B_N], 0.0)
     rollers[:, L.R_B_G] = 0.0
     operating = model.roller_load * model.n_rollers
+    # At the run's top speed: at standstill the regularised friction laws (tanh of a sliding
+    # speed over ≈ 0.1 rad/s) act as stiff dampers whose RK4 limit would set a far smaller step,
+    # though a run only crosses that band for microseconds, where the bounded tanh cannot grow.
+    top = float(np.max(np.abs(model.motion[1])))
     loaded = replace(
-        model, rollers=rollers, load_knots=np.array([[0.0, 1.0], [operating, operating]])
+        model,
+        rollers=rollers,
+        load_knots=np.array([[0.0, 1.0], [operating, operating]]),
+        motion=np.array([[0.0, 1.0], [top, top], [0.0, top]]),
     )
     y0 = initial_state(loaded)
     p = model.params
@@ -128,8 +137,9 @@ def settling_model(model: Model) -> Model:
     params[L.P_C_NA] = c_settle + c_guide
     params[L.P_V_NUT_REF] = c_settle * v_rigid / (c_settle + c_guide)
     m, dt = model.design.masses, model.drive_train
-    j_pair = dt.motor_inertia * m.screw_inertia / (dt.motor_inertia + m.screw_inertia)
-    params[L.P_C_COUP] = 2.0 * math.sqrt(dt.coupling_stiffness * j_pair)
+    params[L.P_C_COUP] = 2.0 * math.sqrt(
+        params[L.P_K_COUP] * dt.coupling_pair_inertia(m.screw_inertia)
+    )
     params[L.P_C_BEAR] = 2.0 * math.sqrt(dt.thrust_bearing_stiffness * m.screw_mass)
     params[L.P_C_LINK] = 2.0 * math.sqrt(dt.linkage_stiffness * dt.payload_mass)
     return replace(model, params=params)
@@ -185,7 +195,9 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
             0.0  # energy book starts at t = 0
         )
     truth_raw = _truth_from_record(integrate(model, y, h, n_steps, progress=progress))
-    channels = instrumentation.measure(
+    # derived after the kernel's signals: the housing at the temperature probe
+    truth_raw["housing_temperature"] = housing_temperature_signal(profile.temperature, truth_raw)
+    channels = bind_drive_train(instrumentation, scenario.drive_train).measure(
         truth_raw,
         1.0 / h,
         np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
@@ -213,13 +225,17 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         },
         energy=energy,
         truth=truth,
+        # the controller commands the check's phases: which one each sample is in is known
+        check_phase=None if profile.check is None else profile.check.phase_at(time),
+        check={} if profile.check is None else profile.check.as_record(),
     )
 
 
 def _truth_from_record(raw: np.ndarray) -> dict[str, np.ndarray]:
     """Truth signals by name from the kernel's record, whose columns (layout ``C_*``) are the
-    truth signals in contract order (prsm_health.core.channels.TRUTH_CHANNELS)."""
-    return {name: raw[:, k] for k, name in enumerate(TRUTH_NAMES)}
+    truth signals in contract order (prsm_health.core.channels.TRUTH_CHANNELS); the truth
+    signals after them are derived from these (``housing_temperature``)."""
+    return {name: raw[:, k] for k, name in enumerate(TRUTH_NAMES[: L.N_CHANNELS])}
 
 
 def integrate(

@@ -67,6 +67,7 @@ def make_run(n=2000, channels=CHANNEL_NAMES, seed=0, truth=False):
         "nut_radial_y_accel": np.cos(2 * np.pi * 700 * t),
         "drive_torque": 0.5 + 0.05 * rng.standard_normal(n),
         "axial_load": np.full(n, 2000.0),
+        "housing_temperature": 313.15 + 0.5 * np.sin(2 * np.pi * 0.5 * t),
     }
     x = signals["nut_radial_x_accel"]
     x[:6] = [-0.0, 5e-324, 1e300, 0.1, 1 / 3, 2.0**-1074 * 3]

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from prsm_health import HealthState, OperatingProfile, preset, simulate
+from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.actuator.faults import ToothCrack, ToothPit
 from prsm_health.core.errors import ParameterError
 from prsm_health.physics.stiffness.damaged_mesh import damaged_mesh
@@ -69,11 +70,16 @@ def test_bad_tooth_damage_names_the_field():
 @pytest.mark.slow
 def test_kernel_reads_the_damaged_tooth_with_energy_balance():
     # Same seed, with and without a severe ring-tooth pit: the signals differ (the table is
-    # read), and the energy book closes within 1 %.
+    # read), and the energy book closes within 1 %. On the direct drive: the default
+    # gearhead's own mesh line dominates the nut's tangential vibration (its signature is
+    # the reduction's, not the PRSM's: docs/faults.md).
     profile = OperatingProfile(duration=0.2, load=300.0)
     pit = ToothPit(location="ring_gear", width=0.9, depth=0.2e-3, length=0.5e-3)
-    healthy = simulate("paper01", HealthState(), profile, "ideal", 4)
-    damaged = simulate("paper01", HealthState(faults=(pit,)), profile, "ideal", 4)
+    direct = DriveTrain.direct()
+    healthy = simulate("paper01", HealthState(), profile, "ideal", 4, drive_train=direct)
+    damaged = simulate(
+        "paper01", HealthState(faults=(pit,)), profile, "ideal", 4, drive_train=direct
+    )
     difference = np.std(damaged["nut_tangential_accel"] - healthy["nut_tangential_accel"])
     assert difference > 0.1 * np.std(healthy["nut_tangential_accel"])
     e = damaged.energy

@@ -208,7 +208,7 @@ def test_same_seed_bit_identical_and_seeds_differ():
 
 def test_step_guard_refuses_unstable_step():
     model = build_model(
-        preset("paper01"), HealthState(), OperatingProfile(), SimulationOptions(), 0
+        preset("paper01"), HealthState(), OperatingProfile(load=100.0), SimulationOptions(), 0
     )
     h_max, f_max = max_stable_step(model)
     assert 1e-6 < h_max < 1e-4 and f_max > 1e3
@@ -260,7 +260,7 @@ def test_blow_up_is_reported_with_its_time():
     from prsm_health.simulation.dynamics.simulate import integrate
 
     model = build_model(
-        preset("paper01"), HealthState(), OperatingProfile(), SimulationOptions(), 0
+        preset("paper01"), HealthState(), OperatingProfile(load=100.0), SimulationOptions(), 0
     )
     h = 20 * max_stable_step(model)[0]
     with pytest.raises(SimulationError, match=r"non-finite at t = [0-9.e-]+ s"):
