@@ -191,7 +191,8 @@ def test_diagnose_subset_of_channels(client, recording):
     assert d["fault_class"] == "cannot_tell"
     assert d["observability"] == {"clearance": 0.0, "fault": 0.0}
     assert any(
-        "screw_angle, screw_speed, nut_position, drive_torque missing" in w for w in d["warnings"]
+        "screw_angle, screw_speed, nut_position, drive_torque, housing_temperature missing" in w
+        for w in d["warnings"]
     )
     assert d["indicator_groups"]["lost_motion"] == "missing channel(s) nut_position, screw_angle"
 
