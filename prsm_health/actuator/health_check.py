@@ -465,12 +465,15 @@ BUILT_IN: dict[str, HealthCheck] = {
             # turns: 3/0.375 = 8 screw turns = 0.503 s at 100 rad/s; 0.52 s. 25 % C_a: the
             # highest load of the duty (EMAs run at 10–40 % of C_a; the issue measured nut
             # spalls at SNR 4–61 at 2.2–6.6 kN), far below C_0a (≈ 1.9 C_a on paper 01).
-            # Retracting: 82 mm back, the longest stroke, centred on the start.
+            # Retracting: 82 mm back, the longest stroke, centred on the start — with the load
+            # aiding the motion (negative), so it presses the same flanks as a resisting load on
+            # an extending stroke: the flanks that carry the service load, where spalls form
+            # (faults.Spall, flank "loaded").
             CheckPhase(
                 "high-load stroke",
                 "constant",
                 speed=-100.0,
-                load="25 % C_a",
+                load="-25 % C_a",
                 duration=0.52,
                 ramp_time=_RAMP,
             ),

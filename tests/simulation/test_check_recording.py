@@ -66,10 +66,14 @@ def test_every_sample_has_its_phase(run):
 def test_energy_balance_through_the_check(run):
     # From rest to rest (the check ramps back down): drive = output + dissipated within 1 %,
     # the bound of the constant-speed energy tests (tests/simulation/dynamics/test_dynamics.py);
-    # what is left is the vibration energy stored at the end and the RK4 error.
+    # what is left is the vibration energy stored at the end and the RK4 error. The high-load
+    # stroke back-drives the motor (its load aids the retraction), so the net drive energy can
+    # be small or negative: the balance is read against the energy that went through the
+    # actuator, (|drive| + |load|)/2.
     e = run.energy
-    assert e["drive"] > 0
-    assert (e["drive"] + e["load"] - e["dissipated"]) / e["drive"] == pytest.approx(0, abs=1e-2)
+    through = 0.5 * (abs(e["drive"]) + abs(e["load"]))
+    assert through > 0 and e["dissipated"] > 0
+    assert (e["drive"] + e["load"] - e["dissipated"]) / through == pytest.approx(0, abs=1e-2)
 
 
 def test_parquet_column_and_metadata_read_by_pyarrow(run, tmp_path):

@@ -5,7 +5,7 @@ Hertzian flanks, seed 3: the built-in ``health-check`` (prsm_health.actuator.hea
 the actuator runs it, loads resolved against the design's ratings. Plots the measured screw
 speed, drive torque, nut position and nut axial acceleration over the whole check with each
 phase shaded and named (the ramps between phases left white), and prints the energy book
-(drive − output − dissipated, relative to the drive energy). Writes
+(drive − output − dissipated, relative to the energy through the actuator). Writes
 docs/figures/health-check.png.
 
     python tools/figures/make_check_figure.py [--design paper01] [--out FILE]
@@ -39,8 +39,11 @@ def simulate_check(design: str):
 
 
 def energy_residual(energy: dict) -> float:
-    """(drive − output − dissipated)/drive, output = −load work (the energy book's sign)."""
-    return (energy["drive"] + energy["load"] - energy["dissipated"]) / energy["drive"]
+    """(drive − output − dissipated) over the energy through the actuator, (|drive| + |load|)/2
+    (output = −load work, the energy book's sign; the high-load stroke back-drives the motor,
+    so the net drive energy alone can be small)."""
+    through = 0.5 * (abs(energy["drive"]) + abs(energy["load"]))
+    return (energy["drive"] + energy["load"] - energy["dissipated"]) / through
 
 
 def figure(run, out: Path) -> Path:
@@ -95,7 +98,7 @@ def main() -> None:
     e = run.energy
     print(
         f"energy: drive {e['drive']:.4g} J, output {-e['load']:.4g} J, dissipated "
-        f"{e['dissipated']:.4g} J; (drive − output − dissipated)/drive = "
+        f"{e['dissipated']:.4g} J; (drive − output − dissipated)/(energy through) = "
         f"{100 * energy_residual(e):+.3f} %"
     )
     for p in run.check["phases"]:

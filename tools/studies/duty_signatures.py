@@ -6,15 +6,16 @@ can read where it should look (issue [2/5], docs/faults.md "At realistic duty"):
 * nut and roller spalls — time-synchronous average (TSA) of the measured nut axial acceleration
   on the measured screw angle, over one nut pass (a carrier turn over the number of rollers:
   every roller passes a nut spall once per carrier turn) and one roller spin relative to the
-  carrier (roller spall); SNR = variance of
-  the TSA over the variance a noise-only average of K periods would have, minus 1 (≈ 0 when
-  nothing repeats at that period);
+  carrier (roller spall); SNR = energy of the TSA over the energy of the residual (the
+  periodic-vs-residual ratio: what repeats at the period against what does not);
 * preload loss — spectral centroid 200–3000 Hz of the nut axial acceleration at no load (the
   nut's axial resonance on its threads softens as the preload goes);
 * lost motion under a slow load reversal — the ``lost_motion`` indicator of
   :func:`prsm_health.signals.features.extract_features` (LVDT against resolver);
 * lubricant — ratio of the mean drive torque at 10 and 100 rad/s under one load (no load cell,
-  no torque constant needed).
+  no torque constant needed);
+* the same four read from the phases of the built-in health check
+  (:mod:`prsm_health.actuator.health_check`), one check per unit and seed.
 
 Loads as shares of the design's dynamic rating C_a (:mod:`prsm_health.physics.load_rating`).
 
@@ -50,13 +51,12 @@ def newtons(load) -> float:
 
 
 def tsa_snr(x: np.ndarray, angle: np.ndarray, period: float) -> float:
-    """Variance of the TSA over the variance of a K-period average of its residual, − 1."""
+    """Energy of the TSA (what repeats at the period) over the energy of the residual (what
+    does not): the periodic-vs-residual ratio of a synchronous average."""
     tsa, periods = time_synchronous_average(x - np.mean(x), angle, period, 256)
-    k = periods.shape[0]
-    if k < 2:
+    if periods.shape[0] < 2:
         return math.nan
-    noise = np.var(periods - tsa) / k
-    return float(np.var(tsa) / noise - 1.0)
+    return float(np.var(tsa) / np.var(periods - tsa))
 
 
 def spall_table(seeds: int) -> list[dict]:
@@ -153,6 +153,49 @@ def lubricant_table(seeds: int) -> list[dict]:
     return rows
 
 
+#: Units run through the built-in health check: (name, health).
+CHECK_UNITS = {
+    "healthy": HealthState(),
+    "nut spall": HealthState(faults=({"kind": "spall", "location": "nut"},)),
+    "roller spall": HealthState(faults=({"kind": "spall", "location": "roller"},)),
+    "preload 5 µm": preloaded(0.0),
+    "preload 60 % lost": preloaded(0.6),
+    "lubricant degraded": HealthState(lubricant_degradation=1.0),
+}
+
+
+def check_table(seeds: int) -> list[dict]:
+    """Each phase of the built-in health check read for what it is there to show (flight-ema,
+    the default drive train): the no-load centroid, the torque ratio between the low- and the
+    high-speed stroke, the lost motion of the slow reversal, the TSA SNR of the high-load stroke."""
+    ratios = speed_ratios(DESIGN)
+    nut_pass = 2 * math.pi / abs(ratios.carrier) / DESIGN.n_rollers
+    roller = 2 * math.pi / abs(ratios.roller_spin - ratios.carrier)
+    rows = []
+    for unit, health in CHECK_UNITS.items():
+        values = {k: [] for k in ("centroid", "ratio", "lost", "snr_nut", "snr_roller")}
+        for seed in range(seeds):
+            run = simulate(
+                DESIGN,
+                health,
+                OperatingProfile(check="health-check"),
+                "flight-ema",
+                seed=500 + seed,
+            )
+            phase = run.phases()
+            values["centroid"].append(centroid(phase["no-load stroke"]))
+            low = np.mean(np.abs(phase["low-speed stroke"]["drive_torque"]))
+            high = np.mean(np.abs(phase["high-speed stroke"]["drive_torque"]))
+            values["ratio"].append(float(low / high))
+            values["lost"].append(float(extract_features(phase["slow reversal"])["lost_motion"]))
+            loaded = phase["high-load stroke"]
+            x, angle = loaded["nut_axial_accel"], loaded["screw_angle"]
+            values["snr_nut"].append(tsa_snr(x, angle, nut_pass))
+            values["snr_roller"].append(tsa_snr(x, angle, roller))
+        rows.append({"unit": unit, **values})
+    return rows
+
+
 def _fmt(values) -> str:
     values = np.asarray(values, float)
     return f"{np.median(values):.3g} ({np.min(values):.3g}–{np.max(values):.3g})"
@@ -168,6 +211,7 @@ def main(argv=None) -> None:
         "spalls": spall_table(args.seeds),
         "preload": preload_table(args.seeds),
         "lubricant": lubricant_table(args.seeds),
+        "check": check_table(args.seeds),
     }
     print("\n| duty | unit | TSA SNR, nut pass (nut spall) | TSA SNR, roller spin (roller spall) |")
     print("|---|---|---|---|")
@@ -182,6 +226,17 @@ def main(argv=None) -> None:
     print("|---|---|")
     for r in tables["lubricant"]:
         print(f"| {r['lubricant_degradation']:.0%} | {_fmt(r['torque_ratio_10_100'])} |")
+    print(
+        "\n| unit (built-in check) | no-load centroid [Hz] | torque 10 / 100 rad/s "
+        "| lost motion, slow reversal [µm] | TSA SNR nut pass | TSA SNR roller spin |"
+    )
+    print("|---|---|---|---|---|---|")
+    for r in tables["check"]:
+        lost = 1e6 * np.asarray(r["lost"])
+        print(
+            f"| {r['unit']} | {_fmt(r['centroid'])} | {_fmt(r['ratio'])} | {_fmt(lost)} "
+            f"| {_fmt(r['snr_nut'])} | {_fmt(r['snr_roller'])} |"
+        )
     if args.json:
         with open(args.json, "w") as f:
             json.dump(tables, f, indent=1)
