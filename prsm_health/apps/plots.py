@@ -64,6 +64,60 @@ def plot_run(
     return path
 
 
+#: Phase colours of a health-check plot (cycled).
+PHASE_COLOURS = ("#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860")
+#: Channels of a health-check plot, and the ones shown in other units than SI.
+CHECK_CHANNELS = ("screw_speed", "drive_torque", "nut_position", "nut_axial_accel")
+_SCALE = {"nut_position": (1e3, "mm")}
+
+
+def plot_check(run: Run, path: str | Path) -> Path:
+    """A health-check recording's measured channels over time with its phases shaded and named
+    (the ramps between phases left white), saved as PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    present = [c for c in CHECK_CHANNELS if c in run.channels]
+    fig, axes = plt.subplots(len(present), 1, figsize=(10, 1.9 * len(present)), sharex=True)
+    axes = np.atleast_1d(axes)
+    phases = run.check.get("phases", [])
+    for ax, name in zip(axes, present):
+        factor, unit = _SCALE.get(name, (1.0, UNITS[name]))
+        ax.plot(run.time, factor * run.channels[name], lw=0.5, color="k")
+        ax.set_ylabel(f"{name}\n[{unit}]", fontsize=8)
+        ax.grid(alpha=0.3)
+        for k, phase in enumerate(phases):
+            colour = PHASE_COLOURS[k % len(PHASE_COLOURS)]
+            ax.axvspan(phase["start"], phase["end"], color=colour, alpha=0.18)
+    for k, phase in enumerate(phases):
+        axes[0].text(
+            0.5 * (phase["start"] + phase["end"]),
+            1.02,
+            phase["name"],
+            transform=axes[0].get_xaxis_transform(),
+            ha="center",
+            va="bottom",
+            fontsize=8,
+            color=PHASE_COLOURS[k % len(PHASE_COLOURS)],
+        )
+    axes[-1].set_xlabel("time [s]")
+    fig.suptitle(
+        f"health check '{run.check.get('name', '')}' — {run.labels.get('design', '')}, "
+        f"{run.scenario.get('instrumentation', '')}, seed {run.labels.get('seed', '')}: "
+        "phases shaded (ramps between them unshaded)",
+        fontsize=10,
+        y=0.995,
+    )
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def _run_title(labels: dict) -> str:
     """Design, clearance, speed, load with its profile, seed — what a reader needs to place it."""
     load = f"load {labels.get('axial_load', 0):g} N"

@@ -286,6 +286,10 @@ class Scenario:
     def labels(self) -> dict:
         """Run labels of the contract: nominal health and operating point (SI)."""
         h, p = self.health, self.profile
+        # a health check has no one operating point: its top speed and its peak load
+        check = getattr(p, "check", None)
+        speed = float(np.max(np.abs(p.motion_knots()[1]))) if check else p.speed
+        load = p.peak_load if check else p.load
         return {
             "design": self.design.name,
             # the name is for people; the fingerprint says which design the run is of (as a
@@ -304,13 +308,14 @@ class Scenario:
             # JSON text, so a dataset's labels table keeps one scalar per cell
             "fault_kinds": "+".join(sorted({f.kind for f in h.faults})),
             "faults": json.dumps([fault_as_dict(f) for f in h.faults]),
-            "screw_speed": p.speed,
-            "axial_load": p.load,
-            "load_amplitude": p.load_amplitude,
+            "screw_speed": speed,
+            "axial_load": load,
+            "load_amplitude": 0.0 if check else p.load_amplitude,
             # the peak load as a share of the design's dynamic rating: how hard the run works
             "load_share": p.peak_load / design_ratings(self.design)["C_a"],
-            "motion": p.motion,
-            "load_profile": p.load_profile,
+            "motion": "check" if check else p.motion,
+            "load_profile": "check" if check else p.load_profile,
+            "check": check.name if check else "",
             "duration": p.duration,
             "temperature": p.temperature,
             "seed": self.seed,

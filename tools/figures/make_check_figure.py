@@ -16,15 +16,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
 from prsm_health import OperatingProfile, Scenario, SimulationOptions
-from prsm_health.core.channels import UNITS
+from prsm_health.apps.plots import plot_check
 
 OUT = Path(__file__).resolve().parents[2] / "docs" / "figures" / "health-check.png"
-CHANNELS = ("screw_speed", "drive_torque", "nut_position", "nut_axial_accel")
-SCALE = {"nut_position": (1e3, "mm")}  # shown in mm, the others in SI
-COLOURS = ("#4c72b0", "#dd8452", "#55a868", "#c44e52", "#8172b3", "#937860")
 
 
 def simulate_check(design: str):
@@ -46,49 +41,6 @@ def energy_residual(energy: dict) -> float:
     return (energy["drive"] + energy["load"] - energy["dissipated"]) / through
 
 
-def figure(run, out: Path) -> Path:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    present = [c for c in CHANNELS if c in run.channels]
-    fig, axes = plt.subplots(len(present), 1, figsize=(10, 1.9 * len(present)), sharex=True)
-    axes = np.atleast_1d(axes)
-    for ax, name in zip(axes, present):
-        factor, unit = SCALE.get(name, (1.0, UNITS[name]))
-        ax.plot(run.time, factor * run.channels[name], lw=0.5, color="k")
-        ax.set_ylabel(f"{name}\n[{unit}]", fontsize=8)
-        ax.grid(alpha=0.3)
-        for k, phase in enumerate(run.check["phases"]):
-            ax.axvspan(phase["start"], phase["end"], color=COLOURS[k % len(COLOURS)], alpha=0.18)
-    top = axes[0]
-    for k, phase in enumerate(run.check["phases"]):
-        top.text(
-            0.5 * (phase["start"] + phase["end"]),
-            1.02,
-            phase["name"],
-            transform=top.get_xaxis_transform(),
-            ha="center",
-            va="bottom",
-            fontsize=8,
-            color=COLOURS[k % len(COLOURS)],
-        )
-    axes[-1].set_xlabel("time [s]")
-    labels = run.labels
-    fig.suptitle(
-        f"health check '{run.check['name']}' — {labels.get('design')}, "
-        f"{run.scenario.get('instrumentation')}: phases shaded (ramps between them unshaded)",
-        fontsize=10,
-        y=0.995,
-    )
-    fig.tight_layout()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--design", default="paper01")
@@ -103,7 +55,7 @@ def main() -> None:
     )
     for p in run.check["phases"]:
         print(f"phase {p['index']} {p['name']!r}: {p['start']:.3f}–{p['end']:.3f} s")
-    print("wrote", figure(run, args.out))
+    print("wrote", plot_check(run, args.out))
 
 
 if __name__ == "__main__":

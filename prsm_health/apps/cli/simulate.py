@@ -16,7 +16,7 @@ from prsm_health.io.parquet import write_run_parquet
 from prsm_health.physics.kinematics import characteristic_frequencies
 from prsm_health.simulation.scenario import Scenario
 
-from ..plots import plot_run
+from ..plots import plot_check, plot_run
 from .live import play_live
 from .output import print_json, print_table
 
@@ -123,7 +123,9 @@ def simulate(args) -> int:
     elif out is not None:
         write_run_parquet(run, out)
     mesh = characteristic_frequencies(scenario.design, args.speed).gear_mesh
-    if args.plot:
+    if args.plot and run.check:  # a check: its phases over time, not one operating point
+        plot_check(run, args.plot)
+    elif args.plot:
         plot_run(run, args.plot, mesh_frequency=mesh)
     if args.json:
         print_json(
@@ -150,7 +152,7 @@ def simulate(args) -> int:
                 ("channels", ", ".join(run.channels), ""),
                 ("samples", len(run), f"at {run.sample_rate:g} Hz"),
                 # the load as resolved against the design's rating (a share given, or the default)
-                ("axial load", scenario.profile.load, "N, mean"),
+                ("axial load", run.labels["axial_load"], "N, peak" if run.check else "N, mean"),
                 ("peak load", 100.0 * run.labels["load_share"], "% of C_a"),
                 *[
                     (f"check {run.check['name']}", p["name"], f"{p['start']:.3f}–{p['end']:.3f} s")

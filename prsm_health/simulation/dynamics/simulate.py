@@ -320,8 +320,8 @@ def integrate(
                 "beyond the linearised bound) — lower options.max_step"
             )
         done += count
-        if bar is not None:
-            bar.update(count * h)
+        if bar is not None:  # the bar's position from the count: summing steps overshoots
+            bar.update(done * h - bar.n)
     if bar is not None:
         bar.close()
     return raw
