@@ -53,7 +53,7 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
         run = spec.scenario().simulate()
         label = spec.labels(run)
         if run.check:  # a check's phase names and boundaries, one JSON cell per run
-            label["check"] = json.dumps(run.check)
+            label["check_phases"] = json.dumps(run.check)
         run.labels = dict(run.labels, **label)
         if formats in ("mcap", "both"):
             from prsm_health.io.mcap import write_mcap

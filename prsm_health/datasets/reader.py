@@ -112,7 +112,7 @@ class Dataset:
         if CHECK_PHASE in names:  # a health-check run: its phases, as the generator stored them
             check = {
                 "check_phase": table.column(CHECK_PHASE).to_numpy().astype(np.int16),
-                "check": json.loads(labels.get("check") or "{}"),
+                "check": json.loads(labels.get("check_phases") or "{}"),
             }
         return Run(
             table.column("time").to_numpy(),
