@@ -29,8 +29,6 @@ ONE_JOB = {
     "actuator/design.py": "the PRSM design dataclasses, their validation and the presets",
     "diagnostics/estimators.py": "the scikit-learn estimators of a diagnosis model",
     "simulation/dynamics/_kernels.py": "the numba right-hand side and RK4 of the PRSM model",
-    "simulation/dynamics/model.py": "the kernel's arrays of the PRSM model (options, parameters, "
-    "roller and error tables, initial state)",
 }
 
 MODULES = sorted(p for p in PACKAGE.rglob("*.py") if p != PACKAGE / "__init__.py")
