@@ -588,8 +588,11 @@ def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> Non
         out["drive_torque_mean"] = float(np.mean(ch["drive_torque"]))
         out["drive_torque_ripple"] = float(np.std(ch["drive_torque"]))
         if speed is not None and load is not None and "nut_position" in ch:
+            # drive_torque is the motor's, screw_speed the gearbox output's: the input power
+            # is T_m·N·ω_s, so the efficiency is the drive's from the motor shaft (reduction
+            # and screw)
             out["efficiency"] = _window_efficiency(
-                ch["drive_torque"], speed, load, ch["nut_position"], run.time
+                ch["drive_torque"] * _gear_ratio(run), speed, load, ch["nut_position"], run.time
             )
 
     # ---- reversals: of the motion, of the load (load cell), or of the drive torque when no
@@ -707,6 +710,18 @@ def _reverses(x: np.ndarray) -> bool:
     # smoothed signal: a steady run's noise around a small mean must not count).
     margin = 0.1 * float(np.ptp(x))
     return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
+
+
+def _gear_ratio(run: Run) -> float:
+    """The reduction N between the motor (whose torque ``drive_torque`` is) and the screw: the
+    run's ``gear_ratio`` label (a simulated run's drive train), else 1 (a recording that gives
+    none: its torque is taken as the screw's)."""
+    ratio = run.labels.get("gear_ratio", 1.0)
+    try:
+        ratio = float(ratio)
+    except (TypeError, ValueError):
+        return 1.0
+    return ratio if np.isfinite(ratio) and ratio > 0 else 1.0
 
 
 def _window_efficiency(torque, speed, load, position, time) -> float:

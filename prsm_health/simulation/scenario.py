@@ -316,6 +316,8 @@ class Scenario:
             "motion": "check" if check else p.motion,
             "load_profile": "check" if check else p.load_profile,
             "check": check.name if check else "",
+            # the drive torque is the motor's: N between it and the screw (features need it)
+            "gear_ratio": self.drive_train.gear_ratio,
             "duration": p.duration,
             "temperature": p.temperature,
             "seed": self.seed,
