@@ -126,6 +126,7 @@ class BodyParams:
     load: float | None = None
     design: str | None = None
     operating_hours: float | None = None
+    gear_ratio: float | None = None
 
 
 def check_design(design: str | None, bundle) -> None:
@@ -162,6 +163,8 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
         labels["screw_speed"] = float(req.speed)
     if req.load is not None:
         labels["axial_load"] = float(req.load)
+    if req.gear_ratio is not None:
+        labels["gear_ratio"] = float(req.gear_ratio)
     # the channels a file reader derives (screw speed from the angle), derived here too
     return derive_channels(
         Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
@@ -235,7 +238,9 @@ def diagnose_body(
     if fmt == "json":
         req = parse_diagnose_request(body, limits)
         run = run_from_request(req, bundle)
-        params = BodyParams(req.asset_id, req.speed, req.load, req.design, req.operating_hours)
+        params = BodyParams(
+            req.asset_id, req.speed, req.load, req.design, req.operating_hours, req.gear_ratio
+        )
     else:
         params = params or BodyParams()
         check_design(params.design, bundle)
@@ -247,6 +252,8 @@ def diagnose_body(
             labels["screw_speed"] = params.speed
         if params.load is not None:
             labels["axial_load"] = params.load
+        if params.gear_ratio is not None:
+            labels["gear_ratio"] = params.gear_ratio
         run = Run(run.time, run.channels, run.sample_rate, labels, run.scenario)
         limits.check_sample_rate(run.sample_rate, _what(fmt))  # a JSON body's is validated
     max_samples = limits.max_json_samples(run.sample_rate)

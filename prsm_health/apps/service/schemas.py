@@ -75,6 +75,14 @@ class DiagnoseParams(BaseModel):
     )
     speed: Finite | None = Field(None, description="nominal screw speed [rad/s] (stored)")
     load: Finite | None = Field(None, description="nominal axial load [N] (stored)")
+    gear_ratio: Finite | None = Field(
+        None,
+        gt=0,
+        le=1000,
+        description="reduction between the motor and the screw (drive_torque is the motor's "
+        "torque): the efficiency indicator's input power is drive_torque × gear_ratio × "
+        "screw_speed; default: the recording's gear_ratio label, else 1",
+    )
     operating_hours: Finite | None = Field(
         None,
         ge=0,

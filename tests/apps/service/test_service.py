@@ -61,9 +61,11 @@ def recording(bundle, reversing_run) -> Run:
 
 
 def _body(run: Run, **extra) -> dict:
+    # the gear ratio the files carry as a label (the efficiency indicator needs it)
     return {
         "sample_rate": run.sample_rate,
         "channels": {k: v.tolist() for k, v in run.channels.items()},
+        "gear_ratio": run.labels.get("gear_ratio", 1.0),
         **extra,
     }
 

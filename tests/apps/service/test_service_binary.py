@@ -84,10 +84,13 @@ def _get(app, url: str, params=None) -> httpx.Response:
 
 
 def _json_body(run) -> bytes:
+    # the files carry the run's labels, a gear ratio among them (the efficiency indicator
+    # needs it): the JSON body says it as a field
     return json.dumps(
         {
             "sample_rate": run.sample_rate,
             "channels": {k: v.tolist() for k, v in run.channels.items()},
+            "gear_ratio": run.labels["gear_ratio"],
         }
     ).encode()
 
