@@ -382,6 +382,11 @@ class OperatingProfile:
         return float(np.max(np.abs(knots[1]))) + amplitude
 
     @property
+    def top_speed(self) -> float:
+        """Largest |screw speed| of the run [rad/s] (a health check's fastest phase)."""
+        return float(np.max(np.abs(self.motion_knots()[1])))
+
+    @property
     def rms_load(self) -> float:
         """RMS axial load over the run [N] (the knots sampled finely, plus a sinusoid's
         amplitude/√2): what heats a motor, against its continuous torque."""

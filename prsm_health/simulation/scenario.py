@@ -177,9 +177,8 @@ class Scenario:
         object.__setattr__(self, "profile", profile)
         # The duty against the drive train's motor (torque, speed): a duty beyond the motor's
         # continuous torque is a warning, one it cannot run at all an error (the user's).
-        top_speed = float(np.max(np.abs(profile.motion_knots()[1])))
         for message in duty_check(
-            self.drive_train, self.design, peak, top_speed, continuous_load=profile.rms_load
+            self.drive_train, self.design, peak, profile.top_speed, continuous_load=profile.rms_load
         ):
             warnings.warn(message, stacklevel=3)
 
@@ -288,7 +287,7 @@ class Scenario:
         h, p = self.health, self.profile
         # a health check has no one operating point: its top speed and its peak load
         check = getattr(p, "check", None)
-        speed = float(np.max(np.abs(p.motion_knots()[1]))) if check else p.speed
+        speed = p.top_speed if check else p.speed
         load = p.peak_load if check else p.load
         return {
             "design": self.design.name,
