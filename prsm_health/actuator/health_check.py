@@ -230,12 +230,26 @@ class HealthCheck:
 
     def boundaries(self) -> list[dict]:
         """Every phase's ``index``, ``name``, ``start`` and ``end`` [s] (the settled part; the
-        ramp before ``start`` belongs to no phase)."""
+        ramp before ``start`` belongs to no phase) and its commanded condition: ``motion``,
+        ``speed`` [rad/s] and, once the check is :meth:`resolved`, ``load`` [N] (resisting the
+        motion; None before). The controller commands them, so a hardware recording has them
+        too; the diagnosis reads a phase by its condition, not its name."""
         out, t = [], 0.0
         for k, p in enumerate(self.phases):
             start = t + p.ramp_time
             end = start + p.duration
-            out.append({"index": k, "name": p.name, "start": start, "end": end})
+            load = float(p.load) if isinstance(p.load, (int, float)) else None
+            out.append(
+                {
+                    "index": k,
+                    "name": p.name,
+                    "start": start,
+                    "end": end,
+                    "motion": p.motion,
+                    "speed": float(p.speed),
+                    "load": load,
+                }
+            )
             t = end
         return out
 

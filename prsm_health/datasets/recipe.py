@@ -19,6 +19,7 @@ import copy
 import hashlib
 import itertools
 import json
+import zlib
 from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
 from pathlib import Path
@@ -93,6 +94,15 @@ LIFE_SETS = (
     "lubricant_degradation",
     "lubricant_starvation",
 )
+#: Health fields a unit is built with: ``[units.build]`` draws them once per unit.
+UNIT_BUILD = (
+    "clearance",
+    "clearance_screw",
+    "clearance_nut",
+    "clearance_gear",
+    "wear_spread",
+    "preload",
+)
 #: Fleets of life recipes computed in this process, by recipe fingerprint.
 _FLEETS: dict[str, list] = {}
 
@@ -117,6 +127,7 @@ class Recipe:
     batch_size: int = DEFAULT_BATCH
     dtype: str = "float32"
     life: dict = field(default_factory=dict)
+    units: dict = field(default_factory=dict)
     source: dict = field(default_factory=dict, compare=False)
 
     @classmethod
@@ -199,6 +210,7 @@ class Recipe:
         check(
             0 <= self.test_fraction < 1, "test_fraction", self.test_fraction, "must lie in [0, 1)"
         )
+        self._validate_units(check)
         check(
             isinstance(self.batch_size, int) and self.batch_size >= 1,
             "batch_size",
@@ -393,6 +405,55 @@ class Recipe:
             _FLEETS[key] = fleet_lives(self.prsm_design, self.life_spec, self.seed)
         return _FLEETS[key]
 
+    def _validate_units(self, check) -> None:
+        units = self.units
+        check(isinstance(units, dict), "units", units, "must be a table {count = …, seed = …}")
+        if not units:
+            return
+        unknown = sorted(set(units) - {"count", "seed", "build"})
+        check(not unknown, "units", units, f"unknown key(s) {unknown}; allowed: count, seed, build")
+        build = units.get("build", {})
+        check(isinstance(build, dict), "units.build", build, "must be a table of [min, max]")
+        for key, value in build.items():
+            check(
+                key in UNIT_BUILD or key.split(".")[0] in ("options", "drive_train"),
+                f"units.build.{key}",
+                value,
+                f"must be one of {', '.join(UNIT_BUILD)} or an options./drive_train. field "
+                "(what a unit is built and installed with)",
+            )
+            check(_is_range(value), f"units.build.{key}", value, "must be [min, max]")
+        for key, minimum in (("count", 1), ("seed", 0)):
+            value = units.get(key)
+            check(
+                isinstance(value, int) and not isinstance(value, bool) and value >= minimum,
+                f"units.{key}",
+                value,
+                f"must be an integer ≥ {minimum}",
+            )
+        check(
+            not self.life,
+            "units",
+            units,
+            "a life recipe's fleet has its own units: leave [units] out",
+        )
+
+    def unit_build(self, unit: int) -> dict:
+        """The ``[units.build]`` values of unit ``unit``: uniform in each range, each key drawn
+        from the units' seed, the unit and the key alone — the same in every recipe with the
+        same ``[units]`` seed that lists the key with the same range."""
+        out = {}
+        for key, (lo, hi) in self.units.get("build", {}).items():
+            u = np.random.default_rng([self.units["seed"], unit, zlib.crc32(key.encode())]).random()
+            out[key] = float(lo + u * (hi - lo))
+        return out
+
+    def unit_build_seed(self, unit: int) -> int:
+        """The seed of unit ``unit`` as built (its manufacturing scatter) in a recipe with
+        ``[units]``: the same for every recipe with the same ``units.seed``, so two recipes
+        (say a baseline and a test) record the same units."""
+        return int(np.random.SeedSequence([self.units["seed"], unit]).generate_state(1)[0])
+
     def _validate_fault_cases(self, check) -> None:
         cases = self.fault_cases
         check(isinstance(cases, dict), "fault_cases", cases, "must be a table of named cases")
@@ -436,6 +497,10 @@ class Recipe:
         specs = []
         n_total = len(points) * repeats
         test = _test_set(n_total, self.test_fraction, self.seed)
+        if self.units:  # whole units held out
+            count = self.units["count"]
+            test_units = _test_set(count, self.test_fraction, self.units["seed"])
+            test = {i for i in range(n_total) if i % count in test_units}
         run_id = 0
         sweep = self.resolved_sweep
         drawn = {k: v["uniform"] for k, v in sweep.items() if isinstance(v, dict)}
@@ -448,6 +513,8 @@ class Recipe:
                     unit = np.random.default_rng([self.seed, run_id, 0x44524157]).random(len(drawn))
                     for u, (k, (lo, hi)) in zip(unit, sorted(drawn.items())):
                         run_point[k] = float(lo + u * (hi - lo))
+                if self.units:  # what the unit is built with, the same in each of its runs
+                    run_point.update(self.unit_build(run_id % self.units["count"]))
                 specs.append(
                     RunSpec(self, run_id, run_point, seed, "test" if run_id in test else "train")
                 )
@@ -609,6 +676,12 @@ class RunSpec:
         for key in ("load", "load_amplitude", "temperature"):
             if key in p:
                 profile[key] = p[key]
+        if r.units:
+            # recordings of a few units: run i records unit i mod count as built (its
+            # manufacturing scatter; its [units.build] values are in the run's point); each
+            # run's sensors draw their own noise
+            build = r.unit_build_seed(self.run_id % r.units["count"])
+            return self._build(health, profile, seed=build, sensor_seed=self.seed)
         return self._build(health, profile, seed=self.seed)
 
     def _build(self, health, profile: dict, *, seed: int, sensor_seed: int | None = None):
@@ -690,6 +763,9 @@ class RunSpec:
         unit = self.unit()
         if unit is not None:
             out.update(unit.labels(self.point["age_hours"]))
+        if self.recipe.units:
+            out["unit_id"] = self.run_id % self.recipe.units["count"]
+            out["units_seed"] = self.recipe.units["seed"]
         if run is not None:
             out.update({k: v for k, v in run.labels.items() if "_realised_" in k})
             out["n_samples"] = len(run)

@@ -100,6 +100,18 @@ def read_mcap(path: str | os.PathLike) -> Run:
         return run
 
 
+def _condition(phase: dict) -> dict:
+    """A phase's commanded condition (``motion``, ``speed`` [rad/s], ``load`` [N]) where the
+    recording has it (files written before it was recorded have none)."""
+    out = {}
+    if "motion" in phase:
+        out["motion"] = str(phase["motion"])
+    for key in ("speed", "load"):
+        if phase.get(key) is not None:
+            out[key] = float(phase[key])
+    return out
+
+
 def _check_record(record: dict | None) -> dict:
     """``{"name", "phases"}`` of the ``health_check`` metadata record; {} when absent or
     unreadable (a recording without a check)."""
@@ -113,6 +125,7 @@ def _check_record(record: dict | None) -> dict:
                 "name": str(p["name"]),
                 "start": float(p["start"]),
                 "end": float(p["end"]),
+                **_condition(p),
             }
             for p in phases
         ]
