@@ -52,7 +52,10 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError
 
-from .kernels import interp_rows
+# order tracking and the TSA live in angle_domain (one implementation); re-exported here,
+# where they were first public
+from .angle_domain import angle_resample as angle_resample
+from .angle_domain import time_synchronous_average as time_synchronous_average
 from .spectra import hilbert_envelope
 
 #: Fewest whole periods a TSA averages before its indicators are given (NaN below): with one
@@ -63,67 +66,6 @@ MIN_PERIODS = 2
 SHAFT_ORDERS = 2
 #: Mesh harmonics counted as regular and summed by FM0.
 MESH_HARMONICS = 3
-
-
-def angle_resample(
-    x: np.ndarray, angle: np.ndarray, period: float, samples_per_period: int
-) -> tuple[np.ndarray, int]:
-    """Resample ``x`` to a uniform grid of ``angle`` covering whole periods.
-
-    Parameters
-    ----------
-    x : ndarray (..., n)
-        Signal sampled in time; several signals of the same instants on leading axes.
-    angle : ndarray (n,) [rad]
-        The measured shaft angle at the same instants; monotonic in either direction (a
-        negative direction is mirrored so the grid increases).
-    period : float [rad of ``angle``]
-        The averaging period, e.g. 2π/|carrier ratio| for a carrier revolution.
-    samples_per_period : int
-
-    Returns
-    -------
-    (resampled signal of ``n_periods·samples_per_period`` samples (..., n_periods·samples_per_period), n_periods)
-        Linear interpolation: at the 20 kHz diagnostics rate a mesh cycle spans ≥ 30 samples, so
-        its error (McFadden 1987: attenuation of high orders) stays below 1 % of the mesh line.
-    """
-    x, angle = np.asarray(x, float), np.asarray(angle, float)
-    if x.shape[-1:] != angle.shape or angle.ndim != 1:
-        raise PRSMHealthError(
-            f"x and angle must be 1-D of one length, got {x.shape}, {angle.shape}"
-        )
-    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(angle))):
-        raise PRSMHealthError("x and angle must be finite")
-    if not (math.isfinite(period) and period > 0):
-        raise PRSMHealthError(f"period = {period!r} must be a positive angle [rad]")
-    if not (isinstance(samples_per_period, (int, np.integer)) and samples_per_period >= 8):
-        raise PRSMHealthError(f"samples_per_period = {samples_per_period!r} must be an integer ≥ 8")
-    step = np.diff(angle)
-    direction = np.sign(angle[-1] - angle[0])
-    if direction == 0 or np.any(step * direction <= 0):
-        raise PRSMHealthError("angle must be strictly monotonic (no stop or reversal in a window)")
-    angle = angle * direction
-    n_periods = int((angle[-1] - angle[0]) // period)
-    if n_periods < 1:
-        return np.empty(x.shape[:-1] + (0,)), 0
-    grid = angle[0] + np.arange(n_periods * samples_per_period) * (period / samples_per_period)
-    rows = x.reshape(-1, x.shape[-1])
-    out = np.empty((len(rows), len(grid)))
-    interp_rows(grid, angle, rows, out)  # np.interp of every row, bitwise, one walk for all
-    return out.reshape(x.shape[:-1] + (len(grid),)), n_periods
-
-
-def time_synchronous_average(
-    x: np.ndarray, angle: np.ndarray, period: float, samples_per_period: int = 1024
-) -> tuple[np.ndarray, np.ndarray]:
-    """TSA of ``x`` (..., n) over whole periods of ``angle``: (average over one period
-    (..., samples_per_period), the periods (..., n_periods, samples_per_period)).
-
-    The second array holds every period's samples (rows), the ensemble NA4 and NB4 read.
-    """
-    resampled, n = angle_resample(x, angle, period, samples_per_period)
-    periods = resampled.reshape(resampled.shape[:-1] + (n, samples_per_period))
-    return (periods.mean(axis=-2) if n else resampled), periods
 
 
 def _orders(tsa: np.ndarray) -> np.ndarray:

@@ -1,0 +1,596 @@
+"""Indicators of a health-check recording, each read in the phase whose commanded condition
+brings it out (docs/angle-domain.md).
+
+A health check (:mod:`prsm_health.actuator.health_check`) drives the actuator through a few
+conditions; each fault shows best under one of them. The phases are found by their
+**condition** — motion, speed, load, as the check's record gives them (the controller
+commands them, so a hardware recording has them too), else as measured — never by their name,
+so a user-defined check is read the same way. Four roles:
+
+* ``no_load`` — a constant-speed phase without load (|load| ≤ :data:`NO_LOAD_SHARE` of C_a):
+  the preload alone holds the nut on its threads, so the nut's axial resonance on them — the
+  spectral centroid of the nut axial acceleration, 200–3000 Hz — moves as the preload goes;
+  its RMS with it.
+* ``torque_pair`` — two constant phases under one load at different speeds: the ratio of the
+  mean |drive torque| low/high speed grows as the lubricant degrades (the film thins at low
+  entrainment speed), and needs neither a load cell nor the motor's torque constant. The
+  check's mean housing temperature is given beside it: temperature thins the oil too, so a
+  classifier can tell the two apart.
+* ``reversal`` — a reversing phase under load: the lost motion (LVDT against the resolver,
+  :func:`~prsm_health.signals.features.extract_features`) and the other reversal indicators
+  of that phase.
+* ``high_load`` — the constant phase with the largest |load|: the spalls, read in the angle
+  domain (:mod:`prsm_health.signals.angle_domain`) on the nut axial acceleration band-passed
+  to :data:`IMPACT_BAND`, the reduction's orders removed: synchronous-average SNRs at the nut
+  pass, the roller spin, the carrier and the screw revolution; kurtosis, crest factor and RMS
+  of that residual; the stroke-position profile (a screw spall).
+
+:func:`check_indicators` returns every indicator of :data:`CHECK_INDICATORS`, NaN where the
+check lacks the phase or the recording the channel, with the reason.
+
+Measured on simulated checks (paper01, flight-ema, built-in ``health-check``, seeds 1–3;
+:func:`measure_classes` prints the table, docs/angle-domain.md keeps it) — a summary:
+the nut-pass SNR separates a nut spall, the roller-spin SNR a roller spall, the kurtosis (with
+those two SNRs low) and the position contrast a screw spall, the no-load centroid a preloaded
+nut from one with clearance and the lost motion an intact preload from a 60 % lost one, the
+torque ratio a degraded lubricant. The position SNR does not separate the screw spall (its
+sporadic impacts scatter the replicas of its bins as much as they raise the profile).
+
+References
+----------
+See :mod:`prsm_health.signals.angle_domain` (order tracking, synchronous averages) and
+:mod:`prsm_health.signals.features` (lost motion). Spectral centroid: the power-weighted mean
+frequency of a Welch PSD (Welch 1967). Kurtosis of the residual after the discrete components
+are removed: Randall & Antoni 2011 §3.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+from scipy import signal
+
+from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.design_files import load_design
+from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.run import Run
+from prsm_health.physics.kinematics import speed_ratios
+from prsm_health.physics.load_rating import load_ratings
+
+from .angle_domain import (
+    position_profile,
+    prsm_periods,
+    subtract_synchronous,
+    synchronous_average,
+)
+from .features import extract_features, run_design
+from .spectra import welch_psd
+
+#: The roles a check's phases are found for, in order.
+ROLES = ("no_load", "torque_pair", "reversal", "high_load")
+#: A load at most this share of C_a is "no load" (and a larger one "under load"): 2 % is
+#: ≈ 200 N on paper 01 — a controller's residual force, against the check's 10–25 % C_a.
+NO_LOAD_SHARE = 0.02
+#: The spalls' phase needs at least this share of C_a: the synchronous averages separated
+#: 0.5 mm nut and roller spalls from healthy units at 25 % and 40 % of C_a, not at 20 % or below
+#: (tools/studies/duty_signatures.py, docs/faults.md "At realistic duty").
+HIGH_LOAD_SHARE = 0.2
+#: Two phase loads are "one load" within this share of the larger.
+SAME_LOAD = 0.05
+#: Two phase speeds are "different" when the faster is at least this many times the slower.
+SPEED_RATIO = 1.5
+#: Below this measured speed [rad/s] (90th percentile of |speed|) a phase is at rest.
+REST_SPEED = 1.0
+#: Band of the no-load spectral centroid [Hz]: around the nut's axial resonance on its threads
+#: (400–1200 Hz on paper 01 as the preload goes), above the drive's low orders.
+CENTROID_BAND = (200.0, 3000.0)
+#: Welch segment of the no-load spectrum: 512 samples (39 Hz at 20 kHz), 75 % overlap —
+#: 28 segments in the built-in check's 0.2 s.
+CENTROID_SEGMENT = 512
+#: Band the spalls are read in [Hz]: a spall's impacts are broadband, while the healthy nut
+#: vibration (the axial resonance near 200–300 Hz, the gearhead's mesh at 764 Hz and its
+#: second harmonic at 100 rad/s) lies below 2 kHz. Measured (docs/angle-domain.md): in this
+#: band a nut spall's nut-pass SNR is 0.41–0.47 against ≤ 0.04 for every other class;
+#: broadband it drowns in the healthy periodic content (−0.03…0.63 across seeds, faulty or
+#: not). The upper edge stays below 0.4 of the sampling rate.
+IMPACT_BAND = (2000.0, 8000.0)
+#: The angle-domain periods of the high-load indicators (:func:`prsm_periods`).
+SNR_PERIODS = ("nut_pass", "roller_spin", "carrier", "screw")
+#: Position bins of the stroke profile, as a share of the engaged length (threads × pitch): a
+#: screw spall is met while the nut is within ± half of it, so it spans ≈ 4 bins.
+POSITION_BIN_SHARE = 0.25
+#: The reversal indicators of :func:`~prsm_health.signals.features.extract_features` kept
+#: (module docstring of :func:`check_indicators`).
+REVERSAL_FEATURES = ("lost_motion", "torque_rattle_rate", "drive_torque_ripple", "efficiency")
+
+
+def _indicator_table() -> dict[str, str]:
+    units = {"check_noload_centroid": "Hz", "check_noload_rms": "m/s²"}
+    units.update(
+        {
+            "check_torque_low": "N·m",
+            "check_torque_high": "N·m",
+            "check_torque_ratio": "-",
+            "check_temperature": "K",
+        }
+    )
+    reversal_units = {
+        "lost_motion": "m",
+        "torque_rattle_rate": "1/s",
+        "drive_torque_ripple": "N·m",
+        "efficiency": "-",
+    }
+    units.update({f"check_reversal_{k}": reversal_units[k] for k in REVERSAL_FEATURES})
+    units.update({f"check_highload_snr_{k}": "-" for k in SNR_PERIODS})
+    units.update(
+        {
+            "check_highload_kurtosis": "-",
+            "check_highload_crest": "-",
+            "check_highload_rms": "m/s²",
+            "check_highload_position_snr": "-",
+            "check_highload_position_contrast": "-",
+        }
+    )
+    return units
+
+
+#: Indicator name → unit, in the order :func:`check_indicators` gives them.
+CHECK_INDICATORS: dict[str, str] = _indicator_table()
+#: The indicators of each role (``check_temperature``: the whole check's, given with the
+#: torque pair it disambiguates).
+ROLE_INDICATORS: dict[str, tuple[str, ...]] = {
+    "no_load": tuple(k for k in CHECK_INDICATORS if k.startswith("check_noload_")),
+    "torque_pair": tuple(
+        k for k in CHECK_INDICATORS if k.startswith("check_torque_") or k == "check_temperature"
+    ),
+    "reversal": tuple(k for k in CHECK_INDICATORS if k.startswith("check_reversal_")),
+    "high_load": tuple(k for k in CHECK_INDICATORS if k.startswith("check_highload_")),
+}
+#: The measured channels each role reads.
+ROLE_CHANNELS: dict[str, tuple[str, ...]] = {
+    "no_load": ("nut_axial_accel",),
+    "torque_pair": ("drive_torque",),
+    "reversal": ("nut_position", "screw_angle", "drive_torque"),
+    "high_load": ("nut_axial_accel", "screw_angle"),
+}
+
+
+@dataclass(frozen=True)
+class CheckReading:
+    """What :func:`check_indicators` read from one check recording.
+
+    Attributes
+    ----------
+    indicators : dict of name → float
+        Every indicator of :data:`CHECK_INDICATORS`, in its order and unit; NaN where not read.
+    roles : dict of role → phase name
+        The phase each role was read in (roles of :data:`ROLES` found; for the torque pair
+        ``"<low-speed phase> / <high-speed phase>"``).
+    missing : dict of role → reason
+        Why a role's indicators are NaN, or some of them: the condition the check lacks
+        ("no constant phase without load …"), or the channels the recording lacks (then the
+        role is in ``roles`` too).
+    """
+
+    indicators: dict[str, float]
+    roles: dict[str, str] = field(default_factory=dict)
+    missing: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class PhaseCondition:
+    """A phase's condition: as commanded (the check's record) or, where the record lacks it,
+    as measured.
+
+    Attributes
+    ----------
+    name : str
+    motion : {"constant", "reversing", "rest"} or None (not known)
+    speed : float [rad/s] or NaN (screw; signed; the amplitude of a reversing phase)
+    load : float [N] or None (resisting the motion; the amplitude of a reversing phase)
+    samples : int
+    run : Run
+        The phase's settled samples.
+    """
+
+    name: str
+    motion: str | None
+    speed: float
+    load: float | None
+    samples: int
+    run: Run
+
+
+# ---------------------------------------------------------------------------- conditions
+def _measured_speed(part: Run) -> np.ndarray | None:
+    if "screw_speed" in part.channels:
+        return np.asarray(part.channels["screw_speed"], float)
+    if "screw_angle" in part.channels and len(part) > 1:
+        return np.gradient(np.asarray(part.channels["screw_angle"], float)) * part.sample_rate
+    return None
+
+
+def _measured_motion(speed: np.ndarray | None) -> str | None:
+    if speed is None or len(speed) == 0:
+        return None
+    if float(np.percentile(np.abs(speed), 90)) < REST_SPEED:
+        return "rest"
+    # both signs reached by a tenth of the range or more: a reversal, not noise about a mean
+    margin = 0.1 * float(np.ptp(speed))
+    if float(np.percentile(speed, 2)) < -margin and float(np.percentile(speed, 98)) > margin:
+        return "reversing"
+    return "constant"
+
+
+def _measured_load(part: Run, motion: str | None, speed: np.ndarray | None) -> float | None:
+    """The load resisting the motion from a load cell (positive resists a positive speed, the
+    kernel's convention): the mean for a constant phase, the 95th-percentile magnitude with
+    the mean's sign for a reversing one; None without a load cell."""
+    load = part.channels.get("axial_load")
+    if load is None or len(load) == 0:
+        return None
+    load = np.asarray(load, float)
+    if motion == "rest" or speed is None:
+        return float(np.mean(load))
+    resisting = load * np.sign(speed)
+    if motion == "reversing":
+        return math.copysign(float(np.percentile(np.abs(load), 95)), float(np.mean(resisting)))
+    return float(np.mean(resisting))
+
+
+def phase_conditions(run: Run) -> list[PhaseCondition]:
+    """Every phase of a check recording with its condition, in check order (empty for a run
+    that is no check): motion, speed and load as the check's record gives them, each that it
+    lacks (older files, a load left as a share of a rating) as measured — the motion from the
+    sign changes of the measured speed, the speed as its mean (its largest magnitude for a
+    reversal), the load from a load cell (None without one)."""
+    phases = run.phases()
+    records = {str(p.get("name")): p for p in run.check.get("phases", [])}
+    out = []
+    for name, part in phases.items():
+        record = records.get(name, {})
+        speed_signal = _measured_speed(part)
+        motion = record.get("motion") or _measured_motion(speed_signal)
+        speed = record.get("speed")
+        if not _is_number(speed):
+            if speed_signal is None or len(speed_signal) == 0:
+                speed = math.nan
+            elif motion == "reversing":
+                speed = float(np.percentile(np.abs(speed_signal), 98))
+            else:
+                speed = float(np.mean(speed_signal))
+        load = record.get("load")
+        if not _is_number(load):
+            load = _measured_load(part, motion, speed_signal)
+        out.append(PhaseCondition(name, motion, float(speed), load, len(part), part))
+    return out
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+# ---------------------------------------------------------------------------- roles
+def find_roles(
+    conditions: list[PhaseCondition], rating: float
+) -> tuple[dict[str, object], dict[str, str]]:
+    """({role: the phase, or (low, high) phases for the torque pair}, {role: why not found})
+    for phases with the conditions given and a design of dynamic rating ``rating`` [N]."""
+    limit = NO_LOAD_SHARE * rating
+    constant = [c for c in conditions if c.motion == "constant"]
+    known = [c for c in constant if c.load is not None]
+    loaded = [c for c in known if abs(c.load) > limit]
+    found: dict[str, object] = {}
+    missing: dict[str, str] = {}
+
+    free = [c for c in known if abs(c.load) <= limit]
+    if free:
+        found["no_load"] = max(free, key=lambda c: c.samples)
+    elif not constant:
+        missing["no_load"] = "no constant-speed phase"
+    elif not known:
+        missing["no_load"] = "no constant-speed phase with a known load (no load in the record)"
+    else:
+        missing["no_load"] = (
+            f"no constant-speed phase without load (|load| ≤ {NO_LOAD_SHARE:.0%} C_a)"
+        )
+
+    pairs = []
+    for i, a in enumerate(loaded):
+        for b in loaded[i + 1 :]:
+            same = abs(a.load - b.load) <= SAME_LOAD * max(abs(a.load), abs(b.load))
+            slow, fast = sorted((a, b), key=lambda c: abs(c.speed))
+            if same and abs(fast.speed) >= SPEED_RATIO * abs(slow.speed) > 0:
+                pairs.append((abs(fast.speed) / abs(slow.speed), abs(a.load), slow, fast))
+    if pairs:
+        _, _, slow, fast = max(pairs, key=lambda p: (p[0], p[1]))
+        found["torque_pair"] = (slow, fast)
+    else:
+        missing["torque_pair"] = "no two constant-speed phases under one load at different speeds"
+
+    reversing = [c for c in conditions if c.motion == "reversing"]
+    under_load = [c for c in reversing if c.load is None or abs(c.load) > limit]
+    if under_load:
+        # a known load first (an unknown one may be none), the largest
+        found["reversal"] = max(
+            under_load, key=lambda c: (c.load is not None, abs(c.load or 0.0), c.samples)
+        )
+    elif reversing:
+        missing["reversal"] = "no reversing phase under load (the reversing phases have none)"
+    else:
+        missing["reversal"] = "no reversing phase under load"
+
+    heavy = [c for c in loaded if abs(c.load) >= HIGH_LOAD_SHARE * rating]
+    if heavy:
+        found["high_load"] = max(heavy, key=lambda c: (abs(c.load), c.samples))
+    elif loaded:
+        missing["high_load"] = (
+            f"no constant-speed phase at ≥ {HIGH_LOAD_SHARE:.0%} of C_a (the highest has "
+            f"{max(abs(c.load) for c in loaded) / rating:.0%})"
+        )
+    elif constant:
+        missing["high_load"] = "no constant-speed phase under a known load"
+    else:
+        missing["high_load"] = "no constant-speed phase"
+    return found, missing
+
+
+# ---------------------------------------------------------------------------- indicators
+def spectral_centroid(x: np.ndarray, sample_rate: float, band=CENTROID_BAND) -> float:
+    """Power-weighted mean frequency of the Welch PSD of ``x`` inside ``band`` [Hz]
+    (:data:`CENTROID_SEGMENT`-sample Hann segments, 75 % overlap); NaN for a record shorter
+    than a segment or without power in the band."""
+    x = np.asarray(x, float)
+    if len(x) < CENTROID_SEGMENT:
+        return math.nan
+    f, p = welch_psd(x - np.mean(x), sample_rate, CENTROID_SEGMENT, 3 * CENTROID_SEGMENT // 4)
+    inside = (f >= band[0]) & (f <= band[1])
+    total = float(np.sum(p[inside]))
+    return float(np.sum(f[inside] * p[inside]) / total) if total > 0 else math.nan
+
+
+@lru_cache(maxsize=32)
+def dynamic_rating(design: PRSMDesign) -> float:
+    """The design's dynamic load rating C_a [N], computed once per design (the thread-load
+    solution behind it takes ~60 ms, the rest of a check's reading ~30 ms)."""
+    return float(load_ratings(design).dynamic)
+
+
+@lru_cache(maxsize=16)
+def _band_sos(low: float, high: float, sample_rate: float) -> np.ndarray:
+    # designed once per band and rate: the design costs more than filtering a phase
+    return signal.butter(4, (low, high), btype="bandpass", fs=sample_rate, output="sos")
+
+
+def impact_band(sample_rate: float) -> tuple[float, float] | None:
+    """:data:`IMPACT_BAND` at a sampling rate, its top at most 0.4 of the rate; None when
+    less than an octave is left."""
+    low, high = IMPACT_BAND[0], min(IMPACT_BAND[1], 0.4 * sample_rate)
+    return (low, high) if high >= 2 * low else None
+
+
+def _no_load(phase: Run, out: dict) -> None:
+    x = phase.channels["nut_axial_accel"]
+    out["check_noload_centroid"] = spectral_centroid(x, phase.sample_rate)
+    out["check_noload_rms"] = float(np.std(x))
+
+
+def _torque_pair(slow: Run, fast: Run, out: dict) -> None:
+    low = float(np.mean(np.abs(slow.channels["drive_torque"])))
+    high = float(np.mean(np.abs(fast.channels["drive_torque"])))
+    out["check_torque_low"], out["check_torque_high"] = low, high
+    out["check_torque_ratio"] = low / high if high > 0 else math.nan
+
+
+def _reversal(phase: Run, design: PRSMDesign, out: dict) -> None:
+    # only the channels the reversal indicators read: extract_features then skips the
+    # spectra, envelopes and averages of the vibration (measured: 5 ms instead of 80 ms)
+    wanted = ["screw_angle", "screw_speed", "drive_torque", "nut_position", "axial_load"]
+    if "nut_position" not in phase.channels:
+        wanted.append("nut_axial_accel")  # extract_features needs a position or a vibration
+    channels = {k: phase.channels[k] for k in wanted if k in phase.channels}
+    part = Run(phase.time, channels, phase.sample_rate, phase.labels)
+    try:
+        values = extract_features(part, design)
+    except PRSMHealthError:  # too short for a window, or no position and no vibration
+        return
+    for name in REVERSAL_FEATURES:
+        out[f"check_reversal_{name}"] = float(values[name])
+
+
+def _high_load(phase: Run, design: PRSMDesign, gear_ratio: float, out: dict) -> str | None:
+    """The spall indicators of the high-load phase; a reason when they cannot be read."""
+    band = impact_band(phase.sample_rate)
+    if band is None:
+        return f"sample rate {phase.sample_rate:g} Hz too low for the {IMPACT_BAND} Hz band"
+    x = np.asarray(phase.channels["nut_axial_accel"], float)
+    angle = np.asarray(phase.channels["screw_angle"], float)
+    periods = prsm_periods(design, gear_ratio)
+    # band first, then the reduction's orders: resampling the broadband signal on the measured
+    # angle turns the resolver's angle noise into phase noise of the strong mesh line, which
+    # leaks into the band (measured: carrier SNR 0.27 against 0.08 band-first)
+    y = signal.sosfiltfilt(_band_sos(*band, phase.sample_rate), x - np.mean(x))
+    try:
+        if gear_ratio > 1:
+            y, _ = subtract_synchronous(y, angle, periods["motor"])
+        for name in SNR_PERIODS:
+            out[f"check_highload_snr_{name}"] = synchronous_average(y, angle, periods[name]).snr
+    except PRSMHealthError as exc:  # the angle stopped or turned back, too short
+        return f"no angle domain in the phase: {exc}"
+    rms = float(np.sqrt(np.mean(y * y)))
+    out["check_highload_rms"] = rms
+    if rms > 0:
+        out["check_highload_kurtosis"] = float(np.mean(y**4) / rms**4)
+        out["check_highload_crest"] = float(np.max(np.abs(y)) / rms)
+    if "nut_position" in phase.channels:
+        position = np.asarray(phase.channels["nut_position"], float)
+    else:  # the nut's travel from the screw angle (a relative position)
+        position = speed_ratios(design).nut * angle
+    width = POSITION_BIN_SHARE * design.engaged_threads * design.pitch
+    profile = position_profile(y, position, width)
+    out["check_highload_position_snr"] = profile.snr
+    out["check_highload_position_contrast"] = profile.contrast
+    return None
+
+
+def check_indicators(
+    run: Run,
+    design: PRSMDesign | str | dict | None = None,
+    gear_ratio: float | None = None,
+) -> CheckReading:
+    """The indicators of a health-check recording, each read in the phase of its role.
+
+    Parameters
+    ----------
+    run : Run
+        A check recording: ``check_phase`` and ``check`` (phases with ``motion``, ``speed``
+        [rad/s], ``load`` [N] when the record has them). Missing channels make the indicators
+        that need them NaN.
+    design : PRSMDesign, preset name, design file, dict or None
+        None: the run's own (:func:`~prsm_health.signals.features.run_design`). Gives C_a
+        (the no-load threshold), the PRSM's periods, the position bins.
+    gear_ratio : float or None
+        Motor turns per screw turn; None: the run's ``gear_ratio`` label, else 1 (no
+        reduction: nothing is removed before the averages).
+
+    Returns
+    -------
+    CheckReading
+        Roles (module docstring) found by condition: ``no_load`` the longest constant phase
+        with |load| ≤ 2 % C_a; ``torque_pair`` the two constant phases under one load
+        (within 5 %) with the largest speed ratio (≥ 1.5); ``reversal`` the reversing phase
+        under the largest load (a load the record does not give counts as a load);
+        ``high_load`` the constant phase with the largest |load|.
+
+        The reversal indicators kept from :func:`~prsm_health.signals.features.extract_features`
+        are those about the play and the friction across it: ``lost_motion`` (the play
+        crossed, LVDT against resolver: clearance, preload), ``torque_rattle_rate`` (bounces
+        across the play: the more clearance the more), ``drive_torque_ripple`` (the torque
+        swing under the commanded load swing: friction hysteresis) and ``efficiency``
+        (friction under a reversing load; NaN without a load cell). The vibration indicators
+        of that phase are left out: the slow reversal excites little and the other roles read
+        the vibration.
+
+    Raises
+    ------
+    PRSMHealthError
+        A run labelled with a design that cannot be resolved, no ``design`` given.
+    """
+    out = dict.fromkeys(CHECK_INDICATORS, math.nan)
+    if run.check_phase is None or not run.check.get("phases"):
+        reason = "the run is no health check (no check phases)"
+        return CheckReading(out, {}, dict.fromkeys(ROLES, reason))
+    design = run_design(run) if design is None else load_design(design)
+    if design is None:
+        reason = "no PRSM design (an imported rig): no load rating, no kinematics"
+        return CheckReading(out, {}, dict.fromkeys(ROLES, reason))
+    if gear_ratio is None:
+        gear_ratio = run.labels.get("gear_ratio", 1.0)
+    gear_ratio = float(gear_ratio) if _is_number(gear_ratio) and gear_ratio > 0 else 1.0
+    found, missing = find_roles(phase_conditions(run), dynamic_rating(design))
+    roles: dict[str, str] = {}
+    if "housing_temperature" in run.channels:
+        out["check_temperature"] = float(np.mean(run.channels["housing_temperature"]))
+    for role in ROLES:
+        if role not in found:
+            continue
+        phase = found[role]
+        if role == "torque_pair":
+            roles[role] = f"{phase[0].name} / {phase[1].name}"
+        else:
+            roles[role] = phase.name
+        lacking = [c for c in ROLE_CHANNELS[role] if c not in run.channels]
+        if lacking:
+            missing[role] = "missing channel(s) " + ", ".join(lacking)
+            # the reversal's torque indicators need the torque only, its lost motion the rest
+            if role != "reversal" or "drive_torque" not in run.channels:
+                continue
+        if role == "no_load":
+            _no_load(phase.run, out)
+        elif role == "torque_pair":
+            _torque_pair(phase[0].run, phase[1].run, out)
+        elif role == "reversal":
+            _reversal(phase.run, design, out)
+        else:
+            reason = _high_load(phase.run, design, gear_ratio, out)
+            if reason:
+                missing[role] = reason
+    return CheckReading(out, roles, missing)
+
+
+# ---------------------------------------------------------------------------- measurement
+def _preloaded(lost: float) -> dict:
+    faults = ({"kind": "preload_loss", "fraction": lost},) if lost else ()
+    return {
+        "clearance_screw": 0.0,
+        "clearance_nut": 0.0,
+        "clearance_gear": 10e-6,
+        "preload": 5e-6,
+        "faults": faults,
+    }
+
+
+#: The classes :func:`measure_classes` simulates: name → HealthState fields.
+MEASURED_CLASSES: dict[str, dict] = {
+    "healthy": {},
+    "nut spall": {"faults": ({"kind": "spall", "location": "nut"},)},
+    "roller spall": {"faults": ({"kind": "spall", "location": "roller"},)},
+    "screw spall": {"faults": ({"kind": "spall", "location": "screw"},)},
+    "preload 5 µm": _preloaded(0.0),
+    "preload 60 % lost": _preloaded(0.6),
+    "lubricant degraded": {"lubricant_degradation": 1.0},
+}
+
+
+def measure_classes(
+    seeds=(1, 2, 3),
+    design: str = "paper01",
+    drive: str = "flight-ema",
+    check: str = "health-check",
+    classes: dict[str, dict] | None = None,
+    show: bool = True,
+) -> dict[str, dict[str, list[float]]]:
+    """Simulate a check per class and seed, read it, print a table: the measurement behind
+    docs/angle-domain.md (≈ 5 s of simulation per run on one core)::
+
+        python -c "from prsm_health.signals.check_indicators import measure_classes; measure_classes()"
+
+    Returns {indicator: {class: [value per seed]}} (and ``"_time_ms"``: the time
+    :func:`check_indicators` took per run, after a first call that compiles its kernels).
+    """
+    import time
+
+    from prsm_health.actuator.states import HealthState, OperatingProfile
+    from prsm_health.simulation.scenario import simulate
+
+    classes = MEASURED_CLASSES if classes is None else classes
+    table: dict[str, dict[str, list[float]]] = {k: {} for k in CHECK_INDICATORS}
+    table["_time_ms"] = {}
+    for name, health in classes.items():
+        for seed in seeds:
+            run = simulate(
+                design, HealthState(**health), OperatingProfile(check=check), drive, seed=seed
+            )
+            check_indicators(run)  # the first call compiles the kernels
+            start = time.perf_counter()
+            reading = check_indicators(run)
+            table["_time_ms"].setdefault(name, []).append(1e3 * (time.perf_counter() - start))
+            for key, value in reading.indicators.items():
+                table[key].setdefault(name, []).append(value)
+    if show:
+        print("| indicator | " + " | ".join(classes) + " |")
+        print("|---|" + "---|" * len(classes))
+        for key, row in table.items():
+            cells = []
+            for name in classes:
+                values = np.asarray(row.get(name, [math.nan]), float)
+                if np.all(np.isnan(values)):
+                    cells.append("NaN")
+                    continue
+                lo, mid, hi = np.nanmin(values), np.nanmedian(values), np.nanmax(values)
+                cells.append(f"{mid:.3g} ({lo:.3g}–{hi:.3g})")
+            print(f"| {key} | " + " | ".join(cells) + " |")
+    return table
