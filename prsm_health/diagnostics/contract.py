@@ -38,7 +38,9 @@ def contract_json(value):
         out = {}
         for f in dataclasses.fields(value):
             item = getattr(value, f.name)
-            if f.metadata.get("omit_empty") and (item is None or item == []):
+            if f.metadata.get("omit_empty") and (
+                item is None or (isinstance(item, (list, dict)) and not item)
+            ):
                 continue
             out[f.name] = contract_json(item)
         return out
@@ -135,6 +137,87 @@ class WindowSpan(_Part):
     end: float = describe("time of the window's last sample [s]")
 
 
+#: ``Undecided.kind`` of a class the recording could not show (a condition or channel missing).
+NOT_OBSERVABLE = "not_observable"
+#: ``Undecided.kind`` of a class the recording showed, with the classes not separated.
+AMBIGUOUS = "ambiguous"
+
+
+@dataclass(frozen=True, eq=False)
+class Undecided(_Part):
+    """Why the diagnosis names no class (``fault_class`` is ``cannot_tell``), and what to
+    record next to decide."""
+
+    kind: str = describe(
+        f"{NOT_OBSERVABLE!r}: the recording could not show the class (a condition or channel "
+        f"missing); {AMBIGUOUS!r}: it showed it, and the classes were not separated"
+    )
+    missing: list[str] = describe(
+        "the conditions the recording lacked (e.g. 'load reversal', 'load ≥ 10 % of C_a', "
+        "'steady segment', 'channel nut_position', 'health check'); empty when ambiguous",
+        default_factory=list,
+    )
+    candidates: list[str] = describe(
+        "the classes left (the class set) when ambiguous", default_factory=list
+    )
+    next_recording: str = describe(
+        "the recording that would decide, in words a maintainer can act on", default=""
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class BaselineState(_Part):
+    """A unit's own baseline and how far this recording lies from it."""
+
+    recordings: int = describe("recordings in the unit's baseline")
+    needed: int = describe("recordings a baseline needs before changes are scored")
+    changes: dict[str, float] = describe(
+        "indicator → robust z-score of this recording against the baseline (the largest |z| "
+        "first); empty until the baseline is complete",
+        default_factory=dict,
+    )
+    distance: float | None = describe(
+        "combined change score against the baseline (RMS of the robust z-scores: 0 at the "
+        "baseline's centre, about 1 for a recording like the baseline's; see docs/diagnostics.md)",
+        default=None,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class EvidenceState(_Part):
+    """The class evidence accumulated over a unit's recordings."""
+
+    recordings: int = describe("recordings whose evidence has accumulated")
+    posterior: dict[str, float] = describe(
+        "class → posterior probability after those recordings (sum 1)", default_factory=dict
+    )
+    fault_class: str = describe(
+        f"the class whose posterior reaches the naming threshold, else {CANNOT_TELL!r}",
+        default=CANNOT_TELL,
+    )
+    change_statistic: float | None = describe(
+        "sequential change statistic of the baseline distance (CUSUM, docs/diagnostics.md)",
+        default=None,
+    )
+    change_alarm: bool = describe(
+        "the change statistic crossed its threshold: the unit has changed from its baseline",
+        default=False,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class AssetState(_Part):
+    """The unit (asset) a recording belongs to: its baseline and accumulated evidence."""
+
+    asset_id: str = describe("the asset's identifier")
+    baseline: BaselineState | None = describe("its baseline", default=None)
+    evidence: EvidenceState | None = describe("its accumulated evidence", default=None)
+
+    def __post_init__(self):
+        object.__setattr__(self, "baseline", BaselineState.of(self.baseline))
+        object.__setattr__(self, "evidence", EvidenceState.of(self.evidence))
+
+
 @dataclass(kw_only=True)
 class Diagnosis:
     """The Diagnosis contract (docs/formats.md): of a window (with ``window``) or of a whole
@@ -187,6 +270,22 @@ class Diagnosis:
     windows: list[Diagnosis] = describe(
         "per-window diagnoses (recording diagnoses only)", omit_empty=True, default_factory=list
     )
+    undecided: Undecided | None = describe(
+        f"why fault_class is {CANNOT_TELL!r} and the recording that would decide (only then)",
+        omit_empty=True,
+        default=None,
+    )
+    check_phases: dict[str, str] = describe(
+        "a health-check recording: role → the phase that gave it (e.g. 'no_load' → 'no-load "
+        "stroke'); the roles the check lacked are in undecided.missing or the warnings",
+        omit_empty=True,
+        default_factory=dict,
+    )
+    asset: AssetState | None = describe(
+        "the unit the recording belongs to, when given: its baseline and accumulated evidence",
+        omit_empty=True,
+        default=None,
+    )
 
     def __post_init__(self):
         # mappings accepted where a part is expected (code written before the parts had types)
@@ -194,6 +293,8 @@ class Diagnosis:
         self.observability = Observability.of(self.observability)
         self.model = ModelReference.of(self.model)
         self.window = WindowSpan.of(self.window)
+        self.undecided = Undecided.of(self.undecided)
+        self.asset = AssetState.of(self.asset)
 
     def to_json(self) -> dict:
         """The Diagnosis contract as plain JSON values."""

@@ -34,6 +34,7 @@ import numpy as np
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, Recipe, generate, load_recipe
 
+from .check_evaluation import check_card_section
 from .diagnosis import DEFAULT_MODEL, OOD_LIMIT, diagnose, load_bundle
 from .evaluation import (
     clearance_report,
@@ -731,4 +732,4 @@ Fault class (drop of accuracy):
   at higher load (docs/faults.md).
 - Real recordings differ from the simulator (mounting, transfer paths, temperature): validate
   on measured data (`prsm-health import`, `prsm-health evaluate`) before trusting it.
-"""
+""" + check_card_section(metrics.get("check", {}))

@@ -52,6 +52,7 @@ from prsm_health.signals.features import (
     indicator_groups,
 )
 
+from .answer import NAME_PROBABILITY, SET_NOTE, ambiguous, fault_answer, not_observable  # noqa: F401 (NAME_PROBABILITY: public here)
 from .contract import (
     CANNOT_TELL,
     ClearanceInterval,
@@ -71,12 +72,6 @@ MIN_TAIL_FRACTION = 0.5
 #: the 99th percentile of the training windows' own scores; 1.5 leaves room for the held-out
 #: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
 OOD_LIMIT = 1.5
-#: A class is named when its calibrated probability reaches this: more probable than all the
-#: others together, so the named class is right more often than not (calibration figure of the
-#: model card); below it the answer is ``cannot_tell`` with the candidates in a warning.
-NAME_PROBABILITY = 0.5
-#: How the class-set part of a fault-class warning begins.
-_SET_NOTE = "not ruled out at "
 #: How the warning of windows unlike the training set begins.
 _OOD_NOTE = "indicators unlike the training windows"
 #: A clearance interval at least this share of the trained range wide says nothing: the
@@ -101,6 +96,7 @@ class ModelBundle:
     feature_names: list[str]
     metadata: dict
     guard: object | None = None
+    check: dict | None = None
     design: PRSMDesign | None = field(init=False)
 
     def __post_init__(self):
@@ -208,6 +204,7 @@ def load_bundle(
         list(model["feature_names"]),
         metadata,
         model.get("guard"),
+        model.get("check"),
     )
 
 
@@ -255,12 +252,13 @@ def diagnose_indicators(
 def _window_gates(
     row: dict, channels, bundle: ModelBundle, ood: float, design, interval_share: float
 ) -> tuple:
-    """(clearance observable, fault observable, warnings) of one window.
+    """(clearance observable, fault observable, warnings, missing conditions) of one window.
 
     ``interval_share``: the share of the trained range the regression's clearance interval
     covers (NaN without a clearance model or a recorded range)."""
-    notes = []
+    notes, conditions = [], []
     missing = bundle.missing_channels(channels)
+    conditions += [f"channel {name}" for name in missing]
     if missing:
         notes.append(
             f"channel(s) {', '.join(missing)} missing: model {bundle.name!r} was trained with "
@@ -276,6 +274,12 @@ def _window_gates(
     # does not show it, whatever the gates above say (observability must not claim it does).
     wide = bool(np.isfinite(interval_share) and interval_share >= WHOLE_RANGE_SHARE)
     clearance_ok = shown and not ood_high and not wide
+    if not reverses:
+        conditions.append("a load or motion reversal")
+    elif not (gate_ok or missing):
+        conditions.append(f"a window where {gate} is computable")
+    if ood_high:
+        conditions.append("indicators like the training recordings (design, instrumentation, duty)")
     if bundle.clearance is not None and not shown:
         if not reverses:
             notes.append(
@@ -316,7 +320,19 @@ def _window_gates(
             else "fault class: cannot tell — wear classes differ by clearance, which this window "
             "does not show"
         )
-    return clearance_ok, fault_ok, notes
+    if wide and not conditions:
+        conditions.append("a load reversal the clearance shows in (its interval spans the range)")
+    return clearance_ok, fault_ok, notes, conditions
+
+
+def _undecided(fault_class, class_set, observable: bool, conditions: list, bundle):
+    """Why a diagnosis cannot tell (None when it names a class)."""
+    if fault_class != CANNOT_TELL:
+        return None
+    has_check = getattr(bundle, "check", None) is not None
+    if not observable:
+        return not_observable(list(dict.fromkeys(conditions)), has_check=has_check)
+    return ambiguous(class_set, baseline=False, check=False)
 
 
 def _ood_note(scores: list[float]) -> str:
@@ -392,9 +408,9 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
     model = bundle.model_reference()
     out = []
     for i, row in enumerate(rows):
-        clearance_ok, fault_ok, notes = gates[i]
+        clearance_ok, fault_ok, notes, conditions = gates[i]
         probabilities = {c: float(p) for c, p in zip(classes, proba[i])}
-        fault_class, class_set = _fault_answer(probabilities, fault_ok, bundle, notes)
+        fault_class, class_set = fault_answer(probabilities, fault_ok, bundle.fault, notes)
         out.append(
             Diagnosis(
                 clearance=ClearanceInterval(
@@ -411,54 +427,10 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
                 observability=Observability(clearance_ok, fault_ok),
                 ood_score=finite_or_none(ood[i]),
                 indicator_groups=indicator_groups(row, channels[i]),
+                undecided=_undecided(fault_class, class_set, fault_ok, conditions, bundle),
             )
         )
     return out
-
-
-def _fault_answer(probabilities: dict, observable: bool, bundle: ModelBundle, notes: list):
-    """(fault class, class set) of class probabilities, and a warning when the set holds more
-    than the named class or no class is named.
-
-    The class is named when the fault is observable and its probability reaches
-    :data:`NAME_PROBABILITY`; otherwise ``cannot_tell``. The class set (the model's conformal
-    set) lists what the evidence cannot rule out: where the instrumentation cannot tell
-    classes apart, their held-out probabilities overlap and the set holds them all."""
-    from .estimators import class_sets  # scikit-learn only when a model is used
-
-    if not probabilities:
-        return None, []
-    names = list(probabilities)
-    if not observable:
-        return CANNOT_TELL, names
-    best = max(probabilities, key=probabilities.get)
-    thresholds = getattr(bundle.fault, "set_thresholds_", None)
-    members = [best]  # a bundle saved before class sets: its most probable class
-    if thresholds is not None:
-        chosen = class_sets([list(probabilities.values())], thresholds)[0]
-        members = sorted(
-            (c for c, keep in zip(names, chosen) if keep), key=probabilities.get, reverse=True
-        )
-    named = probabilities[best] >= NAME_PROBABILITY
-    if named and members == [best]:
-        return best, members
-    others = [c for c in members if c != best] if named else members
-    ruled_out = [c for c in names if c not in members]
-    head = (
-        f"fault class {best} (P = {probabilities[best]:.2f})"
-        if named
-        else f"fault class: cannot tell — no class reaches P = {NAME_PROBABILITY:g} (most "
-        f"probable {best}, {probabilities[best]:.2f})"
-    )
-    notes.append(
-        f"{head}; {_SET_NOTE}{100 * _set_coverage(bundle):.0f} %: {', '.join(others)}"
-        + (f"; ruled out: {', '.join(ruled_out)}" if ruled_out else "")
-    )
-    return (best if named else CANNOT_TELL), members
-
-
-def _set_coverage(bundle: ModelBundle) -> float:
-    return float(getattr(bundle.fault, "set_coverage", 0.9))
 
 
 def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
@@ -482,7 +454,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         for note in d.warnings:
             if note.startswith(_OOD_NOTE):  # one note with the range of the windows' scores
                 note = _OOD_NOTE
-            if _SET_NOTE not in note:  # restated below for the mean probabilities
+            if SET_NOTE not in note:  # restated below for the mean probabilities
                 counts[note] = counts.get(note, 0) + 1
     flagged = [
         d.ood_score for d in diagnoses if d.ood_score is not None and d.ood_score > OOD_LIMIT
@@ -492,7 +464,8 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         + ("" if k == len(diagnoses) else f" (in {k} of {len(diagnoses)} windows)")
         for note, k in counts.items()
     ]
-    fault_class, class_set = _fault_answer(probs, bool(told), bundle, notes)
+    fault_class, class_set = fault_answer(probs, bool(told), bundle.fault, notes)
+    conditions = [m for d in diagnoses if d.undecided is not None for m in d.undecided.missing]
     names = diagnoses[0].indicators.keys()
     groups = {
         g: next(
@@ -519,6 +492,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         ),
         ood_score=median([d.ood_score for d in diagnoses]),
         indicator_groups=groups,
+        undecided=_undecided(fault_class, class_set, bool(told), conditions, bundle),
     )
 
 
@@ -544,8 +518,11 @@ def diagnose(
     *,
     window: float | None = None,
     windows: tuple[list[Run], list[str]] | None = None,
+    baseline=None,
 ) -> Diagnosis:
-    """Diagnose a recording: a :class:`Diagnosis` of the whole, with one per window.
+    """Diagnose a recording: a :class:`Diagnosis` of the whole, with one per window — or, for a
+    health-check recording and a bundle with a check model, one of the check read phase by
+    phase (:func:`prsm_health.diagnostics.check_model.diagnose_check`).
 
     Parameters
     ----------
@@ -556,9 +533,12 @@ def diagnose(
     windows : (windows, notes) or None
         ``run`` already cut by :func:`split_windows`, for a caller that needs the windows too
         (it then cuts once); ``window`` is ignored.
+    baseline : Baseline or None
+        The unit's own baseline (:class:`prsm_health.diagnostics.baseline.Baseline`): a check
+        recording is then read against it too.
     """
     split = None if windows is None else [windows]
-    return diagnose_runs([run], bundle, window=window, split=split)[0]
+    return diagnose_runs([run], bundle, window=window, split=split, baseline=baseline)[0]
 
 
 def diagnose_runs(
@@ -567,16 +547,46 @@ def diagnose_runs(
     *,
     window: float | None = None,
     split: list[tuple[list[Run], list[str]]] | None = None,
+    baseline=None,
 ) -> list[Diagnosis]:
     """Diagnose several recordings in one batch (every window's indicators in one call):
     one :class:`Diagnosis` per run, each as :func:`diagnose` gives it; ``split``: each run
-    already cut by :func:`split_windows` (``window`` then ignored)."""
+    already cut by :func:`split_windows` (``window`` then ignored); ``baseline``: of the unit
+    all the runs belong to."""
+    from .check_model import diagnose_check, is_check
+
     bundle = bundle or load_bundle()
     for run in runs:
         reason = bundle.refuses(run.labels)
         if reason is not None:
             raise PRSMHealthError(reason)
     runs = [run.without_truth().validate() for run in runs]
+    # a check recording is read phase by phase when the model can (and was not cut already)
+    checks = {
+        i: diagnose_check(run, bundle, baseline)
+        for i, run in enumerate(runs)
+        if bundle.check is not None and split is None and is_check(run)
+    }
+    rest = [i for i in range(len(runs)) if i not in checks]
+    windowed = _diagnose_windowed(
+        [runs[i] for i in rest],
+        bundle,
+        window=window,
+        split=None if split is None else [split[i] for i in rest],
+    )
+    if baseline is not None:
+        for d in windowed:
+            d.warnings.append(
+                "the unit's baseline is read against its health-check recordings; this "
+                "recording, no check (or a model without a check part), is read alone"
+            )
+    out = dict(checks) | dict(zip(rest, windowed))
+    return [out[i] for i in range(len(runs))]
+
+
+def _diagnose_windowed(runs, bundle, *, window, split) -> list[Diagnosis]:
+    if not runs:
+        return []
     if split is None:
         split = [split_windows(run, window or bundle.window) for run in runs]
     elif len(split) != len(runs):

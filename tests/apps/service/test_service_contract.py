@@ -99,7 +99,8 @@ def test_published_schema_is_the_contract(doc):
     schemas = doc["components"]["schemas"]
     diagnosis = schemas["Diagnosis"]
     assert set(diagnosis["required"]) == CONTRACT_FIELDS
-    assert set(diagnosis["properties"]) == CONTRACT_FIELDS | {"window", "windows"}
+    optional = {"window", "windows", "undecided", "check_phases", "asset"}
+    assert set(diagnosis["properties"]) == CONTRACT_FIELDS | optional
     assert diagnosis["additionalProperties"] is False
     assert set(schemas["ClearanceInterval"]["required"]) == {"estimate", "lower", "upper"}
     assert set(schemas["ModelReference"]["required"]) == {

@@ -1,0 +1,342 @@
+"""The check model judged on units it never saw: one check recording alone, and five check
+recordings of a unit read against its own baseline with the evidence accumulated.
+
+:func:`evaluation_recipes` derives, from a check training recipe, recipes of *fresh* units (a
+``[units]`` seed never used in training): each unit recorded three times new and healthy (its
+baseline) and five times in each state of :data:`EVAL_STATES` at default severity, as built
+(its preload, uneven wear, installation the same in all its recordings), the temperature and
+the sensors' noise and errors drawn per recording. :func:`evaluate_check_model` diagnoses every
+recording through :func:`prsm_health.diagnostics.diagnosis.diagnose` — alone, and against the
+unit's baseline — and accumulates each unit's evidence
+(:class:`~prsm_health.diagnostics.baseline.Evidence`).
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+
+from .contract import CANNOT_TELL
+
+#: Fresh units: a seed the training recipes never used.
+EVAL_UNITS_SEED = 7373
+#: Recordings per unit and state, and baseline recordings per unit.
+RECORDINGS, BASELINE = 5, 3
+#: States of the evaluation: (true class, the sweep entries of the state, extra unit build).
+EVAL_STATES = {
+    "healthy": ("healthy", {}, {}),
+    "wear": ("wear", {}, {"clearance": [17e-6, 28e-6]}),
+    "severe_wear": ("severe_wear", {}, {"clearance": [32e-6, 40e-6]}),
+    "lubrication": ("lubrication", {"lubricant_degradation": [0.6, 1.0]}, {}),
+    "spall_nut": ("spall", {"fault_case": ["spall_nut"]}, {}),
+    "spall_roller": ("spall", {"fault_case": ["spall_roller"]}, {}),
+    "preload_loss": ("preload_loss", {"fault_case": ["preload_loss"]}, {}),
+    "spall_screw": ("spall", {"fault_case": ["spall_screw"]}, {}),
+    "tooth_damage": (
+        "tooth_damage",
+        {"fault_case": ["crack_ring_gear", "crack_roller_gear", "tooth_pit"]},
+        {},
+    ),
+}
+#: The unit as built in every evaluation recipe: a preloaded nut (so a preload loss is one),
+#: clearance as built 2–8 µm, the training recipe's uneven wear and installation ranges.
+AS_BUILT = {"preload": [2e-6, 5e-6], "clearance": [2e-6, 8e-6]}
+
+
+def evaluation_recipes(training, units: int = 8) -> dict:
+    """``{"baseline": Recipe, state: Recipe …}`` of fresh units (:data:`EVAL_UNITS_SEED`)
+    from a check training recipe (``datasets/flight-ema-check.toml``)."""
+    from prsm_health.datasets import Recipe
+
+    source = copy.deepcopy(training.source)
+    build = dict(source.get("units", {}).get("build", {}))
+    build.update(AS_BUILT)
+    sweep = {
+        k: v
+        for k, v in source["sweep"].items()
+        if k.split(".")[0] in ("options", "instrumentation") or k == "temperature"
+    }
+
+    def recipe(name, seed, per_unit, extra_sweep, extra_build):
+        return Recipe.from_dict(
+            dict(
+                source,
+                name=f"{training.name}-eval-{name}",
+                seed=seed,
+                test_fraction=0.0,
+                units={"count": units, "seed": EVAL_UNITS_SEED, "build": build | extra_build},
+                sweep={
+                    "mode": "random",
+                    "samples": units * per_unit,
+                    "severity": [1.0, 1.0],
+                    "lubricant_degradation": [0.0, 0.2],
+                    "fault_case": ["none"],
+                    **sweep,
+                    **extra_sweep,
+                },
+            )
+        )
+
+    out = {"baseline": recipe("baseline", training.seed + 100, BASELINE, {}, {})}
+    for k, (state, (_, extra_sweep, extra_build)) in enumerate(EVAL_STATES.items()):
+        out[state] = recipe(state, training.seed + 101 + k, RECORDINGS, extra_sweep, extra_build)
+    return out
+
+
+def generate_evaluation(recipes: dict, work: str | Path, *, workers: int | None = None) -> dict:
+    """Generate (resumably) every evaluation recipe into ``work``: name → dataset directory."""
+    from prsm_health.datasets import generate
+
+    work = Path(work)
+    out = {}
+    for name, recipe in recipes.items():
+        generate(recipe, work / recipe.name, workers=workers)
+        out[name] = work / recipe.name
+    return out
+
+
+def evaluate_check_model(bundle, datasets: dict, *, threshold: float = 0.9) -> dict:
+    """Every evaluation recording through the diagnosis, alone and against its unit's
+    baseline, and each unit's evidence accumulated over its five recordings of a state.
+
+    Returns
+    -------
+    dict
+        ``single``: one recording alone (per-state confusion, macro-F1 over the states the
+        check shows, healthy named healthy, confident wrong); ``accumulated``: five recordings
+        against the baseline (macro-F1 of the units' named classes, ROC AUC of the spall
+        posterior of nut/roller spall units vs healthy units); ``clearance``: MAE and 90 %
+        coverage on the check recordings; ``records``: one row per recording.
+    """
+    from prsm_health.datasets import Dataset
+
+    from .baseline import Baseline, Evidence
+    from .check_model import CheckModel
+    from .diagnosis import diagnose
+
+    model = CheckModel.from_part(bundle.check)
+    base = Dataset(datasets["baseline"])
+    baselines = {}
+    for unit, group in base.runs.groupby("unit_id"):
+        rows = [diagnose(base.run(int(i), truth=False), bundle).indicators for i in group.run_id]
+        baselines[int(unit)] = Baseline.fit(
+            rows, prior_scale=model.repeatability, names=list(model.feature_names)
+        )
+    records, units = [], []
+    for state, (true_class, _, _) in EVAL_STATES.items():
+        ds = Dataset(datasets[state])
+        for unit, group in ds.runs.groupby("unit_id"):
+            evidence = None
+            for run_id in group.run_id:
+                run = ds.run(int(run_id), truth=False)
+                alone = diagnose(run, bundle)
+                against = diagnose(run, bundle, baseline=baselines[int(unit)])
+                if evidence is None:
+                    evidence = Evidence.start(list(against.class_probabilities))
+                evidence = evidence.update(
+                    against.class_probabilities, training_prior=model.training_prior
+                )
+                row = group[group.run_id == run_id].iloc[0]
+                records.append(
+                    {
+                        "state": state,
+                        "fault_class": true_class,
+                        "unit_id": int(unit),
+                        "predicted_alone": alone.fault_class,
+                        "top_alone": max(alone.class_probabilities.values()),
+                        "predicted_against": against.fault_class,
+                        "clearance": 0.5 * (row.clearance_screw + row.clearance_nut),
+                        "estimate": alone.clearance["estimate"],
+                        "lower": alone.clearance["lower"],
+                        "upper": alone.clearance["upper"],
+                    }
+                )
+            posterior = evidence.posterior()
+            units.append(
+                {
+                    "state": state,
+                    "fault_class": true_class,
+                    "unit_id": int(unit),
+                    "named": evidence.named(threshold),
+                    "posterior": posterior,
+                }
+            )
+    return {
+        "single": _class_scores(records, "predicted_alone", model),
+        "against_baseline_single": _class_scores(records, "predicted_against", model),
+        "accumulated": _accumulated(units, model, threshold),
+        "clearance": _clearance(records),
+        "records": records,
+        "units": units,
+    }
+
+
+def _observable_states(model) -> list[str]:
+    return [
+        s
+        for s, (cls, _, _) in EVAL_STATES.items()
+        if cls not in model.not_observable and s not in model.not_observable
+    ]
+
+
+def _class_scores(records, key: str, model) -> dict:
+    from sklearn.metrics import f1_score
+
+    shown = set(_observable_states(model))
+    rows = [r for r in records if r["state"] in shown]
+    truth = np.array([r["fault_class"] for r in rows])
+    pred = np.array([r[key] for r in rows])
+    labels = sorted(set(truth))
+    confusion = {}
+    for r in records:
+        confusion.setdefault(r["state"], {}).setdefault(r[key], 0)
+        confusion[r["state"]][r[key]] += 1
+    healthy = truth == "healthy"
+    wrong = (pred != truth) & (pred != CANNOT_TELL)
+    out = {
+        "n": len(rows),
+        "macro_f1": float(f1_score(truth, pred, labels=labels, average="macro", zero_division=0)),
+        "per_class_f1": dict(
+            zip(
+                labels,
+                map(float, f1_score(truth, pred, labels=labels, average=None, zero_division=0)),
+            )
+        ),
+        "healthy_named_healthy": float(np.mean(pred[healthy] == "healthy"))
+        if healthy.any()
+        else None,
+        "wrong_fraction": float(np.mean(wrong)),
+        "cannot_tell_fraction": float(np.mean(pred == CANNOT_TELL)),
+        "confusion": confusion,
+    }
+    if key == "predicted_alone":
+        top = np.array([r["top_alone"] for r in rows])
+        out["confident_wrong_fraction"] = float(np.mean(wrong & (top > 0.6)))
+    return out
+
+
+def _accumulated(units, model, threshold) -> dict:
+    from sklearn.metrics import f1_score, roc_auc_score
+
+    shown = set(_observable_states(model))
+    rows = [u for u in units if u["state"] in shown]
+    truth = np.array([u["fault_class"] for u in rows])
+    pred = np.array([u["named"] for u in rows])
+    labels = sorted(set(truth))
+    confusion = {}
+    for u in units:
+        confusion.setdefault(u["state"], {}).setdefault(u["named"], 0)
+        confusion[u["state"]][u["named"]] += 1
+    auc = {}
+    for state in ("spall_nut", "spall_roller"):
+        sick = [u["posterior"].get("spall", 0.0) for u in units if u["state"] == state]
+        well = [u["posterior"].get("spall", 0.0) for u in units if u["state"] == "healthy"]
+        if sick and well:
+            auc[state] = float(roc_auc_score([1] * len(sick) + [0] * len(well), sick + well))
+    return {
+        "units": len(rows),
+        "threshold": threshold,
+        "macro_f1": float(f1_score(truth, pred, labels=labels, average="macro", zero_division=0)),
+        "wrong_fraction": float(np.mean((pred != truth) & (pred != CANNOT_TELL))),
+        "cannot_tell_fraction": float(np.mean(pred == CANNOT_TELL)),
+        "spall_auc": auc,
+        "confusion": confusion,
+    }
+
+
+def _clearance(records) -> dict:
+    y = np.array([r["clearance"] for r in records], float)
+    est = np.array([r["estimate"] for r in records], float)
+    lo = np.array([r["lower"] for r in records], float)
+    hi = np.array([r["upper"] for r in records], float)
+    return {
+        "n": len(y),
+        "mae": float(np.mean(np.abs(est - y))),
+        "coverage": float(np.mean((y >= lo) & (y <= hi))),
+        "mean_width": float(np.mean(hi - lo)),
+    }
+
+
+def _pct(x) -> str:
+    return "–" if x is None else f"{x:.3f}"
+
+
+def check_card_section(check: dict) -> str:
+    """The model card's "Health-check recordings" section from ``metrics["check"]``
+    (:func:`evaluate_check_model`'s numbers and the training's)."""
+    ev = check.get("evaluation")
+    if not ev:
+        return ""
+    tr = check.get("training", {})
+    single, acc, clr = ev["single"], ev["accumulated"], ev["clearance"]
+    rel = ev["against_baseline_single"]
+    states = list(EVAL_STATES)
+    predicted = sorted({p for row in single["confusion"].values() for p in row})
+    head = " | ".join(predicted)
+    rows = "\n".join(
+        f"| {s} | "
+        + " | ".join(str(single["confusion"].get(s, {}).get(p, 0)) for p in predicted)
+        + " |"
+        for s in states
+    )
+    named = sorted({p for row in acc["confusion"].values() for p in row})
+    acc_rows = "\n".join(
+        f"| {s} | " + " | ".join(str(acc["confusion"].get(s, {}).get(p, 0)) for p in named) + " |"
+        for s in states
+    )
+    held = tr.get("held_out", {})
+    auc = ", ".join(f"{k} {v:.3f}" for k, v in acc["spall_auc"].items()) or "–"
+    return f"""
+## Health-check recordings (the check part of the bundle)
+
+*Generated by `tools/release/train_check_model.py`.* A recording of the built-in health check
+(`prsm-health simulate --profile health-check`; docs/diagnostics.md) is read phase by phase:
+the no-load stroke (preload), the torque at two speeds under one load with the housing
+temperature (lubricant), the slow reversal under load (clearance, lost motion), the high-load
+stroke (synchronous averages at the nut-pass and roller-spin periods: spalls). Trained on
+`datasets/flight-ema-check.toml` ({tr.get("runs", {}).get("train", "–")} recordings of 64
+units in every state, {tr.get("runs", {}).get("test", "–")} of 16 held-out units) and the same
+units' baselines (`datasets/flight-ema-check-baseline.toml`); tooth damage left out of the
+classifiers (not observable, below). Held-out units: clearance MAE
+{_um_text(held.get("clearance_mae"))}, coverage {_pct(held.get("clearance_coverage"))};
+macro-F1 (argmax) alone {_pct(held.get("macro_f1_alone"))}, against the unit's baseline
+{_pct(held.get("macro_f1_against_baseline"))}.
+
+**Fresh units** ({acc["units"] // max(1, len(_observable_states_of(check)))} per state, a units
+seed never used in training): three baseline checks each, then five checks in each state at
+default severity. Fault macro-F1 over the states a check shows (`cannot_tell` a miss):
+
+| reading | n | macro-F1 | healthy named healthy | wrong class | confident wrong | `cannot_tell` |
+|---|---|---|---|---|---|---|
+| one check alone | {single["n"]} | {_pct(single["macro_f1"])} | {_pct(single["healthy_named_healthy"])} | {_pct(single["wrong_fraction"])} | {_pct(single.get("confident_wrong_fraction"))} | {_pct(single["cannot_tell_fraction"])} |
+| one check against the unit's baseline | {rel["n"]} | {_pct(rel["macro_f1"])} | {_pct(rel["healthy_named_healthy"])} | {_pct(rel["wrong_fraction"])} | – | {_pct(rel["cannot_tell_fraction"])} |
+| five checks against the baseline, evidence accumulated (named at posterior ≥ {acc["threshold"]}) | {acc["units"]} units | {_pct(acc["macro_f1"])} | – | {_pct(acc["wrong_fraction"])} | – | {_pct(acc["cannot_tell_fraction"])} |
+
+Spall detection after five checks (ROC AUC of the spall posterior, spall units vs healthy
+units; the check's high-load stroke is at 25 % of C_a): {auc}. Clearance on the check
+recordings: MAE {_um_text(clr["mae"])}, 90 % coverage {_pct(clr["coverage"])}, mean width
+{_um_text(clr["mean_width"])}.
+
+One check alone, per state (rows: the unit's state; columns: the diagnosis):
+
+| state | {head} |
+|---|{"---|" * len(predicted)}
+{rows}
+
+Five checks against the baseline, per unit:
+
+| state | {" | ".join(named)} |
+|---|{"---|" * len(named)}
+{acc_rows}
+"""
+
+
+def _um_text(x) -> str:
+    return "–" if x is None else f"{1e6 * x:.2f} µm"
+
+
+def _observable_states_of(check: dict) -> list[str]:
+    unseen = set(check.get("training", {}).get("not_observable", {}))
+    return [s for s, (cls, _, _) in EVAL_STATES.items() if cls not in unseen]

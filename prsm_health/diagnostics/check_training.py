@@ -1,0 +1,246 @@
+"""Training the check model of a bundle (:class:`~prsm_health.diagnostics.check_model.CheckModel`)
+from health-check recordings of units and their baselines.
+
+Two datasets of one recipe family (``datasets/flight-ema-check.toml`` and
+``datasets/flight-ema-check-baseline.toml``: the same ``[units]``): check recordings of units
+in every health state, and each unit recorded new and healthy. From them:
+
+* the **repeatability** of each check indicator — its within-unit scatter between two check
+  recordings of the same healthy unit (the pooled within-group standard deviation), the prior
+  scale of a unit's baseline (:meth:`prsm_health.diagnostics.baseline.Baseline.fit`);
+* each recording's **change** against its unit's baseline (robust z-scores);
+* a clearance estimator and a fault classifier on the indicators alone (one recording), and a
+  fault classifier on the indicators and their change (a unit with a baseline) — the package's
+  estimators (:mod:`prsm_health.diagnostics.estimators`, conformal intervals and class sets),
+  cross-validated by unit (a unit's recordings never straddle folds) and scored on the held-out
+  units.
+
+Classes no check shows (``not_observable``: class → measured reason) are left out of the
+classifiers' training — a class the classifier cannot learn only blurs the ones it can — and
+named in every check diagnosis instead.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from prsm_health.core.errors import PRSMHealthError
+
+from .check_model import CHANGE_PREFIX, change_row, check_reading
+from .training import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target
+
+#: Cross-validation folds (by unit).
+CHECK_CV = 3
+#: Classes no health check of the flight-ema instrumentation shows, and why (measured:
+#: tools/studies/duty_signatures.py and docs/faults.md "At realistic duty").
+NOT_OBSERVABLE = {
+    "tooth_damage": "a cracked or pitted ring- or roller-gear tooth changes the mesh force by "
+    "≤ 1.6 N and the nut acceleration by ≈ 0.0007 m/s² RMS at 20–40 % of C_a, far below the "
+    "accelerometer's noise and the healthy units' scatter (docs/faults.md)",
+}
+#: The fault cases of those classes, left out of the classifiers' training.
+UNSEEN_CASES = ("crack_ring_gear", "crack_roller_gear", "tooth_pit")
+
+
+def check_table(dataset, progress: bool = False):
+    """The check indicators of every run of a dataset of check recordings, with the run
+    labels, as a DataFrame (one row per run)."""
+    import pandas as pd
+
+    design = getattr(dataset, "design", None)
+    ids = list(dataset.runs["run_id"])
+    iterator = ids
+    if progress:
+        from tqdm import tqdm
+
+        iterator = tqdm(ids, unit="run", desc="check indicators")
+    rows = []
+    for run_id in iterator:
+        run = dataset.run(int(run_id), truth=False)
+        if run.check_phase is None:
+            raise PRSMHealthError(f"{dataset.path}: run {run_id} is no health-check recording")
+        row = dict(check_reading(run, design).indicators)
+        row.update(run.labels)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def repeatability(baseline_table, names: list[str]) -> dict[str, float]:
+    """Within-unit scatter of each indicator: the pooled standard deviation of the units'
+    baseline recordings around their unit's mean (each unit with ≥ 2 recordings), NaN where no
+    unit has two finite values."""
+    out = {}
+    for name in names:
+        squares, dof = 0.0, 0
+        for _, group in baseline_table.groupby("unit_id"):
+            values = group[name].to_numpy(float)
+            values = values[np.isfinite(values)]
+            if len(values) >= 2:
+                squares += float(np.sum((values - values.mean()) ** 2))
+                dof += len(values) - 1
+        out[name] = math.sqrt(squares / dof) if dof else math.nan
+    return out
+
+
+def unit_baselines(baseline_table, names: list[str], prior_scale: dict) -> dict:
+    """Unit id → its :class:`~prsm_health.diagnostics.baseline.Baseline` (all its baseline
+    recordings)."""
+    from .baseline import Baseline
+
+    out = {}
+    for unit, group in baseline_table.groupby("unit_id"):
+        rows = group[names].to_dict("records")
+        ids = [str(r) for r in group["run_id"]]
+        out[int(unit)] = Baseline.fit(rows, prior_scale=prior_scale, names=names, recordings=ids)
+    return out
+
+
+def change_table(table, baselines: dict, names: list[str]):
+    """Each recording's indicators and their change against its unit's baseline
+    (:func:`~prsm_health.diagnostics.check_model.change_row`)."""
+    import pandas as pd
+
+    rows = [
+        change_row(row, baselines.get(int(row["unit_id"])), names)
+        for row in table.to_dict("records")
+    ]
+    return pd.DataFrame(rows, index=table.index)
+
+
+def train_check_model(
+    check_dir,
+    baseline_dir,
+    *,
+    not_observable: dict | None = None,
+    unseen_cases: tuple[str, ...] = (),
+    random_state: int = 0,
+    progress: bool = False,
+) -> tuple[dict, dict]:
+    """Train the check part of a model bundle.
+
+    Parameters
+    ----------
+    check_dir, baseline_dir : path
+        Datasets of check recordings and of the same units' baselines (``[units]`` recipes).
+    not_observable : dict or None
+        Class → why no check shows it (measured), named in every check diagnosis.
+    unseen_cases : tuple of str
+        Fault cases (``fault_case`` label) of those classes, left out of the classifiers'
+        training (they are still scored in ``metrics["held_out"]`` for what the model says of them).
+    random_state : int
+
+    Returns
+    -------
+    (part, metrics)
+        ``part``: the bundle's ``check`` dict (:meth:`CheckModel.from_part`); ``metrics``: the
+        cross-validated and held-out numbers.
+    """
+    from prsm_health.datasets import Dataset
+
+    from .estimators import ClearanceEstimator, FaultClassifier
+    from .evaluation import cross_validated_metrics
+
+    checks, base = Dataset(check_dir), Dataset(baseline_dir)
+    for ds in (checks, base):
+        if "unit_id" not in ds.runs:
+            raise PRSMHealthError(f"{ds.path}: runs without unit_id: a recipe with [units]")
+    table = check_table(checks, progress)
+    base_table = check_table(base, progress)
+    from prsm_health.signals.check_indicators import CHECK_INDICATORS
+
+    # an indicator this instrumentation cannot give (all NaN: no load cell) carries nothing
+    names = [n for n in CHECK_INDICATORS if n in table and table[n].notna().any()]
+    healthy_base = base_table[base_table["split"] == "train"]
+    scatter = repeatability(healthy_base, names)
+    baselines = unit_baselines(base_table, names, scatter)
+    changes = change_table(table, baselines, names)
+    relative_names = [*names, *(CHANGE_PREFIX + n for n in names)]
+
+    train = table["split"] == "train"
+    seen = ~table["fault_case"].isin(list(unseen_cases))
+    fit_rows = train & seen
+    units = table.loc[fit_rows, "unit_id"].to_numpy()
+    y_class = table.loc[fit_rows, "fault_class"].astype(str).to_numpy()
+    y_clearance = clearance_target(table.loc[train])
+    metrics: dict = {
+        "runs": {"train": int(train.sum()), "test": int((~train).sum())},
+        "baseline_runs": len(base_table),
+        "indicators": names,
+        "unseen_cases": list(unseen_cases),
+        "not_observable": dict(not_observable or {}),
+    }
+
+    def clearance_model():
+        return ClearanceEstimator(**CLEARANCE_PARAMS, random_state=random_state)
+
+    def classifier():
+        return FaultClassifier(**FAULT_PARAMS, random_state=random_state)
+
+    x_train = table.loc[train, names]
+    metrics["clearance_cv"] = cross_validated_metrics(
+        clearance_model, x_train, y_clearance, groups=table.loc[train, "unit_id"], cv=CHECK_CV
+    )
+    clearance = clearance_model().fit(x_train, y_clearance)
+    metrics["fault_cv"] = cross_validated_metrics(
+        classifier, table.loc[fit_rows, names], y_class, groups=units, cv=CHECK_CV
+    )
+    fault = classifier().fit(table.loc[fit_rows, names], y_class)
+    metrics["fault_relative_cv"] = cross_validated_metrics(
+        classifier, changes.loc[fit_rows, relative_names], y_class, groups=units, cv=CHECK_CV
+    )
+    fault_relative = classifier().fit(changes.loc[fit_rows, relative_names], y_class)
+    classes, counts = np.unique(y_class, return_counts=True)
+    part = {
+        "feature_names": names,
+        "clearance": clearance,
+        "fault": fault,
+        "fault_relative": fault_relative,
+        "repeatability": scatter,
+        "training_prior": {str(c): float(k / counts.sum()) for c, k in zip(classes, counts)},
+        "not_observable": dict(not_observable or {}),
+        "clearance_range": [float(np.min(y_clearance)), float(np.max(y_clearance))],
+    }
+    metrics["held_out"] = _held_out(part, table[~train], changes[~train], names, relative_names)
+    return part, metrics
+
+
+def _held_out(part, table, changes, names, relative_names) -> dict:
+    """The held-out units' recordings: clearance MAE and coverage, class F1 alone and against
+    the baseline (every fault case, unseen ones included, with its true class)."""
+    from sklearn.metrics import f1_score
+
+    if table.empty:
+        return {}
+    y = clearance_target(table)
+    est = part["clearance"].predict(table[names])
+    lo, hi = part["clearance"].predict_interval(table[names])
+    truth = table["fault_class"].astype(str).to_numpy()
+    out = {
+        "n": len(table),
+        "clearance_mae": float(np.mean(np.abs(est - y))),
+        "clearance_coverage": float(np.mean((y >= lo) & (y <= hi))),
+    }
+    for key, model, x in (
+        ("alone", part["fault"], table[names]),
+        ("against_baseline", part["fault_relative"], changes[relative_names]),
+    ):
+        predicted = np.asarray(model.predict(x)).astype(str)
+        labels = sorted(set(truth) & set(model.classes_))
+        out[f"macro_f1_{key}"] = float(
+            f1_score(truth, predicted, labels=labels, average="macro", zero_division=0)
+        )
+    return out
+
+
+def add_check_model(model_path, part: dict) -> None:
+    """Put the check part into a saved model bundle (re-saved atomically, its metadata kept)."""
+    from .model_files import load_model, save_model
+
+    model, metadata = load_model(model_path)
+    if not isinstance(model, dict) or "feature_names" not in model:
+        raise PRSMHealthError(f"{model_path}: not a prsm_health diagnosis bundle")
+    model["check"] = part
+    keep = {k: v for k, v in metadata.items() if k not in ("versions", "saved_at")}
+    save_model(model_path, model, metadata=keep)
