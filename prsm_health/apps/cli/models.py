@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import sys
+from datetime import datetime, timezone
+from pathlib import Path
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset
+from prsm_health.diagnostics.asset_history import AssetStore, diagnose_asset, file_recording_id
 from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
 from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
@@ -107,9 +110,24 @@ def evaluation_rows(report: dict) -> list:
 
 # ----------------------------------------------------------------------------- diagnose
 def diagnose(args) -> int:
+    _check_asset_options(args)
     bundle = load_bundle(args.model)
     run = read_recording(args.file, column_map=args.map)
-    result = diagnose_recording(run, bundle, window=args.window)
+    if args.asset is None:
+        result = diagnose_recording(run, bundle, window=args.window)
+    else:
+        result = diagnose_asset(
+            run,
+            bundle,
+            AssetStore(args.store),
+            args.asset,
+            file_recording_id(args.file, args.map),
+            healthy=True if args.healthy else (False if args.unhealthy else None),
+            operating_hours=args.operating_hours,
+            time=args.time if args.time is not None else _modified(args.file),
+            window=args.window,
+            source=Path(args.file).name,
+        )
     if args.plot:
         plot_diagnosis(result, args.plot)
     if args.json:
@@ -117,6 +135,30 @@ def diagnose(args) -> int:
         return 0
     print_table(diagnosis_rows(args.file, result))
     return 0
+
+
+def _check_asset_options(args) -> None:
+    """The options that describe the recording's asset need ``--asset``."""
+    if getattr(args, "asset", None) is not None:
+        return
+    given = [
+        option
+        for option, value in (
+            ("--healthy", getattr(args, "healthy", False)),
+            ("--unhealthy", getattr(args, "unhealthy", False)),
+            ("--operating-hours", getattr(args, "operating_hours", None) is not None),
+            ("--time", getattr(args, "time", None) is not None),
+        )
+        if value
+    ]
+    if given:
+        raise PRSMHealthError(f"{given[0]} describes the recording's asset: give --asset ID")
+
+
+def _modified(file: str) -> str:
+    """The file's modification time, ISO 8601 in UTC to the second."""
+    stamp = datetime.fromtimestamp(Path(file).stat().st_mtime, tz=timezone.utc)
+    return stamp.isoformat(timespec="seconds")
 
 
 def diagnosis_rows(file: str, result) -> list:
@@ -140,7 +182,40 @@ def diagnosis_rows(file: str, result) -> list:
         ("windows", len(result.windows), ""),
         ("model", f"{result.model['name']} v{result.model['version']}", ""),
     ]
+    rows += asset_rows(getattr(result, "asset", None))
     rows += [("warning", text, "") for text in result.warnings]
+    return rows
+
+
+#: Changes shown in the table of ``diagnose --asset`` (the JSON has them all).
+SHOWN_CHANGES = 3
+
+
+def asset_rows(asset) -> list:
+    """The asset part of the ``diagnose`` table: the baseline (how full, the distance and the
+    largest changes), the accumulated evidence and the change statistic."""
+    if asset is None:
+        return []
+    rows = [("asset", asset.asset_id, "")]
+    b, e = asset.baseline, asset.evidence
+    if b is not None and b.recordings < b.needed:
+        rows.append(("baseline", f"{b.recordings} of {b.needed} recordings", "(incomplete)"))
+    elif b is not None:
+        rows.append(("baseline", f"{b.recordings} recordings", ""))
+        rows.append(
+            ("baseline distance", scaled(b.distance), "(RMS of robust z; about 1: like it)")
+        )
+        for name, z in list(b.changes.items())[:SHOWN_CHANGES]:
+            rows.append((f"change of {name}", f"{z:+.2f}", "robust z"))
+    if e is not None and e.recordings == 0:
+        rows.append(("evidence", "none yet", "(baseline recordings add none)"))
+    elif e is not None:
+        rows.append(("evidence", f"{e.recordings} recordings", ""))
+        rows += [(f"posterior({k})", v, "") for k, v in e.posterior.items()]
+        rows.append(("asset class", e.fault_class, ""))
+    if e is not None and e.change_statistic is not None:
+        alarm = "  ALARM: changed from its baseline" if e.change_alarm else ""
+        rows.append(("change statistic", f"{e.change_statistic:.3g}", f"(CUSUM){alarm}"))
     return rows
 
 

@@ -43,3 +43,18 @@ def share(value, of: str) -> str:
 def hours(value: float) -> str:
     """Hours for the summary: whole hours from 100 h, else 3 significant digits."""
     return f"{value:.0f}" if abs(value) >= 100 else f"{value:.3g}"
+
+
+def print_columns(header: tuple[str, ...], rows: list[tuple]) -> None:
+    """A table of several columns under ``header``, each column as wide as its widest cell;
+    floats to 4 significant digits, None as '–'."""
+
+    def cell(value) -> str:
+        if value is None:
+            return "–"
+        return f"{value:.4g}" if isinstance(value, float) else str(value)
+
+    cells = [tuple(header)] + [tuple(cell(v) for v in row) for row in rows]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    for r in cells:
+        print("  ".join(f"{c:<{w}}" for c, w in zip(r, widths)).rstrip())

@@ -14,6 +14,8 @@ with ``default_text``.
 from __future__ import annotations
 
 import argparse
+import re
+from datetime import datetime
 
 from prsm_health import __version__
 from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS
@@ -48,6 +50,13 @@ LIVE_HOST, LIVE_PORT, LIVE_MESSAGE_BUDGET = "127.0.0.1", 8765, 20_000
 TRAIN_TARGETS = ("clearance", "fault", "both", "rul")
 #: ``train --cv`` when not given.
 DEFAULT_CV = 5
+#: The asset histories of ``diagnose --asset`` and ``asset`` when ``--store`` is not given.
+DEFAULT_ASSET_STORE = "prsm-assets"
+#: An asset id (prsm_health.diagnostics.asset_history, which imports numpy).
+ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
+ASSET_ID_RULE = (
+    "1–128 characters: letters, digits, '.', '_', ':' or '-', starting with a letter or digit"
+)
 
 DESIGN_HELP = "preset name (paper01…paper05) or design TOML file"
 PROFILE_HELP = (
@@ -71,6 +80,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_simulate(command)
     _add_data(command)
     _add_models(command)
+    _add_assets(command)
     _add_prognose(command)
     _add_serve(command)
     return parser
@@ -555,6 +565,44 @@ def _add_models(command) -> None:
         default_text="no plot",
         help="write a PNG of the per-window estimates",
     )
+    d.add_argument(
+        "--asset",
+        type=asset_id,
+        default=None,
+        metavar="ID",
+        default_text="no asset",
+        help="the unit the recording belongs to: read it against the unit's own baseline, add "
+        "it to the unit's evidence and save its history in --store (docs/diagnostics.md); the "
+        "same recording again is counted once",
+    )
+    _add_store(d)
+    label = d.add_mutually_exclusive_group()
+    label.add_argument(
+        "--healthy",
+        action="store_true",
+        help="--asset: the recording is known healthy: put it in the unit's baseline",
+    )
+    label.add_argument(
+        "--unhealthy",
+        action="store_true",
+        help="--asset: the recording is known not healthy: keep it out of the unit's baseline",
+    )
+    d.add_argument(
+        "--operating-hours",
+        type=non_negative_float,
+        default=None,
+        metavar="H",
+        default_text="not recorded",
+        help="--asset: the unit's operating hours at the recording [h]",
+    )
+    d.add_argument(
+        "--time",
+        type=iso_time,
+        default=None,
+        metavar="ISO",
+        default_text="the file's modification time",
+        help="--asset: when the recording was made (ISO 8601)",
+    )
     _add_json(d, "the Diagnosis contract")
     d.set_defaults(handler="models:diagnose")
 
@@ -588,6 +636,65 @@ def _add_models(command) -> None:
     _add_json(r, "every window")
     _add_live(r, rate_option=False)
     r.set_defaults(handler="models:replay")
+
+
+# ----------------------------------------------------------------------------- assets
+def asset_id(text: str) -> str:
+    """``--asset`` and ``asset show``'s ID: safe as a file name and a URL segment."""
+    if re.fullmatch(ASSET_ID_PATTERN, text) is None:
+        raise argparse.ArgumentTypeError(f"{text!r}: an asset id is {ASSET_ID_RULE}")
+    return text
+
+
+def iso_time(text: str) -> str:
+    """``--time``: an ISO 8601 date or time, kept as written."""
+    try:
+        datetime.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not an ISO 8601 date or time (e.g. 2024-05-01T10:30:00+00:00)"
+        ) from None
+    return text
+
+
+def non_negative_float(text: str) -> float:
+    value = finite_float(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: use a number >= 0")
+    return value
+
+
+def _add_store(p) -> None:
+    p.add_argument(
+        "--store",
+        default=DEFAULT_ASSET_STORE,
+        default_text=f"./{DEFAULT_ASSET_STORE}, in the current directory",
+        metavar="DIR",
+        help="directory of the asset histories, one JSON file per asset (created)",
+    )
+
+
+def _add_assets(command) -> None:
+    action = _maker(
+        command("asset", "units recorded with diagnose --asset: baseline, evidence, changes"),
+        "action",
+    )
+    s = action("show", "an asset's baseline, evidence and change statistic over its recordings")
+    s.add_argument("asset", type=asset_id, metavar="ID", help="the asset id")
+    _add_store(s)
+    s.add_argument(
+        "--model",
+        default=None,
+        default_text="none: each indicator's scale from the unit's recordings alone",
+        help="model bundle whose baseline indicators and within-unit repeatability the "
+        "baseline's scales use, as diagnose --asset uses them (--json shows the scales)",
+    )
+    _add_json(s, "the asset's history report")
+    s.set_defaults(handler="assets:show")
+    s = action("list", "the assets in the store")
+    _add_store(s)
+    _add_json(s, "the asset ids")
+    s.set_defaults(handler="assets:list_assets")
 
 
 # ----------------------------------------------------------------------------- prognose

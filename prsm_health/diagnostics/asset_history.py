@@ -1,0 +1,645 @@
+"""An asset's recorded history — its baseline, accumulated evidence and change statistic — and
+the store of histories on disk that the CLI uses.
+
+An **asset** is one unit (one actuator) recorded again and again over its life. Its history
+is a sequence of :class:`AssetEntry`, one per recording, in the order the recordings reached
+it, and the sequential state they built: the class :class:`~.baseline.Evidence` and the
+:class:`~.baseline.Cusum` on the baseline distance. :meth:`AssetHistory.record` adds one
+diagnosed recording and attaches the asset's state to the diagnosis (``Diagnosis.asset``):
+
+* while the baseline is incomplete (fewer than :data:`BASELINE_RECORDINGS` recordings in
+  it), a recording joins the baseline unless it is labelled not healthy or the diagnosis
+  names a fault with confidence (:func:`names_a_fault`); a recording labelled healthy joins
+  it at any time;
+* every recording not put in the baseline adds its class probabilities to the evidence and,
+  once the baseline is complete, its distance from the baseline to the CUSUM;
+* recording the same ``recording_id`` again changes nothing: the diagnosis comes back with
+  the state stored the first time (an interrupted or repeated run counts each recording once).
+
+:class:`AssetStore` keeps one JSON file per asset in a directory, written atomically; a file
+it cannot read is an error naming the file, never a silent fresh start.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import hashlib
+import json
+import math
+import os
+import re
+import tempfile
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from urllib.parse import quote, unquote
+
+from prsm_health.core.errors import PRSMHealthError, require
+from prsm_health.core.jsonable import dumps, finite_or_none
+
+from .baseline import EVIDENCE_NAME_PROBABILITY, Baseline, Cusum, Evidence
+from .contract import CANNOT_TELL, AssetState, BaselineState, Diagnosis, EvidenceState
+
+#: Recordings a baseline needs before recordings are scored against it. Three is the fewest
+#: whose median is robust (one odd recording of three cannot move it beyond the other two)
+#: and whose spread, with the prior scale worth :data:`~.baseline.PRIOR_WEIGHT` recordings,
+#: has 5 degrees of freedom; it is also what a commissioning routine can afford (three health
+#: checks of a new unit). More come in as recordings labelled healthy.
+BASELINE_RECORDINGS = 3
+#: The class of a healthy unit.
+HEALTHY = "healthy"
+#: An asset id: also a file name and a URL path segment (the service's pattern).
+ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
+ASSET_ID_RULE = (
+    "1–128 characters: letters, digits, '.', '_', ':' or '-', starting with a letter or digit"
+)
+#: Version of the history's JSON form.
+FORMAT = 1
+
+
+def validate_asset_id(asset_id, field_name: str = "asset_id") -> str:
+    """``asset_id`` if it is a valid asset id, else :class:`ParameterError` naming the field."""
+    require(
+        isinstance(asset_id, str) and re.fullmatch(ASSET_ID_PATTERN, asset_id) is not None,
+        field_name,
+        asset_id,
+        ASSET_ID_RULE,
+    )
+    return asset_id
+
+
+def names_a_fault(diagnosis: Diagnosis) -> bool:
+    """Whether ``diagnosis`` names a fault with confidence: a class other than healthy is
+    named (observable, calibrated probability ≥ 0.5) and healthy is outside its class set,
+    i.e. ruled out at the set's coverage (90 % for the shipped model). Such a recording is kept
+    out of a baseline in the making."""
+    named = diagnosis.fault_class not in (None, CANNOT_TELL, HEALTHY)
+    return named and HEALTHY not in (diagnosis.class_set or [])
+
+
+def bundle_priors(bundle) -> tuple[dict | None, dict | None, list[str] | None]:
+    """What a model bundle's check part (:class:`~.check_model.CheckModel`) tells a unit's
+    history: (prior scale per indicator — the within-unit repeatability, training prior per
+    class, the indicators a baseline is of); None for what the bundle lacks (a bundle without
+    a check part: the defaults of :meth:`AssetHistory.record`)."""
+    check = getattr(bundle, "check", None) or {}
+    scale, prior = check.get("repeatability"), check.get("training_prior")
+    names = check.get("feature_names")
+    return (
+        dict(scale) if scale else None,
+        dict(prior) if prior else None,
+        list(names) if names else None,
+    )
+
+
+def file_recording_id(*paths: str | Path) -> str:
+    """A recording's identifier from its file's content (and its column map's, if given):
+    the same recording under another name or path is the same recording."""
+    digest = hashlib.sha256()
+    for path in paths:
+        if path is None:
+            continue
+        try:
+            digest.update(Path(path).read_bytes())
+        except OSError as err:
+            raise PRSMHealthError(f"{path}: cannot read ({err.strerror})") from None
+        digest.update(b"\0")
+    return digest.hexdigest()[:16]
+
+
+def _by_size(changes: Mapping[str, float]) -> dict[str, float]:
+    """The finite z-scores, the largest |z| first."""
+    finite = {k: float(v) for k, v in changes.items() if math.isfinite(v)}
+    return dict(sorted(finite.items(), key=lambda kv: -abs(kv[1])))
+
+
+@dataclass(frozen=True)
+class AssetEntry:
+    """One recording of an asset, as recorded in its history.
+
+    Parameters
+    ----------
+    recording_id : str
+        The recording's identifier (unique within the history).
+    time : str
+        When it was recorded (ISO 8601), or "".
+    operating_hours : float or None [h]
+        The asset's operating hours then.
+    indicators : dict
+        Indicator → value (None where not computable), from the diagnosis.
+    class_probabilities : dict
+        Class → calibrated probability, from the diagnosis.
+    fault_class : str or None
+        The diagnosis's class.
+    clearance : dict
+        The diagnosis's clearance estimate and interval [m].
+    baseline : bool
+        Whether the recording was put in the baseline.
+    distance : float or None
+        Its distance from the baseline (:meth:`Baseline.distance`); None before the baseline
+        was complete.
+    state : AssetState or None
+        The asset's state attached to the diagnosis when it was recorded.
+    source : str
+        What the recording was (a file name), for people.
+    """
+
+    recording_id: str
+    time: str = ""
+    operating_hours: float | None = None
+    indicators: dict = field(default_factory=dict)
+    class_probabilities: dict = field(default_factory=dict)
+    fault_class: str | None = None
+    clearance: dict = field(default_factory=dict)
+    baseline: bool = False
+    distance: float | None = None
+    state: AssetState | None = None
+    source: str = ""
+
+    def __post_init__(self):
+        object.__setattr__(self, "state", AssetState.of(self.state))
+
+    def to_json(self) -> dict:
+        out = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        out["state"] = None if self.state is None else self.state.to_json()
+        return out
+
+    @classmethod
+    def from_json(cls, data: Mapping) -> AssetEntry:
+        names = {f.name for f in dataclasses.fields(cls)}
+        return cls(**{k: v for k, v in data.items() if k in names})
+
+
+@dataclass(frozen=True)
+class AssetHistory:
+    """An asset's recorded history: its entries (oldest first) and the sequential state they
+    built.
+
+    Parameters
+    ----------
+    asset_id : str
+        The asset (:data:`ASSET_ID_PATTERN`).
+    entries : tuple of AssetEntry
+        One per recording, in the order they were recorded.
+    evidence : Evidence or None
+        The class evidence of the recordings not in the baseline (None before the first).
+    cusum : Cusum
+        The change statistic of their distances from the baseline.
+    """
+
+    asset_id: str
+    entries: tuple[AssetEntry, ...] = ()
+    evidence: Evidence | None = None
+    cusum: Cusum = Cusum()
+
+    def __post_init__(self):
+        validate_asset_id(self.asset_id)
+        object.__setattr__(self, "entries", tuple(self.entries))
+
+    def baseline(
+        self,
+        prior_scale: Mapping[str, float] | None = None,
+        names: Sequence[str] | None = None,
+    ) -> Baseline | None:
+        """The baseline fitted on the entries put in it (:meth:`Baseline.fit`); None until
+        :data:`BASELINE_RECORDINGS` of them. Its indicators: ``names`` (those the members
+        have), else every indicator finite in all of them; None too when the members have none
+        of ``names`` (recordings of another kind than the baseline asked for)."""
+        members = [e for e in self.entries if e.baseline]
+        if len(members) < BASELINE_RECORDINGS:
+            return None
+        if names is not None and not any(
+            finite_or_none(e.indicators.get(n)) is not None for e in members for n in names
+        ):
+            return None
+        return Baseline.fit(
+            [e.indicators for e in members],
+            prior_scale=prior_scale,
+            names=names,
+            recordings=[e.recording_id for e in members],
+        )
+
+    def entry(self, recording_id: str) -> AssetEntry | None:
+        """The entry of ``recording_id``, or None."""
+        return next((e for e in self.entries if e.recording_id == recording_id), None)
+
+    def record(
+        self,
+        recording_id: str,
+        diagnosis: Diagnosis,
+        *,
+        healthy: bool | None = None,
+        operating_hours: float | None = None,
+        time: str = "",
+        prior_scale: Mapping[str, float] | None = None,
+        training_prior: Mapping[str, float] | None = None,
+        names: Sequence[str] | None = None,
+        source: str = "",
+    ) -> tuple[AssetHistory, Diagnosis]:
+        """Add a diagnosed recording: the new history, and the diagnosis with
+        ``asset`` (an :class:`AssetState`) attached.
+
+        Parameters
+        ----------
+        recording_id : str
+            The recording's identifier. Already recorded: the same history comes back, with
+            the diagnosis carrying the state stored then (nothing is counted twice).
+        diagnosis : Diagnosis
+            The recording's diagnosis.
+        healthy : bool or None
+            A label: True puts the recording in the baseline (at any time), False keeps it
+            out; None lets the rule decide (it joins an incomplete baseline unless
+            :func:`names_a_fault`).
+        operating_hours : float or None [h]
+            The asset's operating hours at the recording, ≥ 0.
+        time : str
+            When it was recorded (ISO 8601), or "".
+        prior_scale : mapping or None
+            Indicator → within-unit repeatability (:meth:`Baseline.fit`).
+        training_prior : mapping or None
+            Class → training share of the classifier (:meth:`Evidence.update`); uniform when
+            None or when it lacks one of the diagnosis's classes.
+        names : sequence of str or None
+            The indicators of the baseline (default: every one finite in all its recordings).
+        source : str
+            What the recording was (a file name), kept for people.
+
+        Returns
+        -------
+        (AssetHistory, Diagnosis)
+
+        Raises
+        ------
+        ParameterError
+            An empty recording id, negative or non-finite operating hours, a training prior
+            that is not > 0.
+        """
+        require(
+            isinstance(recording_id, str) and recording_id != "",
+            "recording_id",
+            recording_id,
+            "a non-empty string",
+        )
+        require(
+            operating_hours is None
+            or (finite_or_none(operating_hours) is not None and operating_hours >= 0),
+            "operating_hours",
+            operating_hours,
+            "a finite number of hours >= 0, or None",
+        )
+        stored = self.entry(recording_id)
+        if stored is not None:
+            note = (
+                f"recording {recording_id} is already in the history of asset {self.asset_id}: "
+                "its state as recorded then is shown, nothing was counted twice"
+            )
+            return self, dataclasses.replace(
+                diagnosis, asset=stored.state, warnings=[*diagnosis.warnings, note]
+            )
+
+        baseline = self.baseline(prior_scale, names)
+        indicators = {str(k): finite_or_none(v) for k, v in diagnosis.indicators.items()}
+        changes, distance = {}, None
+        if baseline is not None:
+            changes = _by_size(baseline.change(indicators))
+            distance = finite_or_none(baseline.distance(indicators))
+        notes = []
+        if healthy is None:
+            in_baseline = baseline is None and not names_a_fault(diagnosis)
+            if baseline is None and not in_baseline:
+                notes.append(
+                    f"not put in the baseline of asset {self.asset_id}: the diagnosis names "
+                    f"{diagnosis.fault_class} with healthy ruled out; label the recording "
+                    "healthy if it is"
+                )
+        else:
+            in_baseline = bool(healthy)
+
+        evidence, cusum = self.evidence, self.cusum
+        probabilities = {str(k): float(v) for k, v in diagnosis.class_probabilities.items()}
+        if not in_baseline:
+            if probabilities:
+                if evidence is not None and set(evidence.classes) != set(probabilities):
+                    notes.append(
+                        f"the model's classes differ from those of asset {self.asset_id}'s "
+                        f"evidence ({', '.join(evidence.classes)}): its evidence starts afresh"
+                    )
+                    evidence = None
+                if evidence is None:
+                    evidence = Evidence.start(tuple(probabilities))
+                # a prior of another classifier's classes (a check model's, for a recording
+                # read by the window model) does not apply: uniform
+                prior = training_prior
+                if prior is not None and any(c not in prior for c in probabilities):
+                    prior = None
+                evidence = evidence.update(probabilities, training_prior=prior)
+            if baseline is not None:
+                cusum = cusum.update(distance)
+                if cusum.alarm:
+                    notes.append(
+                        f"asset {self.asset_id} has changed from its baseline: change "
+                        f"statistic {cusum.statistic:.3g} above {cusum.threshold:g} "
+                        "(CUSUM of the baseline distance)"
+                    )
+
+        members = sum(e.baseline for e in self.entries) + in_baseline
+        complete = members >= BASELINE_RECORDINGS
+        if evidence is None and probabilities:
+            shown = Evidence.start(tuple(probabilities))
+        else:
+            shown = evidence
+        state = AssetState(
+            asset_id=self.asset_id,
+            baseline=BaselineState(
+                recordings=members,
+                needed=BASELINE_RECORDINGS,
+                changes=changes,
+                distance=distance,
+            ),
+            evidence=EvidenceState(
+                recordings=0 if evidence is None else evidence.recordings,
+                posterior={} if shown is None else shown.posterior(),
+                fault_class=CANNOT_TELL if evidence is None else evidence.named(),
+                change_statistic=cusum.statistic if complete else None,
+                change_alarm=cusum.alarm,
+            ),
+        )
+        entry = AssetEntry(
+            recording_id=recording_id,
+            time=str(time or ""),
+            operating_hours=None if operating_hours is None else float(operating_hours),
+            indicators=indicators,
+            class_probabilities=probabilities,
+            fault_class=diagnosis.fault_class,
+            clearance=dict(diagnosis.clearance.to_json()),
+            baseline=in_baseline,
+            distance=distance,
+            state=state,
+            source=str(source or ""),
+        )
+        history = AssetHistory(self.asset_id, (*self.entries, entry), evidence, cusum)
+        return history, dataclasses.replace(
+            diagnosis, asset=state, warnings=[*diagnosis.warnings, *notes]
+        )
+
+    def state(self) -> AssetState:
+        """The asset's state after its last recording (an empty one before any)."""
+        if self.entries:
+            return self.entries[-1].state
+        return AssetState(
+            asset_id=self.asset_id,
+            baseline=BaselineState(recordings=0, needed=BASELINE_RECORDINGS),
+            evidence=EvidenceState(recordings=0),
+        )
+
+    def report(
+        self,
+        prior_scale: Mapping[str, float] | None = None,
+        names: Sequence[str] | None = None,
+    ) -> dict:
+        """The asset in plain JSON values, for people and tables: its baseline (centre and
+        scale per indicator once complete, as :meth:`baseline` fits it with ``prior_scale`` and
+        ``names``), its evidence, its change statistic, and one row per recording (in the
+        baseline?, distance, the leading class and its posterior then, the class named then)."""
+        baseline = self.baseline(prior_scale, names)
+        members = sum(e.baseline for e in self.entries)
+        evidence = self.evidence
+        rows = []
+        for e in self.entries:
+            told = e.state is not None and e.state.evidence is not None
+            told = told and e.state.evidence.recordings > 0  # else the prior: no leader
+            posterior = e.state.evidence.posterior if told else {}
+            leading = max(posterior, key=posterior.get) if posterior else None
+            rows.append(
+                {
+                    "recording_id": e.recording_id,
+                    "source": e.source,
+                    "time": e.time,
+                    "operating_hours": e.operating_hours,
+                    "baseline": e.baseline,
+                    "distance": e.distance,
+                    "fault_class": e.fault_class,
+                    "leading_class": leading,
+                    "leading_posterior": None if leading is None else posterior[leading],
+                    "named": e.state.evidence.fault_class if e.state else CANNOT_TELL,
+                    "change_statistic": e.state.evidence.change_statistic if e.state else None,
+                }
+            )
+        return {
+            "asset_id": self.asset_id,
+            "recordings": len(self.entries),
+            "baseline": {
+                "recordings": members,
+                "needed": BASELINE_RECORDINGS,
+                "complete": baseline is not None,
+                "indicators": {}
+                if baseline is None
+                else {
+                    n: {"center": c, "scale": s}
+                    for n, c, s in zip(baseline.names, baseline.center, baseline.scale)
+                },
+            },
+            "evidence": {
+                "recordings": 0 if evidence is None else evidence.recordings,
+                "posterior": {} if evidence is None else evidence.posterior(),
+                "fault_class": CANNOT_TELL if evidence is None else evidence.named(),
+                "name_probability": EVIDENCE_NAME_PROBABILITY,
+            },
+            "change": self.cusum.to_json(),
+            "entries": rows,
+        }
+
+    def to_json(self) -> dict:
+        """Plain JSON values; :meth:`from_json` restores an equal history."""
+        return {
+            "format": FORMAT,
+            "asset_id": self.asset_id,
+            "entries": [e.to_json() for e in self.entries],
+            "evidence": None if self.evidence is None else self.evidence.to_json(),
+            "cusum": self.cusum.to_json(),
+        }
+
+    @classmethod
+    def from_json(cls, data: Mapping) -> AssetHistory:
+        """The history of :meth:`to_json`'s values (:class:`ParameterError` for another
+        format version)."""
+        require(data.get("format") == FORMAT, "format", data.get("format"), f"{FORMAT}")
+        evidence = data.get("evidence")
+        return cls(
+            data["asset_id"],
+            tuple(AssetEntry.from_json(e) for e in data["entries"]),
+            None if evidence is None else Evidence.from_json(evidence),
+            Cusum.from_json(data["cusum"]),
+        )
+
+
+class AssetStore:
+    """Asset histories on disk: one JSON file per asset in ``directory`` (created on the
+    first save).
+
+    The file of an asset is its id (``:`` percent-encoded) with ``.json``. :meth:`save` writes
+    a temporary file beside it and renames it over the old one, so a reader (or a run that
+    was interrupted) finds the old history or the new one, never half of one.
+    :meth:`locked` serialises the load–record–save of one asset between processes.
+    """
+
+    SUFFIX = ".json"
+
+    def __init__(self, directory: str | Path):
+        self.directory = Path(directory)
+
+    def path(self, asset_id: str) -> Path:
+        """The file of ``asset_id``."""
+        return self.directory / (quote(validate_asset_id(asset_id), safe="") + self.SUFFIX)
+
+    def load(self, asset_id: str) -> AssetHistory:
+        """The history of ``asset_id``; a new, empty one if it has none.
+
+        Raises
+        ------
+        PRSMHealthError
+            The file exists and cannot be read as a history (truncated, edited, another
+            asset's): the message names the file, which is left as it is.
+        """
+        path = self.path(asset_id)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            return AssetHistory(asset_id)
+        except (OSError, UnicodeDecodeError) as err:
+            raise PRSMHealthError(f"{path}: cannot read the asset history ({err})") from None
+        try:
+            history = AssetHistory.from_json(json.loads(text))
+        except (ValueError, KeyError, TypeError, AttributeError) as err:
+            reason = err if isinstance(err, PRSMHealthError) else f"{type(err).__name__}: {err}"
+            raise PRSMHealthError(
+                f"{path}: not a readable asset history ({reason}); it was left as it is — "
+                "restore it, or move it aside to start the asset afresh"
+            ) from None
+        if history.asset_id != asset_id:
+            raise PRSMHealthError(
+                f"{path}: holds asset {history.asset_id!r}, not {asset_id!r} (asset ids that "
+                "differ only in case share a file on a case-insensitive file system)"
+            )
+        return history
+
+    def save(self, history: AssetHistory) -> None:
+        """Write ``history`` atomically (temporary file, fsync, rename)."""
+        path = self.path(history.asset_id)
+        data = dumps(history.to_json(), indent=1).encode("utf-8")
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.directory)
+        except OSError as err:
+            raise PRSMHealthError(
+                f"{self.directory}: cannot write asset histories there ({err.strerror})"
+            ) from None
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())
+            os.chmod(tmp, 0o644)
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+
+    def assets(self) -> list[str]:
+        """The ids of the assets stored, sorted."""
+        if not self.directory.is_dir():
+            return []
+        found = []
+        for p in self.directory.iterdir():
+            if p.suffix != self.SUFFIX or p.name.startswith("."):
+                continue
+            asset_id = unquote(p.name[: -len(self.SUFFIX)])
+            if re.fullmatch(ASSET_ID_PATTERN, asset_id):
+                found.append(asset_id)
+        return sorted(found)
+
+    @contextlib.contextmanager
+    def locked(self, asset_id: str) -> Iterator[None]:
+        """Hold the asset's lock (an advisory lock file beside its history, where the system
+        has ``fcntl``): two processes recording the same asset take turns instead of one
+        overwriting the other's entry."""
+        path = self.path(asset_id)
+        try:
+            import fcntl
+        except ImportError:  # no advisory locks (Windows): the atomic save still holds
+            yield
+            return
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+            handle = open(path.with_name(f".{path.name}.lock"), "a")  # noqa: SIM115
+        except OSError as err:
+            raise PRSMHealthError(
+                f"{self.directory}: cannot write asset histories there ({err.strerror})"
+            ) from None
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+            handle.close()
+
+
+def diagnose_asset(
+    run,
+    bundle,
+    store: AssetStore,
+    asset_id: str,
+    recording_id: str,
+    *,
+    healthy: bool | None = None,
+    operating_hours: float | None = None,
+    time: str = "",
+    window: float | None = None,
+    source: str = "",
+) -> Diagnosis:
+    """Diagnose a recording of an asset against the asset's history in ``store``, record it
+    and save the history: the diagnosis with its ``asset`` state (what ``prsm-health diagnose
+    --asset`` does).
+
+    The asset's lock is held from load to save; the baseline's indicators and priors come from
+    the bundle (:func:`bundle_priors`). A recording already recorded is diagnosed again and shown with the
+    state stored then; the history is not written again.
+    """
+    from .diagnosis import diagnose  # the model's dependencies only when diagnosing
+
+    validate_asset_id(asset_id)
+    prior_scale, training_prior, names = bundle_priors(bundle)
+    with store.locked(asset_id):
+        history = store.load(asset_id)
+        baseline = history.baseline(prior_scale, names)
+        diagnosis = diagnose(run, bundle, window=window, baseline=baseline)
+        new, diagnosis = history.record(
+            recording_id,
+            diagnosis,
+            healthy=healthy,
+            operating_hours=operating_hours,
+            time=time,
+            prior_scale=prior_scale,
+            training_prior=training_prior,
+            names=names,
+            source=source,
+        )
+        if new is not history:
+            store.save(new)
+    return diagnosis
+
+
+__all__ = [
+    "ASSET_ID_PATTERN",
+    "BASELINE_RECORDINGS",
+    "AssetEntry",
+    "AssetHistory",
+    "AssetStore",
+    "bundle_priors",
+    "diagnose_asset",
+    "file_recording_id",
+    "names_a_fault",
+    "validate_asset_id",
+]

@@ -1,0 +1,282 @@
+"""An asset's history (prsm_health.diagnostics.asset_history): the baseline fills with its first
+recordings, then evidence and the change statistic accumulate; a recording recorded twice
+counts once; the history and its store on disk round-trip exactly, save atomically and refuse
+a damaged file by name. Synthetic diagnoses, no model."""
+
+import json
+import math
+import os
+
+import numpy as np
+import pytest
+
+from prsm_health.core.errors import ParameterError, PRSMHealthError
+from prsm_health.core.jsonable import dumps
+from prsm_health.diagnostics.asset_history import (
+    BASELINE_RECORDINGS,
+    AssetHistory,
+    AssetStore,
+    bundle_priors,
+    names_a_fault,
+    validate_asset_id,
+)
+from prsm_health.diagnostics.baseline import Baseline, Cusum, Evidence
+from prsm_health.diagnostics.contract import (
+    CANNOT_TELL,
+    AssetState,
+    ClearanceInterval,
+    Diagnosis,
+    ModelReference,
+    Observability,
+)
+
+CLASSES = ("healthy", "lubrication", "wear")
+
+
+def diagnosis(a=1.0, b=10.0, probabilities=None, fault_class=CANNOT_TELL, class_set=None):
+    probabilities = probabilities or {"healthy": 0.5, "lubrication": 0.25, "wear": 0.25}
+    return Diagnosis(
+        clearance=ClearanceInterval(10e-6, 8e-6, 12e-6),
+        fault_class=fault_class,
+        class_probabilities=probabilities,
+        class_set=list(CLASSES) if class_set is None else class_set,
+        observability=Observability(True, True),
+        indicators={"a": a, "b": b, "gone": None},
+        model=ModelReference("m", "1", "paper01", "flight-ema"),
+    )
+
+
+WEAR = {"healthy": 0.1, "lubrication": 0.1, "wear": 0.8}
+PRIOR = {"a": 0.1, "b": 1.0}
+
+
+def recorded(values, **kwargs):
+    """A history after recording ``values`` = [(a, b, probabilities or None), …] as r0, r1 …"""
+    h, out = AssetHistory("unit-1"), []
+    for i, (a, b, p) in enumerate(values):
+        h, d = h.record(f"r{i}", diagnosis(a, b, p), prior_scale=PRIOR, **kwargs)
+        out.append(d)
+    return h, out
+
+
+BASE = [(1.0, 10.0, None), (1.1, 10.5, None), (0.9, 9.5, None)]
+
+
+def test_baseline_fills_with_the_first_three_then_evidence_accumulates():
+    assert BASELINE_RECORDINGS == 3
+    h, out = recorded(BASE[:2])
+    assert h.baseline(PRIOR) is None
+    assert [d.asset.baseline.recordings for d in out] == [1, 2]
+    h, out = recorded([*BASE, (1.5, 10.0, WEAR), (1.6, 10.2, WEAR)])
+    assert [e.baseline for e in h.entries] == [True, True, True, False, False]
+    assert [d.asset.baseline.recordings for d in out] == [1, 2, 3, 3, 3]
+    # nothing scored, no evidence, while the baseline fills
+    for d in out[:3]:
+        assert d.asset.baseline.changes == {} and d.asset.baseline.distance is None
+        assert d.asset.evidence.recordings == 0
+    assert out[1].asset.evidence.change_statistic is None
+    assert out[2].asset.evidence.change_statistic == 0.0  # complete: the CUSUM starts
+    # then each recording is scored against the baseline and adds its evidence
+    baseline = Baseline.fit(
+        [{"a": a, "b": b} for a, b, _ in BASE], prior_scale=PRIOR, recordings=["r0", "r1", "r2"]
+    )
+    assert h.baseline(PRIOR) == baseline
+    fourth = out[3].asset
+    z = baseline.change({"a": 1.5, "b": 10.0})
+    assert fourth.baseline.changes == {"a": z["a"], "b": z["b"]}  # largest |z| first
+    assert list(fourth.baseline.changes) == ["a", "b"]
+    assert fourth.baseline.distance == baseline.distance({"a": 1.5, "b": 10.0})
+    expected = Evidence.start(CLASSES).update(WEAR).update(WEAR)
+    assert out[4].asset.evidence.recordings == 2 == h.evidence.recordings
+    assert out[4].asset.evidence.posterior == expected.posterior()
+    assert out[4].asset.evidence.fault_class == expected.named()
+    cusum = Cusum().update(fourth.baseline.distance).update(h.entries[4].distance)
+    assert h.cusum == cusum
+    assert out[4].asset.evidence.change_statistic == cusum.statistic
+    # the diagnosis itself is the one given, with the asset attached
+    assert out[4].fault_class == CANNOT_TELL and out[4].to_json()["asset"]["asset_id"] == "unit-1"
+
+
+def test_a_confident_fault_stays_out_of_a_baseline_in_the_making():
+    h = AssetHistory("u")
+    wear = diagnosis(probabilities=WEAR, fault_class="wear", class_set=["wear"])
+    assert names_a_fault(wear)
+    # named but healthy not ruled out, or not named: not confident
+    assert not names_a_fault(diagnosis(probabilities=WEAR, fault_class="wear"))
+    assert not names_a_fault(diagnosis(fault_class="healthy", class_set=["healthy"]))
+    h, d = h.record("w", wear)
+    assert not h.entries[0].baseline and h.evidence.recordings == 1
+    assert d.asset.baseline.recordings == 0
+    assert any("not put in the baseline" in w for w in d.warnings)
+    # a label decides: healthy=True puts it in, healthy=False keeps a plain one out
+    h, _ = h.record("w2", wear, healthy=True)
+    h, _ = h.record("x", diagnosis(), healthy=False)
+    assert [e.baseline for e in h.entries] == [False, True, False]
+    assert h.evidence.recordings == 2  # the recordings outside the baseline
+
+
+def test_healthy_label_adds_to_a_complete_baseline():
+    h, _ = recorded(BASE)
+    h, d = h.record("late", diagnosis(1.2, 10.1), healthy=True, prior_scale=PRIOR)
+    assert h.entries[-1].baseline and d.asset.baseline.recordings == 4
+    assert h.baseline(PRIOR).count == 4
+    assert h.evidence is None and h.cusum == Cusum()  # baseline recordings add no evidence
+    assert d.asset.baseline.distance is not None  # scored against the baseline before it
+
+
+def test_the_same_recording_twice_is_counted_once():
+    h, out = recorded([*BASE, (1.5, 10.0, WEAR)])
+    again, d = h.record("r3", diagnosis(5.0, 50.0, WEAR), prior_scale=PRIOR)
+    assert again is h
+    assert d.asset == out[3].asset
+    assert any("already in the history" in w for w in d.warnings)
+    again, _ = h.record("r0", diagnosis(), healthy=True)
+    assert again is h and sum(e.baseline for e in h.entries) == 3
+
+
+def test_evidence_restarts_when_the_classes_change():
+    h, _ = recorded([*BASE, (1.5, 10.0, WEAR)])
+    other = {"healthy": 0.2, "spall": 0.8}
+    h, d = h.record("new", diagnosis(1.0, 10.0, other), prior_scale=PRIOR)
+    assert h.evidence.classes == ("healthy", "spall") and h.evidence.recordings == 1
+    assert any("starts afresh" in w for w in d.warnings)
+
+
+def test_training_prior_is_used_when_it_covers_the_classes():
+    prior = {"healthy": 0.5, "lubrication": 0.25, "wear": 0.25}
+    h, _ = recorded([*BASE, (1.0, 10.0, prior)], training_prior=prior)
+    # the classifier said its own prior: no evidence either way
+    assert h.evidence.posterior() == pytest.approx({c: 1 / 3 for c in CLASSES})
+    h, _ = recorded([*BASE, (1.0, 10.0, prior)], training_prior={"healthy": 1.0})
+    assert h.evidence.posterior()["healthy"] == pytest.approx(0.5)  # not covering: uniform
+
+
+def test_cusum_alarm_is_a_warning():
+    h, out = recorded([*BASE, *[(5.0, 30.0, WEAR)] * 2])
+    assert out[3].asset.baseline.distance > 6.5  # k + h: at once
+    assert out[3].asset.evidence.change_alarm
+    assert any("has changed from its baseline" in w for w in out[3].warnings)
+
+
+def test_history_json_round_trip_is_exact():
+    h, _ = recorded([*BASE, (1.5, 10.0, WEAR), (1.3, 9.0, WEAR)], operating_hours=12.5)
+    h, _ = h.record("t", diagnosis(), time="2024-05-01T10:00:00+00:00", source="t.mcap")
+    text = dumps(h.to_json())
+    again = AssetHistory.from_json(json.loads(text))
+    assert again == h
+    assert isinstance(again.entries[0].state, AssetState)
+    assert again.entries[-1].time == "2024-05-01T10:00:00+00:00"
+    assert again.entries[0].indicators["gone"] is None
+    assert dumps(again.to_json()) == text
+
+
+def test_report_has_a_row_per_recording():
+    h, _ = recorded([*BASE, (1.5, 10.0, WEAR)])
+    r = h.report(PRIOR)
+    assert r["baseline"]["complete"] and set(r["baseline"]["indicators"]) == {"a", "b"}
+    assert [row["baseline"] for row in r["entries"]] == [True, True, True, False]
+    assert r["entries"][0]["leading_class"] is None  # no evidence yet: no leader
+    assert r["entries"][3]["leading_class"] == "wear"
+    assert r["evidence"]["recordings"] == 1
+    json.dumps(r, allow_nan=False)
+
+
+def test_bad_input_names_the_field():
+    with pytest.raises(ParameterError, match="asset_id"):
+        AssetHistory("../etc")
+    for bad in ("", "a/b", "-x", "a b", "x" * 129, None):
+        with pytest.raises(ParameterError, match="asset_id"):
+            validate_asset_id(bad)
+    assert validate_asset_id("Pump-7:left_1.2") == "Pump-7:left_1.2"
+    h = AssetHistory("u")
+    with pytest.raises(ParameterError, match="recording_id"):
+        h.record("", diagnosis())
+    with pytest.raises(ParameterError, match="operating_hours"):
+        h.record("r", diagnosis(), operating_hours=-1.0)
+
+
+def test_bundle_priors_read_the_check_part():
+    class Bundle:
+        check = {
+            "repeatability": {"a": 0.1},
+            "training_prior": {"healthy": 0.6, "wear": 0.4},
+            "feature_names": ["a"],
+        }
+
+    assert bundle_priors(Bundle()) == ({"a": 0.1}, {"healthy": 0.6, "wear": 0.4}, ["a"])
+    assert bundle_priors(object()) == (None, None, None)
+
+
+def test_baseline_of_other_indicators_is_none():
+    h, _ = recorded(BASE)
+    assert h.baseline(PRIOR, names=["elsewhere"]) is None
+    assert h.baseline(PRIOR, names=["b"]).names == ("b",)
+
+
+# ----------------------------------------------------------------------------- AssetStore
+def test_store_round_trip_and_listing(tmp_path):
+    store = AssetStore(tmp_path / "assets")
+    assert store.assets() == []
+    fresh = store.load("pump:7")
+    assert fresh == AssetHistory("pump:7")
+    h, _ = recorded(BASE)
+    h = AssetHistory("pump:7", h.entries, h.evidence, h.cusum)
+    store.save(h)
+    assert store.load("pump:7") == h
+    store.save(AssetHistory("A1"))
+    assert store.assets() == ["A1", "pump:7"]
+    assert store.path("pump:7").name == "pump%3A7.json"
+    # no temporary file left behind
+    assert sorted(p.name for p in store.directory.iterdir()) == ["A1.json", "pump%3A7.json"]
+
+
+def test_save_is_atomic(tmp_path, monkeypatch):
+    store = AssetStore(tmp_path)
+    h, _ = recorded(BASE[:1])
+    store.save(h)
+    before = store.path("unit-1").read_bytes()
+
+    def fail(src, dst):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(os, "replace", fail)
+    longer, _ = recorded(BASE)
+    with pytest.raises(OSError):
+        store.save(longer)
+    # the old history intact, the temporary file removed
+    assert store.path("unit-1").read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["unit-1.json"]
+
+
+def test_a_damaged_file_is_an_error_naming_it(tmp_path):
+    store = AssetStore(tmp_path)
+    h, _ = recorded(BASE)
+    store.save(h)
+    path = store.path("unit-1")
+    text = path.read_text()
+    path.write_text(text[: len(text) // 2])  # truncated
+    with pytest.raises(PRSMHealthError, match="unit-1.json: not a readable asset history"):
+        store.load("unit-1")
+    assert path.read_text() == text[: len(text) // 2]  # left as it is
+    path.write_text(json.dumps({"format": 1, "asset_id": "unit-1"}))
+    with pytest.raises(PRSMHealthError, match="unit-1.json"):
+        store.load("unit-1")
+    path.write_text(json.dumps({**h.to_json(), "asset_id": "Unit-1"}))
+    with pytest.raises(PRSMHealthError, match="holds asset 'Unit-1'"):
+        store.load("unit-1")
+
+
+def test_lock_serialises_one_asset(tmp_path):
+    store = AssetStore(tmp_path)
+    with store.locked("u"):
+        store.save(AssetHistory("u"))
+    assert store.assets() == ["u"]
+
+
+def test_distance_is_finite_json(tmp_path):
+    # a recording with no finite indicator of the baseline: distance null, CUSUM unchanged
+    h, _ = recorded(BASE)
+    h, d = h.record("empty", diagnosis(math.nan, math.nan, WEAR), prior_scale=PRIOR)
+    assert d.asset.baseline.distance is None and h.cusum == Cusum()
+    assert np.isfinite(h.evidence.log_posterior).all()
+    json.dumps(d.to_json()["asset"], allow_nan=False)
