@@ -8,13 +8,17 @@ checks are :meth:`Run.validate <prsm_health.core.run.Run.validate>`'s, and each 
 its recording into windows once (:func:`~prsm_health.diagnostics.diagnosis.split_windows`).
 
 Everything that crosses to and from a diagnosis process is plain data: the request body as
-bytes (decoded in the process: cheaper to send than decoded arrays), and back the answer's
-JSON bytes and the history rows (built there too, so the server process never encodes a
-diagnosis).
+bytes (decoded in the process: cheaper to send than decoded arrays) with the asset's baseline
+as JSON (:class:`~.evidence.BaselineFor`), and back the answer's JSON bytes and the history
+rows (built there too, so the server process encodes no windows). A request naming an asset
+sends back instead the recording's diagnosis (the contract value, its windows left out)
+and the answer's other parts already encoded (:class:`~.evidence.AssetPart`): the server
+records it in the asset's history and encodes that one diagnosis with its ``asset`` part.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 
@@ -24,12 +28,14 @@ from prsm_health.core.channels import CHANNEL_NAMES
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import json_ready
 from prsm_health.core.run import MIN_SAMPLES, Run
+from prsm_health.diagnostics.check_model import is_check
 from prsm_health.diagnostics.diagnosis import diagnose, split_windows
 from prsm_health.io import read_with_warnings
 from prsm_health.io.column_map import column_map_from_text
 from prsm_health.io.derived import derive_channels
 from prsm_health.signals.envelope_analysis import window_spectra
 
+from .evidence import AssetPart, BaselineFor, content_id, run_id
 from .history import history_rows, spectra_row, utc_now
 from .limits import MAX_ABS_VALUE, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
@@ -43,6 +49,12 @@ def diagnosis_json(run: Run, bundle, windows: tuple | None = None) -> dict:
     """The library's diagnosis of ``run`` as a JSON-ready dict (with ``windows``);
     ``windows``: ``run`` already cut by :func:`split_windows` with the model's window."""
     return json_ready(diagnose(run, bundle, windows=windows).to_json())
+
+
+def _row_fields(result: dict) -> dict:
+    """What a history row takes from a diagnosis besides its JSON (replaced with the
+    recorded diagnosis': :meth:`AssetPart.answer <.evidence.AssetPart.answer>`)."""
+    return {k: result.get(k) for k in ("clearance", "fault_class", "class_probabilities", "model")}
 
 
 def check_run(run: Run, limits: ServiceLimits, *, max_samples: int, what: str = "") -> None:
@@ -82,13 +94,15 @@ SPECTRA_CHANNEL = "nut_axial_accel"
 @dataclass(frozen=True)
 class Answer:
     """What a diagnose request gives back to the route: the encoded JSON answer and, when the
-    request named an asset, its history rows (:func:`~.history.history_rows`) and the spectra
+    request named an asset, its history rows (:func:`~.history.history_rows`), the spectra
     row of the recording's last window (:func:`~.history.spectra_row`; None when the recording
-    has no nut axial acceleration)."""
+    has no nut axial acceleration) and what the asset's history needs (:class:`AssetPart`:
+    the answer is then made in the server, ``encoded`` is empty)."""
 
     encoded: bytes
     history: list | None = None
     spectra: tuple | None = None
+    asset: AssetPart | None = None
 
 
 def last_window_spectra(
@@ -127,6 +141,8 @@ class BodyParams:
     design: str | None = None
     operating_hours: float | None = None
     gear_ratio: float | None = None
+    healthy: bool | None = None
+    recording_id: str | None = None
 
 
 def check_design(design: str | None, bundle) -> None:
@@ -223,6 +239,21 @@ def read_measured(source, *, fmt: str, name: str, column_map=None) -> tuple[Run,
     return recording.run.without_truth(), list(recording.warnings)
 
 
+def _windows(run: Run, cut: tuple) -> tuple | None:
+    """The cut a diagnosis is given: none for a health-check recording, which the library reads
+    phase by phase (with a model that has a check part) rather than window by window."""
+    return None if is_check(run) else cut
+
+
+def check_asset_fields(asset_id, healthy, recording_id) -> None:
+    """``healthy`` and ``recording_id`` are about the asset's history: 422 without an asset."""
+    if asset_id is None and (healthy is not None or recording_id is not None):
+        given = "healthy" if healthy is not None else "recording_id"
+        raise HTTPError(
+            422, f"{given} is about an asset's history: give asset_id with it (or leave it out)"
+        )
+
+
 def diagnose_body(
     bundle,
     body: bytes,
@@ -230,17 +261,18 @@ def diagnose_body(
     params: BodyParams | None,
     limits: ServiceLimits,
     received_at: str,
+    baseline: BaselineFor | None = None,
 ) -> Answer:
     """``POST /v1/diagnose``: a JSON body (``fmt`` ``"json"``, fields in the body) or a binary
     recording (``params`` from the query) → the Diagnosis contract (``windows`` only when the
-    recording spans more than one model window) and, with an ``asset_id``, its history row."""
+    recording spans more than one model window) and, with an ``asset_id``, its history row
+    and the recording's diagnosis for the asset's history, made with the asset's
+    ``baseline`` (loaded for the asset the request names)."""
     notes: list[str] = []
     if fmt == "json":
         req = parse_diagnose_request(body, limits)
         run = run_from_request(req, bundle)
-        params = BodyParams(
-            req.asset_id, req.speed, req.load, req.design, req.operating_hours, req.gear_ratio
-        )
+        params = BodyParams(**{f: getattr(req, f) for f in BodyParams.__dataclass_fields__})
     else:
         params = params or BodyParams()
         check_design(params.design, bundle)
@@ -254,40 +286,53 @@ def diagnose_body(
             labels["axial_load"] = params.load
         if params.gear_ratio is not None:
             labels["gear_ratio"] = params.gear_ratio
-        run = Run(run.time, run.channels, run.sample_rate, labels, run.scenario)
+        run = dataclasses.replace(run, labels=labels)  # a check's phases kept
         limits.check_sample_rate(run.sample_rate, _what(fmt))  # a JSON body's is validated
     max_samples = limits.max_json_samples(run.sample_rate)
     if len(run) > max_samples:
         raise _too_long(len(run), run.sample_rate, limits)
     check_run(run, limits, max_samples=max(max_samples, MIN_SAMPLES), what=_what(fmt))
+    check_asset_fields(params.asset_id, params.healthy, params.recording_id)
     cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
-    result = diagnosis_json(run, bundle, cut)
+    base = None if baseline is None else baseline.get(params.asset_id)
+    diagnosis = diagnose(run, bundle, windows=_windows(run, cut), baseline=base)
+    if notes:
+        diagnosis.warnings[:0] = notes
+    result = json_ready(diagnosis.to_json())
     windows = result.get("windows", [])
     if len(windows) <= 1:
         result.pop("windows", None)
-    if notes:
-        result["warnings"] = [*notes, *result.get("warnings", [])]
-    history = spectra = None
-    if params.asset_id is not None:
-        history = history_rows(
-            params.asset_id,
-            [result],
-            received_at=received_at,
-            source=fmt,
-            speed=params.speed,
-            load=params.load,
-            operating_hours=params.operating_hours,
-        )
-        spectra = last_window_spectra(
-            cut[0][-1],
-            bundle,
-            params.asset_id,
-            windows,
-            received_at=received_at,
-            source=fmt,
-            operating_hours=params.operating_hours,
-        )
-    return Answer(encode(result), history, spectra)
+    if params.asset_id is None:
+        return Answer(encode(result))
+    history = history_rows(
+        params.asset_id,
+        [_row_fields(result)],
+        received_at=received_at,
+        source=fmt,
+        speed=params.speed,
+        load=params.load,
+        operating_hours=params.operating_hours,
+    )
+    spectra = last_window_spectra(
+        cut[0][-1],
+        bundle,
+        params.asset_id,
+        windows,
+        received_at=received_at,
+        source=fmt,
+        operating_hours=params.operating_hours,
+    )
+    part = AssetPart(
+        params.asset_id,
+        params.recording_id or (content_id(body) if fmt != "json" else run_id(run)),
+        dataclasses.replace(diagnosis, windows=[]),
+        source=fmt,
+        healthy=params.healthy,
+        operating_hours=params.operating_hours,
+        inner=b',"windows":' + encode(windows) if "windows" in result else b"",
+        row=0,
+    )
+    return Answer(b"", history, spectra, part)
 
 
 def _what(fmt: str) -> str:
@@ -322,14 +367,20 @@ def diagnose_upload(
     limits: ServiceLimits,
     asset_id: str | None = None,
     received_at: str | None = None,
+    baseline: BaselineFor | None = None,
+    healthy: bool | None = None,
+    recording_id: str | None = None,
 ) -> Answer:
     """``POST /v1/diagnose/file``: the whole-recording diagnosis, the per-window ones, what
-    was read and the reader's notes; with an ``asset_id``, the windows' history rows."""
+    was read and the reader's notes; with an ``asset_id``, the windows' history rows and the
+    recording's diagnosis for the asset's history, made with the asset's ``baseline``."""
     run, notes = read_upload(upload, limits)
     check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
     cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
-    result = diagnosis_json(run, bundle, cut)
-    per_window = result.pop("windows")
+    base = None if baseline is None else baseline.get(asset_id)
+    diagnosis = diagnose(run, bundle, windows=_windows(run, cut), baseline=base)
+    result = json_ready(diagnosis.to_json())
+    per_window = result.pop("windows", [])
     recording = {
         "filename": upload.filename,
         "samples": len(run),
@@ -337,24 +388,37 @@ def diagnose_upload(
         "duration": float(len(run) / run.sample_rate),
         "channels": [c for c in CHANNEL_NAMES if c in run.channels],
     }
-    answer = {"diagnosis": result, "windows": per_window, "recording": recording, "warnings": notes}
-    history = spectra = None
-    if asset_id is not None:
-        received_at = received_at or utc_now()
-        history = history_rows(
-            asset_id,
-            per_window,
-            received_at=received_at,
-            source="file",
-            filename=upload.filename,
-        )
-        spectra = last_window_spectra(
-            cut[0][-1],
-            bundle,
-            asset_id,
-            per_window,
-            received_at=received_at,
-            source="file",
-            filename=upload.filename,
-        )
-    return Answer(encode(answer), history, spectra)
+    rest = {"windows": per_window, "recording": recording, "warnings": notes}
+    if asset_id is None:
+        return Answer(encode({"diagnosis": result, **rest}))
+    received_at = received_at or utc_now()
+    history = history_rows(
+        asset_id,
+        per_window,
+        received_at=received_at,
+        source="file",
+        filename=upload.filename,
+    )
+    spectra = last_window_spectra(
+        cut[0][-1],
+        bundle,
+        asset_id,
+        per_window,
+        received_at=received_at,
+        source="file",
+        filename=upload.filename,
+    )
+    if recording_id is None:  # the file's content, with its column map's
+        maps = () if upload.column_map is None else (upload.column_map,)
+        recording_id = content_id(upload.path, *maps)
+    part = AssetPart(
+        asset_id,
+        recording_id,
+        dataclasses.replace(diagnosis, windows=[]),
+        source="file",
+        filename=upload.filename,
+        healthy=healthy,
+        head=b'{"diagnosis":',
+        tail=b"," + encode(rest)[1:],
+    )
+    return Answer(b"", history, spectra, part)

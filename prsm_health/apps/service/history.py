@@ -1,7 +1,8 @@
 """Diagnoses per asset over time: :class:`HistoryStore` (embedded SQLite, WAL journal), its
 default location (:func:`default_db_path`), its time format (:func:`utc_now`,
 :func:`parse_time`), the table a prognosis is made from (:func:`prognosis_history`) and each
-asset's latest window spectra (:func:`spectra_row`)."""
+asset's latest window spectra (:func:`spectra_row`). Each asset's own history — its baseline
+and accumulated evidence — is kept in the store's asset tables (:mod:`.asset_tables`)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,16 @@ from typing import NamedTuple
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps, json_ready
 
+from .asset_tables import (  # noqa: F401 (re-exported: the rows of the store's tables)
+    ASSET_SCHEMA,
+    AssetTables,
+    AssetUpdate,
+    RecordingRow,
+    StoredHistory,
+    _insert,
+    _named,
+)
+
 #: Environment variable overriding the default history database path.
 DB_ENV = "PRSM_HEALTH_DB"
 
@@ -30,7 +41,8 @@ def default_db_path() -> Path:
     return Path(base) / "prsm-health" / "history.sqlite"
 
 
-_SCHEMA = """
+_SCHEMA = (
+    """
 CREATE TABLE IF NOT EXISTS diagnoses (
     id                  INTEGER PRIMARY KEY AUTOINCREMENT,
     asset_id            TEXT    NOT NULL,
@@ -66,10 +78,14 @@ CREATE TABLE IF NOT EXISTS spectra (
     spectra             TEXT    NOT NULL      -- JSON: prsm_health.signals.envelope_analysis.window_spectra
 );
 """
+    + ASSET_SCHEMA
+)
 #: Version 1: the diagnoses table without ``operating_hours``; version 2 added it (a version 1
 #: database gets the column on open, its existing rows NULL); version 3 added the ``spectra``
-#: table (created on open: ``CREATE TABLE IF NOT EXISTS`` above).
-_SCHEMA_VERSION = 3
+#: table (created on open: ``CREATE TABLE IF NOT EXISTS`` above); version 4 the
+#: ``asset_histories`` and ``asset_recordings`` tables (created on open, empty: an asset's
+#: baseline and evidence start with its next recording).
+_SCHEMA_VERSION = 4
 
 
 class DiagnosisRow(NamedTuple):
@@ -123,22 +139,8 @@ class OperatingRow(NamedTuple):
     design: str | None
 
 
-def _insert(verb: str, table: str, row_type: type[NamedTuple]) -> str:
-    """The ``INSERT`` statement of a row type, its values bound by column name."""
-    columns = row_type._fields
-    return (
-        f"{verb} INTO {table} ({', '.join(columns)}) VALUES ({', '.join(':' + c for c in columns)})"
-    )
-
-
 _INSERT_DIAGNOSIS = _insert("INSERT", "diagnoses", DiagnosisRow)
 _INSERT_SPECTRA = _insert("INSERT OR REPLACE", "spectra", SpectraRow)
-
-
-def _named(cursor: sqlite3.Cursor) -> list[dict]:
-    """A query's rows as dicts by column name (``AS`` names for expressions)."""
-    names = [d[0] for d in cursor.description]
-    return [dict(zip(names, row)) for row in cursor.fetchall()]
 
 
 def utc_now() -> str:
@@ -162,7 +164,7 @@ def parse_time(text: str, field: str = "since") -> str:
         raise PRSMHealthError(f"{field} = {text!r} is out of range") from None
 
 
-class HistoryStore:
+class HistoryStore(AssetTables):
     """Diagnoses per asset over time, in an embedded SQLite database.
 
     The database uses the WAL journal (readers never block the writer, a crash never leaves a
@@ -188,6 +190,9 @@ class HistoryStore:
             if Path(self.path).is_dir():
                 raise PRSMHealthError(f"{self.path}: is a directory, not a database file")
         self._lock = threading.Lock()
+        #: Parsed asset histories, by asset and stored version, kept by
+        #: :mod:`prsm_health.apps.service.evidence` (one per store: versions are per database).
+        self.parsed_histories = None
         try:
             self._conn = sqlite3.connect(
                 self.path, timeout=timeout, isolation_level=None, check_same_thread=False
@@ -224,7 +229,9 @@ class HistoryStore:
         two processes opening the same file migrate it once): version 1 → 2 adds the nullable
         ``operating_hours`` column; version 2 → 3 adds the ``spectra`` table, which the schema's
         ``CREATE TABLE IF NOT EXISTS`` has created just before (empty: spectra come with the
-        next recordings)."""
+        next recordings); version 3 → 4 adds the ``asset_histories`` and ``asset_recordings``
+        tables the same way (empty: each asset's baseline and evidence start with its next
+        recording; its stored diagnoses are not replayed into them)."""
         columns = {row[1] for row in self._conn.execute("PRAGMA table_info(diagnoses)")}
         if "operating_hours" not in columns:
             self._conn.execute("ALTER TABLE diagnoses ADD COLUMN operating_hours REAL")
@@ -272,14 +279,17 @@ class HistoryStore:
         given, the asset's latest spectra (a :func:`spectra_row`, replacing the asset's
         previous one) in one transaction; returns the rows' ids. Plain tuples in column
         order are taken too."""
-        ids = []
         with self._lock, self._transaction():
-            if spectra is not None:
-                self._conn.execute(_INSERT_SPECTRA, SpectraRow._make(spectra)._asdict())
-            for row in rows:
-                cur = self._conn.execute(_INSERT_DIAGNOSIS, DiagnosisRow._make(row)._asdict())
-                ids.append(cur.lastrowid)
-        return ids
+            return self._write_rows(rows, spectra)
+
+    def _write_rows(self, rows: list, spectra: tuple | None) -> list[int]:
+        # under self._lock, in a transaction
+        if spectra is not None:
+            self._conn.execute(_INSERT_SPECTRA, SpectraRow._make(spectra)._asdict())
+        return [
+            self._conn.execute(_INSERT_DIAGNOSIS, DiagnosisRow._make(row)._asdict()).lastrowid
+            for row in rows
+        ]
 
     def history(self, asset_id: str, *, since: str | None = None, limit: int = 100) -> dict:
         """The most recent ``limit`` diagnoses of an asset at or after ``since`` (ISO-8601),
@@ -409,6 +419,7 @@ class HistoryStore:
         spectra = self._conn.execute(
             "SELECT received_at FROM spectra WHERE asset_id = ?", (asset_id,)
         ).fetchone()
+        baseline, evidence = self._asset_state(asset_id)
         warnings, model = latest["warnings"], latest["model"]
         return {
             "asset_id": asset_id,
@@ -431,6 +442,8 @@ class HistoryStore:
                 "model": json.loads(model) if model else None,
             },
             "spectra_received_at": None if spectra is None else spectra[0],
+            "baseline": baseline,
+            "evidence": evidence,
         }
 
     def has_asset(self, asset_id: str) -> bool:

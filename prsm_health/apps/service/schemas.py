@@ -31,13 +31,12 @@ from pydantic import (
 from pydantic_core import PydanticKnownError
 
 from prsm_health.core.channels import CHANNEL_NAMES, CHANNELS, TRUTH_NAMES, TRUTH_PREFIX
+from prsm_health.core.identifiers import ASSET_ID_PATTERN, RECORDING_ID_PATTERN
 from prsm_health.diagnostics import contract
 
 from .limits import MAX_OPERATING_HOURS, ServiceLimits
 from .responses import HTTPError
 
-#: Pattern of an asset id (also a URL path segment).
-ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
 _DEFAULT_LIMITS = ServiceLimits()
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -45,6 +44,20 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 OPERATING_HOURS_DESCRIPTION = (
     "operating hours of the asset when the recording was made [h], 0 – 1e7; stored with the "
     "diagnosis and used by GET /v1/assets/{asset_id}/prognosis"
+)
+
+#: What ``healthy`` of a diagnose request means (JSON field, query parameter, form field).
+HEALTHY_DESCRIPTION = (
+    "with asset_id: the recording is of the asset in a known healthy state — true puts it in "
+    "the asset's baseline (at any time), false keeps it out; absent: it joins a baseline that "
+    "has fewer than `needed` recordings unless the diagnosis names a fault with healthy ruled "
+    "out"
+)
+#: What ``recording_id`` of a diagnose request means.
+RECORDING_ID_DESCRIPTION = (
+    "with asset_id: the recording's identifier in the asset's history; a recording sent again "
+    "with the same id is not counted twice (its answer carries the asset's state recorded "
+    "then). Default: a hash of the recording's content (sample rate, start time, channels)"
 )
 
 # One optional array per measured contract channel; any other name is an error
@@ -92,7 +105,17 @@ class DiagnoseParams(BaseModel):
     asset_id: str | None = Field(
         None,
         pattern=ASSET_ID_PATTERN,
-        description="store the diagnosis in this asset's history",
+        description="store the diagnosis in this asset's history, judge the recording against "
+        "the asset's own baseline and add it to the asset's evidence (the answer's `asset`)",
+    )
+    healthy: bool | None = Field(
+        None,
+        description=HEALTHY_DESCRIPTION,
+    )
+    recording_id: str | None = Field(
+        None,
+        pattern=RECORDING_ID_PATTERN,
+        description=RECORDING_ID_DESCRIPTION,
     )
 
 
@@ -183,6 +206,7 @@ _CONTRACT: dict[str, type[BaseModel]] = {}
 Diagnosis = contract_model(contract.Diagnosis, _CONTRACT)
 ClearanceInterval = _CONTRACT["ClearanceInterval"]
 WindowSpan = _CONTRACT["WindowSpan"]
+AssetState = _CONTRACT["AssetState"]
 
 
 class RecordingInfo(BaseModel):
@@ -291,6 +315,82 @@ class PrognosisBrief(BaseModel):
     status: int | None = Field(None, description="the prognosis endpoint's status: 422, 503")
 
 
+class BaselineMember(BaseModel):
+    """A recording in an asset's baseline."""
+
+    recording_id: str
+    received_at: str = Field(description="server receive time, UTC ISO-8601")
+    source: str = Field(description="'json', 'arrow', 'parquet', 'mcap' or 'file'")
+    filename: str | None
+    operating_hours: float | None = Field(description="[h], as sent")
+    healthy: bool | None = Field(
+        description="as the client marked it (null: not said; the rule put it in)"
+    )
+
+
+class AssetBaseline(BaseModel):
+    """An asset's own baseline: the recordings it is fitted on."""
+
+    recordings: int = Field(description="recordings in the baseline")
+    needed: int | None = Field(description="recordings a baseline needs before changes are scored")
+    members: list[BaselineMember] = Field(description="the baseline's recordings, oldest first")
+
+
+class AssetEvidence(BaseModel):
+    """An asset's class evidence and change statistic after its latest recording (the
+    contract's ``asset.evidence``, with the recording and its baseline distance)."""
+
+    recordings: int = Field(description="recordings whose evidence has accumulated")
+    posterior: dict[str, float] = Field(description="class → posterior probability (sum 1)")
+    fault_class: str = Field(
+        description="the class whose posterior reaches the naming threshold, else cannot_tell"
+    )
+    change_statistic: float | None = Field(
+        description="CUSUM of the baseline distance (null until the baseline is complete)"
+    )
+    change_alarm: bool = Field(description="the change statistic crossed its threshold")
+    name_probability: float = Field(description="posterior a class needs to be named")
+    change_reference: float | None = Field(
+        description="the change statistic's reference k: the distance a recording must exceed "
+        "to add to it"
+    )
+    change_threshold: float | None = Field(
+        description="the change statistic's threshold h: above it, the alarm"
+    )
+    latest_recording: str = Field(description="the recording id this state is after")
+    distance: float | None = Field(
+        description="that recording's distance from the baseline (null: baseline incomplete)"
+    )
+
+
+class AssetRecording(BaseModel):
+    """One recording of an asset and the asset's state after it."""
+
+    recording_id: str
+    received_at: str = Field(description="server receive time, UTC ISO-8601 (the first time)")
+    source: str
+    filename: str | None
+    operating_hours: float | None = Field(description="[h], as sent")
+    healthy: bool | None = Field(description="as the client marked it (null: not said)")
+    baseline: bool = Field(description="the recording is in the asset's baseline")
+    distance: float | None = Field(
+        description="its distance from the baseline (null: the baseline was incomplete)"
+    )
+    fault_class: str | None = Field(description="the recording's own diagnosis")
+    class_probabilities: dict[str, float] = Field(description="the recording's own")
+    asset: AssetState = Field(  # type: ignore[valid-type]
+        description="the asset's state after the recording (the Diagnosis contract's `asset`)"
+    )
+
+
+class AssetRecordings(BaseModel):
+    asset_id: str
+    count: int
+    total: int = Field(description="recordings in the asset's history")
+    truncated: bool
+    recordings: list[AssetRecording] = Field(description="in the order they were recorded")
+
+
 class AssetSummary(BaseModel):
     """One asset: what is stored for it and its latest diagnosis."""
 
@@ -303,6 +403,12 @@ class AssetSummary(BaseModel):
     latest: LatestDiagnosis
     spectra_received_at: str | None = Field(
         description="when the stored spectra of the latest window came (None: none stored)"
+    )
+    baseline: AssetBaseline | None = Field(
+        description="the asset's own baseline (null: none of its recordings recorded yet)"
+    )
+    evidence: AssetEvidence | None = Field(
+        description="its accumulated evidence after its latest recording (null: none recorded)"
     )
     prognosis: PrognosisBrief | None = Field(
         None, description="with `prognosis=true`: the RUL in brief, or why there is none"
@@ -492,7 +598,7 @@ def add_request_schema(schema: dict, limits: ServiceLimits) -> None:
 def document_limits(schema: dict, limits: ServiceLimits) -> None:
     """Write the bounds of ``limits`` that routes check at run time into an OpenAPI document."""
     add_request_schema(schema, limits)
-    for path in ("/v1/assets/{asset_id}/history", "/v1/assets"):
+    for path in ("/v1/assets/{asset_id}/history", "/v1/assets", "/v1/assets/{asset_id}/evidence"):
         for parameter in schema["paths"][path]["get"]["parameters"]:
             if parameter["name"] == "limit":
                 parameter["schema"]["maximum"] = limits.max_history

@@ -23,12 +23,12 @@ from prsm_health.core.errors import PRSMHealthError
 
 from .limits import ServiceLimits
 from .responses import HTTPError
-from .schemas import ASSET_ID_PATTERN
+from .schemas import ASSET_ID_PATTERN, RECORDING_ID_PATTERN
 
 UPLOAD_SUFFIXES = (".mcap", ".parquet", ".csv")
 #: Largest column map (the ``map`` field) accepted [bytes]: a map is a few hundred bytes.
 MAX_MAP_BYTES = 64 * 1024
-#: Largest plain form field (``asset_id``) [bytes].
+#: Largest plain form field (``asset_id``, ``healthy``, ``recording_id``) [bytes].
 MAX_FIELD_BYTES = 1024
 
 
@@ -179,7 +179,7 @@ class Upload:
     (under a fixed name; the client's file name only gives the suffix), the column map
     (``map``, at most :data:`MAX_MAP_BYTES`) and small text fields in memory."""
 
-    FIELDS = ("file", "map", "asset_id")
+    FIELDS = ("file", "map", "asset_id", "healthy", "recording_id")
     #: python-multipart callbacks this class implements.
     CALLBACKS = (
         "on_part_begin",
@@ -237,7 +237,7 @@ class Upload:
             raise HTTPError(
                 422,
                 f"unknown form field {name!r}; expected 'file' (the recording), optional 'map' "
-                "(its column map, TOML) and optional 'asset_id'",
+                "(its column map, TOML), optional 'asset_id', 'healthy' and 'recording_id'",
             )
         if (
             name in self.fields
@@ -345,4 +345,7 @@ async def receive_upload(request: Request, boundary: bytes, directory: Path) -> 
     asset_id = upload.fields.get("asset_id")
     if asset_id is not None and not re.fullmatch(ASSET_ID_PATTERN, asset_id):
         raise HTTPError(422, f"asset_id {asset_id!r} must match {ASSET_ID_PATTERN}")
+    recording_id = upload.fields.get("recording_id")
+    if recording_id is not None and not re.fullmatch(RECORDING_ID_PATTERN, recording_id):
+        raise HTTPError(422, f"recording_id {recording_id!r} must match {RECORDING_ID_PATTERN}")
     return upload

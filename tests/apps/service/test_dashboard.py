@@ -279,7 +279,7 @@ def test_a_version_2_database_gets_the_spectra_table_on_open(bundle, bodies, tmp
     old.close()
 
     store = HistoryStore(path)
-    assert store._conn.execute("PRAGMA user_version").fetchone()[0] == 3
+    assert store._conn.execute("PRAGMA user_version").fetchone()[0] == 4
     columns = [r[1] for r in store._conn.execute("PRAGMA table_info(spectra)")]
     assert columns[:2] == ["asset_id", "received_at"] and "spectra" in columns
     assert store.history("old")["diagnoses"][0]["diagnosis"] == d  # untouched

@@ -192,7 +192,7 @@ def test_a_version_1_database_gets_the_column_on_open(tmp_path):
     store = HistoryStore(path)
     columns = {r[1]: r[2] for r in store._conn.execute("PRAGMA table_info(diagnoses)")}
     assert columns["operating_hours"] == "REAL"
-    assert store._conn.execute("PRAGMA user_version").fetchone()[0] == 3
+    assert store._conn.execute("PRAGMA user_version").fetchone()[0] == 4
     store.add("press-1", [d], received_at=_stamp(1), operating_hours=250.0)
     entries = store.history("press-1")["diagnoses"]
     assert [e["operating_hours"] for e in entries] == [None, 250.0]

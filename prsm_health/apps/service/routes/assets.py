@@ -1,6 +1,8 @@
-"""``GET /v1/assets`` (the stored assets, each with its latest diagnosis in brief),
-``GET /v1/assets/{asset_id}`` (one of them) and ``GET /v1/assets/{asset_id}/spectra`` (the
-spectra of its latest window): what the dashboard's pages read."""
+"""``GET /v1/assets`` (the stored assets, each with its latest diagnosis in brief, baseline
+and evidence), ``GET /v1/assets/{asset_id}`` (one of them), ``GET
+/v1/assets/{asset_id}/evidence`` (its state after each of its recordings) and ``GET
+/v1/assets/{asset_id}/spectra`` (the spectra of its latest window): what the dashboard's
+pages read."""
 
 from typing import Annotated
 
@@ -10,7 +12,14 @@ from fastapi import Path as PathParam
 
 from ..history import HistoryStore
 from ..responses import HTTPError, encode, json_response
-from ..schemas import ASSET_ID_PATTERN, AssetList, AssetSummary, Error, Spectra
+from ..schemas import (
+    ASSET_ID_PATTERN,
+    AssetList,
+    AssetRecordings,
+    AssetSummary,
+    Error,
+    Spectra,
+)
 from .deps import Limits, RULModel, Store
 from .history import bounded_limit
 from .prognosis import asset_prognosis
@@ -83,7 +92,9 @@ async def get_asset(
     model: RULModel,
     prognosis: Annotated[bool, _PROGNOSIS] = False,
 ):
-    """What `GET /v1/assets` lists for this asset."""
+    """What `GET /v1/assets` lists for this asset: its diagnoses, the latest in brief, its
+    baseline (recordings in it, recordings needed, which) and its evidence after its latest
+    recording (class posterior, named class, change statistic and alarm)."""
 
     def read() -> bytes:
         summary = store.asset_summary(asset_id)
@@ -92,6 +103,38 @@ async def get_asset(
         if prognosis:
             summary["prognosis"] = prognosis_brief(store, model, asset_id)
         return encode(summary)
+
+    return json_response(await anyio.to_thread.run_sync(read))
+
+
+@router.get(
+    "/v1/assets/{asset_id}/evidence",
+    summary="An asset's baseline distance and accumulated evidence after each recording",
+    response_model=None,
+    responses={
+        200: {"model": AssetRecordings},
+        404: {"model": Error, "description": "no diagnosis stored for this asset"},
+        422: {"model": Error, "description": "bad asset id or query"},
+    },
+)
+async def get_evidence(
+    request: Request,
+    asset_id: Annotated[str, PathParam(pattern=ASSET_ID_PATTERN)],
+    store: Store,
+    limits: Limits,
+    limit: Annotated[int, Query(ge=1, description="the N most recent recordings")] = 100,
+):
+    """The asset's state after each of its `limit` most recent recordings, in the order they
+    were recorded: whether the recording is in the asset's baseline, its distance from the
+    baseline, its own class probabilities, and the asset's accumulated class posterior, named
+    class and change statistic (CUSUM of the distance) after it. Empty for an asset whose
+    diagnoses were all stored before the service kept baselines."""
+    limit = bounded_limit(request, limits, limit)
+
+    def read() -> bytes:
+        if not store.has_asset(asset_id):
+            raise HTTPError(404, f"no diagnoses stored for asset {asset_id!r}")
+        return encode(store.recordings(asset_id, limit=limit))
 
     return json_response(await anyio.to_thread.run_sync(read))
 

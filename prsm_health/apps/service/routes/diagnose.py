@@ -7,21 +7,25 @@ from fastapi import APIRouter, Request
 
 from prsm_health.actuator.design import PRESETS
 
-from ..diagnosing import BodyParams, diagnose_body, diagnose_upload
+from ..diagnosing import BodyParams, check_asset_fields, diagnose_body, diagnose_upload
+from ..evidence import load_baseline, peek_asset_id, record
 from ..history import utc_now
 from ..limits import MAX_OPERATING_HOURS
 from ..responses import HTTPError, json_response
 from ..schemas import (
     ASSET_ID_PATTERN,
     ERROR_RESPONSES,
+    HEALTHY_DESCRIPTION,
     OPERATING_HOURS_DESCRIPTION,
+    RECORDING_ID_DESCRIPTION,
+    RECORDING_ID_PATTERN,
     Diagnosis,
     Error,
     FileDiagnosis,
     parse_query_params,
 )
 from ..uploads import multipart_boundary, receive_upload, upload_directory
-from .deps import Limits, Store, Workers
+from .deps import Bundle, Limits, Store, Workers
 
 router = APIRouter()
 
@@ -79,6 +83,21 @@ _JSON_BODY = {
             "description": f"binary bodies only: {OPERATING_HOURS_DESCRIPTION}",
             "schema": {"type": "number", "minimum": 0, "maximum": MAX_OPERATING_HOURS},
         },
+        {
+            "name": "healthy",
+            "in": "query",
+            "required": False,
+            "description": f"binary bodies only: {HEALTHY_DESCRIPTION}",
+            "schema": {"type": "boolean"},
+        },
+        {
+            "name": "recording_id",
+            "in": "query",
+            "required": False,
+            "description": f"binary bodies only: {RECORDING_ID_DESCRIPTION}; a binary body's "
+            "default: the hash of its bytes",
+            "schema": {"type": "string", "pattern": RECORDING_ID_PATTERN},
+        },
     ],
     "requestBody": {
         "required": True,
@@ -121,7 +140,19 @@ _MULTIPART_BODY = {
                         "asset_id": {
                             "type": "string",
                             "pattern": ASSET_ID_PATTERN,
-                            "description": "store every window in this asset's history",
+                            "description": "store every window in this asset's history "
+                            "and record the recording in the asset's baseline and evidence",
+                        },
+                        "healthy": {
+                            "type": "string",
+                            "enum": ["true", "false"],
+                            "description": HEALTHY_DESCRIPTION,
+                        },
+                        "recording_id": {
+                            "type": "string",
+                            "pattern": RECORDING_ID_PATTERN,
+                            "description": f"{RECORDING_ID_DESCRIPTION}; an upload's default: "
+                            "the hash of the file (and of its column map)",
                         },
                     },
                 }
@@ -154,7 +185,8 @@ def body_params(request: Request, fmt: str) -> BodyParams | None:
         raise HTTPError(
             422,
             f"query parameter {items[0][0]!r}: a JSON body carries asset_id, speed, load, "
-            "design and operating_hours as fields (query parameters are for binary bodies)",
+            "design, gear_ratio, healthy, recording_id and operating_hours as fields (query "
+            "parameters are for binary bodies)",
         )
     return None
 
@@ -171,7 +203,9 @@ def body_params(request: Request, fmt: str) -> BodyParams | None:
     },
     openapi_extra=_JSON_BODY,
 )
-async def post_diagnose(request: Request, store: Store, limits: Limits, workers: Workers):
+async def post_diagnose(
+    request: Request, store: Store, limits: Limits, workers: Workers, bundle: Bundle
+):
     """Diagnose uniformly sampled contract channels (at most `max_window_seconds`, 2 s by
     default), sent as JSON or as a recording (Arrow IPC stream, Parquet or MCAP: decoded by
     the library's readers; the asset and nominal operating point then come as query
@@ -182,11 +216,27 @@ async def post_diagnose(request: Request, store: Store, limits: Limits, workers:
     params = body_params(request, fmt)
     with workers.admitted():
         body = await request.body()
-        answer = await workers.diagnose(diagnose_body, body, fmt, params, limits, received_at)
+        asset_id = params.asset_id if params is not None else peek_asset_id(body)
+        baseline = None
+        if asset_id is not None:
+            baseline = await anyio.to_thread.run_sync(load_baseline, store, bundle, asset_id)
+        answer = await workers.diagnose(
+            diagnose_body, body, fmt, params, limits, received_at, baseline
+        )
         del body
+    return json_response(await store_answer(store, bundle, answer, received_at))
+
+
+async def store_answer(store, bundle, answer, received_at: str) -> bytes:
+    """Store what a diagnosis gave for an asset — recorded in the asset's history with the
+    request's rows (:func:`~..evidence.record`), or the rows alone — and the answer."""
+    if answer.asset is not None:
+        return await anyio.to_thread.run_sync(
+            record, store, bundle, answer.asset, answer.history, answer.spectra, received_at
+        )
     if answer.history:
         await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
-    return json_response(answer.encoded)
+    return answer.encoded
 
 
 @router.post(
@@ -206,7 +256,9 @@ async def post_diagnose(request: Request, store: Store, limits: Limits, workers:
     },
     openapi_extra=_MULTIPART_BODY,
 )
-async def post_diagnose_file(request: Request, store: Store, limits: Limits, workers: Workers):
+async def post_diagnose_file(
+    request: Request, store: Store, limits: Limits, workers: Workers, bundle: Bundle
+):
     """Stream the upload into a private temporary directory (removed afterwards), read it
     with the library and diagnose every window."""
     received_at = utc_now()
@@ -214,13 +266,31 @@ async def post_diagnose_file(request: Request, store: Store, limits: Limits, wor
     with workers.admitted():
         async with upload_directory() as directory:
             upload = await receive_upload(request, boundary, directory)
+            asset_id = upload.fields.get("asset_id")
+            healthy = form_healthy(upload.fields.get("healthy"))
+            recording_id = upload.fields.get("recording_id")
+            check_asset_fields(asset_id, healthy, recording_id)
+            baseline = None
+            if asset_id is not None:
+                baseline = await anyio.to_thread.run_sync(load_baseline, store, bundle, asset_id)
             answer = await workers.diagnose(
                 diagnose_upload,
                 upload.received(),
                 limits,
-                upload.fields.get("asset_id"),
+                asset_id,
                 received_at,
+                baseline,
+                healthy,
+                recording_id,
             )
-    if answer.history:
-        await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
-    return json_response(answer.encoded)
+    return json_response(await store_answer(store, bundle, answer, received_at))
+
+
+def form_healthy(text: str | None) -> bool | None:
+    """The ``healthy`` form field of an upload: ``true`` or ``false`` (as a query parameter)."""
+    if text is None:
+        return None
+    value = text.strip().lower()
+    if value not in ("true", "false"):
+        raise HTTPError(422, f"healthy = {text[:40]!r}: true or false expected")
+    return value == "true"

@@ -1,5 +1,6 @@
-// One asset (/assets/{asset_id}): its latest diagnosis and prognosis (GET
-// /v1/assets/{asset_id}?prognosis=true), the clearance and class probabilities over time or
+// One asset (/assets/{asset_id}): its latest diagnosis, prognosis, baseline and evidence (GET
+// /v1/assets/{asset_id}?prognosis=true), the evidence after each recording (GET
+// /v1/assets/{asset_id}/evidence), the clearance and class probabilities over time or
 // operating hours (GET /v1/assets/{asset_id}/history) and the spectra of its latest window
 // (GET /v1/assets/{asset_id}/spectra), with the defect frequencies marked.
 "use strict";
@@ -9,12 +10,15 @@ PH.ready(async () => {
   const base = "/v1/assets/" + encodeURIComponent(id);
   const status = document.getElementById("status");
   try {
-    const [summary, history] = await Promise.all([
-      PH.getJSON(base + "?prognosis=true"),
+    // the summary first: an unknown asset is one 404, not three
+    const summary = await PH.getJSON(base + "?prognosis=true");
+    const [history, evidence] = await Promise.all([
       PH.getJSON(base + "/history?limit=1000"),
+      PH.getJSON(base + "/evidence?limit=1000"),
     ]);
     showLatest(summary.latest);
     showPrognosis(summary.prognosis);
+    showEvidence(summary, evidence);
     const axis = xAxis(history.diagnoses);
     clearancePlot(axis, summary.prognosis);
     classPlot(axis);
@@ -69,6 +73,144 @@ function showPrognosis(prognosis) {
     rul.textContent = "–";
     detail.textContent = prognosis && prognosis.error ? prognosis.error : "No prognosis.";
   }
+}
+
+// ---------------------------------------------------------------- baseline and evidence
+function percent(p) {
+  return PH.finite(p) ? `${(100 * p).toFixed(p >= 0.995 || p < 0.01 ? 1 : 0)} %` : "–";
+}
+
+function namedText(evidence) {
+  const top = PH.topClass(evidence.posterior);
+  if (evidence.fault_class !== "cannot_tell") {
+    return `${evidence.fault_class} (posterior ${percent(evidence.posterior[evidence.fault_class])})`;
+  }
+  return top ? `cannot tell (most probable: ${top[0]}, ${percent(top[1])})` : "cannot tell";
+}
+
+function showEvidence(summary, data) {
+  const note = document.getElementById("evidence-note");
+  const baseline = summary.baseline;
+  const evidence = summary.evidence;
+  if (!baseline || !evidence || data.recordings.length === 0) {
+    note.textContent = "No recording of this asset has been judged against its own baseline " +
+      "yet: its diagnoses were stored before the service kept baselines. The next recording " +
+      "sent with its asset id starts the baseline.";
+    for (const id of ["baseline-members", "evidence-plots"]) document.getElementById(id).hidden = true;
+    return;
+  }
+  note.textContent = "Each recording is judged against the asset's own baseline — its first " +
+    "recordings unless a fault is named in them, and any recording sent with healthy=true — " +
+    "and the recordings outside the baseline accumulate the class evidence, older recordings " +
+    "counting less.";
+  const complete = baseline.needed !== null && baseline.recordings >= baseline.needed;
+  document.getElementById("baseline-status").textContent =
+    `${baseline.recordings} of ${baseline.needed} recordings` + (complete ? ": complete" : ": in the making");
+  document.getElementById("baseline-detail").textContent = complete
+    ? "Every later recording is scored against it: its distance from the baseline and the change statistic."
+    : `${baseline.needed - baseline.recordings} more recording(s) needed before changes are scored.`;
+  const yesNo = (v) => (v === true ? "yes" : v === false ? "no" : "–");
+  const rows = baseline.members.map((m) => {
+    const row = PH.el("tr");
+    const name = m.filename ? `${m.recording_id} (${m.filename})` : m.recording_id;
+    row.append(PH.el("th", name, {scope: "row"}), PH.el("td", PH.hours(m.operating_hours), {class: "num"}),
+      PH.el("td", PH.time(m.received_at)), PH.el("td", yesNo(m.healthy)));
+    return row;
+  });
+  document.querySelector("#baseline-members tbody").replaceChildren(...rows);
+
+  const named = document.getElementById("evidence-class");
+  named.textContent = namedText(evidence);
+  const statistic = PH.finite(evidence.change_statistic)
+    ? `${evidence.change_statistic.toFixed(2)} (alarm above ${PH.finite(evidence.change_threshold) ? evidence.change_threshold : "–"})`
+    : "– (baseline incomplete)";
+  PH.define(document.getElementById("evidence"), [
+    ["Recordings accumulated", String(evidence.recordings)],
+    ["Named when the posterior reaches", percent(evidence.name_probability)],
+    ["Latest distance from the baseline", PH.finite(evidence.distance) ? evidence.distance.toPrecision(3) : "–"],
+    ["Change statistic (CUSUM)", statistic],
+    ["Change alarm", evidence.change_alarm ? "ALARM: the asset has changed from its baseline" : "no"],
+  ]);
+  if (evidence.change_alarm) named.classList.add("error");
+
+  const axis = evidenceAxis(data);
+  posteriorPlot(axis, evidence.name_probability);
+  distancePlot(axis, evidence);
+}
+
+// Over operating hours when every recording has them, in the order recorded; else over the
+// recording's number (the evidence accumulates in the order the recordings were recorded).
+function evidenceAxis(data) {
+  const rows = data.recordings;
+  const hours = rows.map((r) => r.operating_hours);
+  const ordered = hours.every((h, i) => PH.finite(h) && (i === 0 || h >= hours[i - 1]));
+  const first = data.total - rows.length + 1;
+  const shown = data.truncated ? `the latest ${rows.length} of ${data.total} recordings` : `${rows.length} recording(s)`;
+  const text = ordered && rows.length >= 2
+    ? `Over operating hours: ${shown}, in the order recorded.`
+    : `Over the recordings in the order recorded (${shown}; not every one has operating hours in increasing order).`;
+  document.getElementById("posterior-note").textContent = text +
+    " The baseline's recordings add no evidence: the posterior stays where it was.";
+  return ordered && rows.length >= 2
+    ? {rows, xs: hours, time: false, label: "operating hours [h]"}
+    : {rows, xs: rows.map((_, i) => first + i), time: false, label: "recording (in the order recorded)"};
+}
+
+const onlyPoints = () => null;
+
+function posteriorPlot(axis, threshold) {
+  const names = [...new Set(axis.rows.flatMap((r) => Object.keys(r.asset.evidence.posterior || {})))].sort();
+  const data = [axis.xs];
+  const series = [{label: axis.label}];
+  names.forEach((name, i) => {
+    data.push(axis.rows.map((r) => {
+      const p = (r.asset.evidence.posterior || {})[name];
+      return PH.finite(p) ? p : null;
+    }));
+    series.push({label: name, stroke: PH.palette[i % PH.palette.length], width: 1.5,
+      points: {show: true, size: 5}});
+  });
+  if (PH.finite(threshold)) {
+    data.push(axis.xs.map(() => threshold));
+    series.push({label: "named at", stroke: "#555", dash: [6, 4], points: {show: false}});
+  }
+  const options = Object.assign(axisOptions(axis, "posterior"), {series});
+  options.scales.y = {range: [0, 1]};
+  PH.plot(document.getElementById("posterior-plot"), options, data);
+}
+
+function distancePlot(axis, evidence) {
+  const rows = axis.rows;
+  const statistic = (r) => r.asset.evidence.change_statistic;
+  const value = (v) => (PH.finite(v) ? v : null);
+  const data = [
+    axis.xs,
+    rows.map((r) => value(r.distance)),
+    rows.map((r) => value(statistic(r))),
+    rows.map((r) => (r.asset.evidence.change_alarm ? value(statistic(r)) : null)),
+    rows.map((r) => (r.baseline ? 0 : null)),
+  ];
+  const series = [
+    {label: axis.label},
+    {label: "distance from the baseline", stroke: PH.palette[0], width: 2, points: {show: true, size: 6}},
+    {label: "change statistic (CUSUM)", stroke: PH.palette[3], width: 1.5, points: {show: true, size: 5}},
+    {label: "alarm", stroke: "#d62728", paths: onlyPoints, points: {show: true, size: 10, fill: "#d62728"}},
+    {label: "baseline recording", stroke: PH.palette[2], paths: onlyPoints, points: {show: true, size: 8, fill: PH.palette[2]}},
+  ];
+  if (PH.finite(evidence.change_threshold)) {
+    data.push(axis.xs.map(() => evidence.change_threshold));
+    series.push({label: "alarm threshold", stroke: "#d62728", dash: [10, 5], points: {show: false}});
+  }
+  const alarms = rows.filter((r) => r.asset.evidence.change_alarm).length;
+  const scored = rows.filter((r) => PH.finite(r.distance)).length;
+  document.getElementById("distance-note").textContent = scored
+    ? `The distance is the RMS of the recording's robust z-scores against the baseline (about 1 ` +
+      `for a recording like the baseline's); the change statistic adds what exceeds ` +
+      `${PH.finite(evidence.change_reference) ? evidence.change_reference : "its reference"} and ` +
+      `alarms above its threshold. ${alarms} recording(s) in alarm.`
+    : "No recording has been scored yet: the baseline is incomplete.";
+  const options = Object.assign(axisOptions(axis, "distance / statistic"), {series});
+  PH.plot(document.getElementById("distance-plot"), options, data);
 }
 
 // Over operating hours when at least two diagnoses have them, else over receive time.

@@ -17,6 +17,7 @@ PH.ready(async () => {
         rulCell(asset.prognosis),
         PH.el("td", asset.diagnoses, {class: "num"}),
         PH.el("td", PH.time(asset.last_received_at)),
+        evidenceCell(asset.baseline, asset.evidence),
       );
       tbody.append(row);
     }
@@ -41,6 +42,32 @@ function rulCell(prognosis) {
   } else {
     cell.textContent = "–";
     if (prognosis && prognosis.error) cell.append(PH.el("span", prognosis.error, {class: "why"}));
+  }
+  return cell;
+}
+
+// The asset against its own baseline: the class its accumulated evidence names (or the most
+// probable), after how many recordings; the baseline while it is in the making; the alarm.
+function evidenceCell(baseline, evidence) {
+  const cell = PH.el("td");
+  if (!baseline || !evidence) {
+    cell.textContent = "–";
+    return cell;
+  }
+  if (baseline.needed !== null && baseline.recordings < baseline.needed) {
+    cell.textContent = `baseline ${baseline.recordings} of ${baseline.needed}`;
+  } else if (evidence.recordings === 0) {
+    cell.textContent = "baseline complete; no evidence yet";
+  } else {
+    const top = PH.topClass(evidence.posterior);
+    const name = evidence.fault_class !== "cannot_tell" ? evidence.fault_class : `cannot tell (${top[0]}`;
+    const p = evidence.posterior[top[0]].toFixed(2);
+    cell.textContent = evidence.fault_class !== "cannot_tell"
+      ? `${name} ${p} after ${evidence.recordings}`
+      : `${name} ${p}) after ${evidence.recordings}`;
+  }
+  if (evidence.change_alarm) {
+    cell.append(PH.el("span", "changed from its baseline (alarm)", {class: "why error"}));
   }
   return cell;
 }

@@ -15,6 +15,7 @@ PH.ready(() => {
     const file = form.elements.file.files[0];
     const assetId = form.elements.asset_id.value.trim();
     const hours = form.elements.operating_hours.value.trim();
+    const healthy = form.elements.healthy.checked;
     const name = file ? file.name.toLowerCase() : "";
     const suffix = Object.keys(BODY_TYPES).find((s) => name.endsWith(s));
     if (!suffix) {
@@ -29,12 +30,14 @@ PH.ready(() => {
       let answer;
       if (hours !== "") {
         const query = new URLSearchParams({asset_id: assetId, operating_hours: hours});
+        if (healthy) query.set("healthy", "true");
         answer = await PH.getJSON("/v1/diagnose?" + query, {
           method: "POST", body: file, headers: {"content-type": BODY_TYPES[suffix]},
         });
       } else {
         const body = new FormData();
         body.append("asset_id", assetId);
+        if (healthy) body.append("healthy", "true");
         body.append("file", file, file.name);
         answer = await PH.getJSON("/v1/diagnose/file", {method: "POST", body});
       }
@@ -47,6 +50,23 @@ PH.ready(() => {
   });
 });
 
+// The asset's state after this recording: its baseline and accumulated evidence.
+function assetRows(asset) {
+  if (!asset) return [];
+  const rows = [];
+  if (asset.baseline) {
+    const b = asset.baseline;
+    const distance = PH.finite(b.distance) ? `; distance from it ${b.distance.toPrecision(3)}` : "";
+    rows.push(["Asset's baseline", `${b.recordings} of ${b.needed} recordings${distance}`]);
+  }
+  if (asset.evidence) {
+    const e = asset.evidence;
+    const alarm = e.change_alarm ? "; change alarm" : "";
+    rows.push(["Asset's evidence", `${e.fault_class} after ${e.recordings} recording(s)${alarm}`]);
+  }
+  return rows;
+}
+
 function show(answer, assetId) {
   const diagnosis = answer.diagnosis || answer;  // an upload wraps it with its windows
   const windows = answer.recording ? answer.windows.length : (diagnosis.windows || []).length || 1;
@@ -55,6 +75,7 @@ function show(answer, assetId) {
     ["Classes not ruled out", (diagnosis.class_set || []).join(", ") || "–"],
     ["Clearance [µm] (90 % interval)", PH.clearanceText(diagnosis.clearance)],
     ["Windows", String(windows)],
+    ...assetRows(diagnosis.asset),
     ["Model", `${diagnosis.model.name} ${diagnosis.model.version} (${diagnosis.model.design})`],
   ]);
   PH.fill(document.getElementById("result-warnings"),
