@@ -50,35 +50,21 @@ from prsm_health.simulation.instrumentation import (
 )
 from prsm_health.simulation.scenario import Scenario, design_ratings
 
+from .sweep import (
+    FORCE_KEYS,
+    SWEEP_MODES,
+    SWEPT,
+    SWEPT_GROUPS,
+    flat_sweep,
+    is_range,
+    is_value,
+    set_path,
+    swept_keys,
+    test_set,
+    written_values,
+)
+
 FORMATS = ("parquet", "mcap", "both")
-SWEEP_MODES = ("grid", "random", "lhs")
-#: Swept quantities and their units (a range is [min, max]).
-SWEPT = {
-    "clearance": "m",
-    "clearance_screw": "m",
-    "clearance_nut": "m",
-    "clearance_gear": "m",
-    "speed": "rad/s",
-    "load": "N, kN or a share of C_a / C_0a",
-    "load_amplitude": "N, kN or a share of C_a / C_0a",
-    "friction_scale": "-",
-    "wear_spread": "-",
-    "preload": "m",
-    "lubricant_degradation": "-",
-    "lubricant_starvation": "-",
-    "temperature": "K",
-    "severity": "-",
-}
-#: Groups whose scalar fields a sweep may also draw — domain randomisation of the operating
-#: profile, simulation options (contact damping, restitution, manufacturing scatter), drive train
-#: and sensors: ``[sweep.drive_train] coupling_stiffness = [1e3, 2e3]`` or the dotted key
-#: ``"drive_train.coupling_stiffness"``; nested fields by more dots
-#: (``options.variation.pitch_error``, ``instrumentation.nut_axial_accel.noise_density_ug``).
-#: Units are the group's (docs/formats.md); the scenario validates every drawn value.
-SWEPT_GROUPS = ("profile", "options", "drive_train", "instrumentation")
-#: Swept keys that are forces: any form of :mod:`prsm_health.core.quantities`, resolved to
-#: newtons against the recipe's design (:attr:`Recipe.resolved_sweep`).
-FORCE_KEYS = ("load", "load_amplitude", "profile.load", "profile.load_amplitude")
 #: Swept by name: a list of ``fault_cases`` names (drawn uniformly in random and lhs mode).
 FAULT_CASE_KEY = "fault_case"
 NO_FAULT = "none"
@@ -162,7 +148,7 @@ class Recipe:
         if "instrumentation" in data:
             data["instrumentation"] = _recipe_instrumentation(data["instrumentation"], base)
         if isinstance(data["sweep"], dict):
-            data["sweep"] = _flat_sweep(data["sweep"])
+            data["sweep"] = flat_sweep(data["sweep"])
         faults = data.pop("faults", {})
         try:
             thresholds = FaultThresholds(**faults)
@@ -225,7 +211,7 @@ class Recipe:
         mode = sweep.get("mode", "grid")
         check(mode in SWEEP_MODES, "sweep.mode", mode, f"must be one of {', '.join(SWEEP_MODES)}")
         unknown = sorted(
-            set(sweep) - set(_swept_keys(sweep)) - {"mode", "repeats", "samples", FAULT_CASE_KEY}
+            set(sweep) - set(swept_keys(sweep)) - {"mode", "repeats", "samples", FAULT_CASE_KEY}
         )
         check(
             not unknown,
@@ -242,11 +228,11 @@ class Recipe:
             repeats,
             "must be an integer ≥ 1",
         )
-        for key in _swept_keys(sweep):
+        for key in swept_keys(sweep):
             value = sweep[key]
             unit = SWEPT.get(key, "the group's unit")
             if mode == "grid" and isinstance(value, dict):
-                ok = set(value) == {"uniform"} and _is_range(value["uniform"], key)
+                ok = set(value) == {"uniform"} and is_range(value["uniform"], key)
                 check(
                     ok,
                     f"sweep.{key}",
@@ -254,7 +240,7 @@ class Recipe:
                     f"a drawn value must be {{uniform = [min, max]}} [{unit}]",
                 )
             elif mode == "grid":
-                ok = isinstance(value, list) and value and all(_is_value(key, v) for v in value)
+                ok = isinstance(value, list) and value and all(is_value(key, v) for v in value)
                 check(
                     ok,
                     f"sweep.{key}",
@@ -263,7 +249,7 @@ class Recipe:
                     f"[{unit}], or {{uniform = [min, max]}}, in grid mode",
                 )
             else:
-                ok = _is_range(value, key)
+                ok = is_range(value, key)
                 check(
                     ok,
                     f"sweep.{key}",
@@ -289,10 +275,10 @@ class Recipe:
     def _validate_forces(self, check) -> None:
         """Each swept force parses (the error names the key and the accepted forms) and each
         range is ordered once resolved against the design's ratings."""
-        for key in _swept_keys(self.sweep):
+        for key in swept_keys(self.sweep):
             if key not in FORCE_KEYS:
                 continue
-            for v in _values(self.sweep[key]):
+            for v in written_values(self.sweep[key]):
                 try:
                     newtons = self._newtons(key, v)
                 except ParameterError as exc:
@@ -422,7 +408,7 @@ class Recipe:
                 f"must be one of {', '.join(UNIT_BUILD)} or an options./drive_train. field "
                 "(what a unit is built and installed with)",
             )
-            check(_is_range(value), f"units.build.{key}", value, "must be [min, max]")
+            check(is_range(value), f"units.build.{key}", value, "must be [min, max]")
         for key, minimum in (("count", 1), ("seed", 0)):
             value = units.get(key)
             check(
@@ -496,10 +482,10 @@ class Recipe:
         repeats = self.sweep.get("repeats", 1)
         specs = []
         n_total = len(points) * repeats
-        test = _test_set(n_total, self.test_fraction, self.seed)
+        test = test_set(n_total, self.test_fraction, self.seed)
         if self.units:  # whole units held out
             count = self.units["count"]
-            test_units = _test_set(count, self.test_fraction, self.units["seed"])
+            test_units = test_set(count, self.test_fraction, self.units["seed"])
             test = {i for i in range(n_total) if i % count in test_units}
         run_id = 0
         sweep = self.resolved_sweep
@@ -527,8 +513,8 @@ class Recipe:
         # snapshot; each snapshot's sensors draw their own noise (sensor_seed). The test split
         # holds out whole units.
         spec = self.life_spec
-        test_units = _test_set(spec.units, self.test_fraction, self.seed)
-        keys = _swept_keys(self.sweep)
+        test_units = test_set(spec.units, self.test_fraction, self.seed)
+        keys = swept_keys(self.sweep)
         sweep = self.resolved_sweep
         specs = []
         for unit in self.fleet():
@@ -547,7 +533,7 @@ class Recipe:
 
     def _points(self) -> list[dict]:
         sweep = self.resolved_sweep
-        keys = _swept_keys(sweep)
+        keys = swept_keys(sweep)
         mode = sweep.get("mode", "grid")
         cases = sweep.get(FAULT_CASE_KEY)
         if mode == "grid":
@@ -581,66 +567,6 @@ class Recipe:
         """Run ids grouped into the fixed batches that workers write as one shard each."""
         ids = list(range(len(self.runs())))
         return [ids[i : i + self.batch_size] for i in range(0, len(ids), self.batch_size)]
-
-
-def _flat_sweep(sweep: dict) -> dict:
-    """The sweep with group tables (``[sweep.drive_train]`` …) as dotted keys."""
-    out = {}
-
-    def walk(prefix: str, table: dict) -> None:
-        for key, value in table.items():
-            name = f"{prefix}.{key}"
-            if isinstance(value, dict) and "uniform" not in value:
-                walk(name, value)
-            else:
-                out[name] = value
-
-    for key, value in sweep.items():
-        if key in SWEPT_GROUPS and isinstance(value, dict):
-            walk(key, value)
-        else:
-            out[key] = value
-    return out
-
-
-def _swept_keys(sweep: dict) -> list[str]:
-    """The swept quantities of a (flat) sweep: :data:`SWEPT` order, then group fields sorted."""
-    grouped = sorted(k for k in sweep if k.split(".")[0] in SWEPT_GROUPS and "." in k)
-    return [k for k in SWEPT if k in sweep] + grouped
-
-
-def _set_path(target: dict, path: list[str], value) -> None:
-    for key in path[:-1]:
-        target = target.setdefault(key, {})
-    target[path[-1]] = value
-
-
-def _is_value(key: str, value) -> bool:
-    """A number, or for a force (:data:`FORCE_KEYS`) any of its written forms: a string; it is
-    parsed (with its own error) by ``Recipe._validate_forces``."""
-    if isinstance(value, bool):
-        return False
-    return isinstance(value, (int, float)) or (key in FORCE_KEYS and isinstance(value, str))
-
-
-def _is_range(value, key: str = "") -> bool:
-    """[min, max]; ordered when numbers (a force range is ordered once resolved)."""
-    if not (isinstance(value, list) and len(value) == 2 and all(_is_value(key, v) for v in value)):
-        return False
-    numbers = all(isinstance(v, (int, float)) for v in value)
-    return not numbers or value[0] <= value[1]
-
-
-def _values(value) -> list:
-    """The written values of a sweep entry (a list, or ``{uniform = [min, max]}``)."""
-    if isinstance(value, dict):
-        return list(value.get("uniform", []))
-    return list(value) if isinstance(value, list) else [value]
-
-
-def _test_set(n: int, fraction: float, seed: int) -> set[int]:
-    k = int(round(n * fraction))
-    return set(np.random.default_rng([seed, 0x54455354]).permutation(n)[:k].tolist())
 
 
 @dataclass(frozen=True)
@@ -695,7 +621,7 @@ class RunSpec:
         for key, value in p.items():
             group, *path = key.split(".")
             if path:  # a domain-randomised field
-                _set_path(groups[group], path, value)
+                set_path(groups[group], path, value)
         try:
             return Scenario.from_dict(
                 {

@@ -36,6 +36,7 @@ from pathlib import Path
 from urllib.parse import quote, unquote
 
 from prsm_health.core.errors import PRSMHealthError, require
+from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
 from prsm_health.core.jsonable import dumps, finite_or_none
 
 from .baseline import EVIDENCE_NAME_PROBABILITY, Baseline, Cusum, Evidence
@@ -49,11 +50,6 @@ from .contract import CANNOT_TELL, AssetState, BaselineState, Diagnosis, Evidenc
 BASELINE_RECORDINGS = 3
 #: The class of a healthy unit.
 HEALTHY = "healthy"
-#: An asset id: also a file name and a URL path segment (the service's pattern).
-ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
-ASSET_ID_RULE = (
-    "1–128 characters: letters, digits, '.', '_', ':' or '-', starting with a letter or digit"
-)
 #: Version of the history's JSON form.
 FORMAT = 1
 

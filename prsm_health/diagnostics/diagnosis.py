@@ -574,11 +574,11 @@ def diagnose_runs(
         window=window,
         split=None if split is None else [split[i] for i in rest],
     )
-    if baseline is not None:
+    if baseline is not None and bundle.check is not None:
         for d in windowed:
             d.warnings.append(
                 "the unit's baseline is read against its health-check recordings; this "
-                "recording, no check (or a model without a check part), is read alone"
+                "recording, no check, is read alone"
             )
     out = dict(checks) | dict(zip(rest, windowed))
     return [out[i] for i in range(len(runs))]

@@ -10,7 +10,6 @@ import pytest
 from sklearn.dummy import DummyClassifier
 
 from prsm_health.apps.cli import main
-from prsm_health.apps.cli import parser as cli_parser
 from prsm_health.diagnostics import asset_history
 from prsm_health.diagnostics.model_files import save_model
 
@@ -157,8 +156,3 @@ def test_asset_show_errors_are_one_line(files, tmp_path, capsys):
     assert code == 2 and "pump-1.json" in err and err.count("\n") == 1
     code, _, err = run(capsys, *diagnose(files, tmp_path, 0))
     assert code == 2 and "pump-1.json" in err and err.count("\n") == 1
-
-
-def test_mirrored_asset_constants_are_the_librarys():
-    assert cli_parser.ASSET_ID_PATTERN == asset_history.ASSET_ID_PATTERN
-    assert cli_parser.ASSET_ID_RULE == asset_history.ASSET_ID_RULE

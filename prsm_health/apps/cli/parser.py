@@ -22,6 +22,7 @@ from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS
 from prsm_health.actuator.health_check import BUILT_IN as BUILT_IN_CHECKS
 from prsm_health.actuator.states import DEFAULT_LOAD, DRIVES, LOADS, MOTIONS, RAMP_SHAPES
 from prsm_health.core.errors import ParameterError
+from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
 from prsm_health.core.quantities import parse_force
 
 from .options import (
@@ -52,11 +53,6 @@ TRAIN_TARGETS = ("clearance", "fault", "both", "rul")
 DEFAULT_CV = 5
 #: The asset histories of ``diagnose --asset`` and ``asset`` when ``--store`` is not given.
 DEFAULT_ASSET_STORE = "prsm-assets"
-#: An asset id (prsm_health.diagnostics.asset_history, which imports numpy).
-ASSET_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9._:-]{0,127}$"
-ASSET_ID_RULE = (
-    "1–128 characters: letters, digits, '.', '_', ':' or '-', starting with a letter or digit"
-)
 
 DESIGN_HELP = "preset name (paper01…paper05) or design TOML file"
 PROFILE_HELP = (
