@@ -21,9 +21,10 @@ carrier ratio (from the true carrier speed only when ``"carrier_speed"`` is aske
 speed varies by more than 5 % in a window the signal is resampled to uniform screw angle (order
 domain) before the spectrum.
 
-The shifted-axial-frequency indicator compares the dominant nut axial frequency with the healthy
-baseline the physics predicts for the same design and load: √(k_axial/m_N)/2π, k_axial the
-paper-04 thread stiffness of all rollers (screw and nut sides in series) at the run's mean load.
+The shifted-axial-frequency indicator compares the dominant nut axial frequency with the physics'
+healthy baseline √(k_axial/m_N)/2π (paper-04 thread stiffness, all rollers, at the mean load);
+the contact-mode indicators track that mode inside the band the linearised model predicts for the
+duty and clearance range instead of the largest peak (:mod:`prsm_health.signals.axial_mode`).
 
 References
 ----------
@@ -127,6 +128,8 @@ def _feature_table() -> dict[str, str]:
             "axial_frequency_shift": "Hz",
             "axial_frequency_shift_relative": "-",
             "axial_dominant_amplitude": "m/s²",
+            "axial_contact_frequency": "Hz",
+            "axial_contact_frequency_shift": "Hz",
             "drive_torque_mean": "N·m",
             "drive_torque_ripple": "N·m",
             "efficiency": "-",
@@ -558,7 +561,7 @@ def _mesh_lines(freq, amp, base: float, side: float, prefix: str, out: dict) -> 
 
 def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
     """Dominant nut axial frequency and its shift from the healthy baseline, every window's
-    Welch spectrum in one call."""
+    Welch spectrum in one call; the contact mode (:mod:`prsm_health.signals.axial_mode`)."""
     nperseg = min(512, centred.shape[-1])
     f, psds = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
     for psd, out in zip(psds, rows):
@@ -574,6 +577,11 @@ def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
             out["axial_baseline_frequency"] = f0
             out["axial_frequency_shift"] = f_dom - f0
             out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
+    if design is not None and design.gear is not None:  # paper 01's mode, tracked in its band
+        from .axial_mode import contact_indicators
+
+        for out, values in zip(rows, contact_indicators(centred, rate, design, rows)):
+            out.update(values)
 
 
 def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> None:
@@ -589,8 +597,7 @@ def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> Non
         out["drive_torque_ripple"] = float(np.std(ch["drive_torque"]))
         if speed is not None and load is not None and "nut_position" in ch:
             # drive_torque is the motor's, screw_speed the gearbox output's: the input power
-            # is T_m·N·ω_s, so the efficiency is the drive's from the motor shaft (reduction
-            # and screw)
+            # is T_m·N·ω_s: the efficiency is the drive's from the motor shaft (reduction, screw)
             out["efficiency"] = _window_efficiency(
                 ch["drive_torque"] * _gear_ratio(run), speed, load, ch["nut_position"], run.time
             )
