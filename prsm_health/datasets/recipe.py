@@ -69,17 +69,6 @@ FORMATS = ("parquet", "mcap", "both")
 FAULT_CASE_KEY = "fault_case"
 NO_FAULT = "none"
 DEFAULT_BATCH = 8
-#: Health fields a life recipe's units set themselves (not sweepable there).
-LIFE_SETS = (
-    "clearance",
-    "clearance_screw",
-    "clearance_nut",
-    "clearance_gear",
-    "wear_spread",
-    "preload",
-    "lubricant_degradation",
-    "lubricant_starvation",
-)
 #: Health fields a unit is built with: ``[units.build]`` draws them once per unit.
 UNIT_BUILD = (
     "clearance",
@@ -89,6 +78,9 @@ UNIT_BUILD = (
     "wear_spread",
     "preload",
 )
+#: Health fields a life recipe's units set themselves (not sweepable there): their build and
+#: their lubricant's ageing.
+LIFE_SETS = (*UNIT_BUILD, "lubricant_degradation", "lubricant_starvation")
 #: Fleets of life recipes computed in this process, by recipe fingerprint.
 _FLEETS: dict[str, list] = {}
 

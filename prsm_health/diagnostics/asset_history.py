@@ -27,14 +27,13 @@ import dataclasses
 import hashlib
 import json
 import math
-import os
 import re
-import tempfile
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from urllib.parse import quote, unquote
 
+from prsm_health.core.atomic import write_atomic
 from prsm_health.core.errors import PRSMHealthError, require
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
 from prsm_health.core.jsonable import dumps, finite_or_none
@@ -526,22 +525,11 @@ class AssetStore:
         data = dumps(history.to_json(), indent=1).encode("utf-8")
         try:
             self.directory.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=self.directory)
         except OSError as err:
             raise PRSMHealthError(
                 f"{self.directory}: cannot write asset histories there ({err.strerror})"
             ) from None
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(data)
-                f.flush()
-                os.fsync(f.fileno())
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+        write_atomic(path, data, "the asset history")
 
     def assets(self) -> list[str]:
         """The ids of the assets stored, sorted."""

@@ -296,10 +296,12 @@ def check_card_section(check: dict) -> str:
 the no-load stroke (preload), the torque at two speeds under one load with the housing
 temperature (lubricant), the slow reversal under load (clearance, lost motion), the high-load
 stroke (synchronous averages at the nut-pass and roller-spin periods: spalls). Trained on
-`datasets/flight-ema-check.toml` ({tr.get("runs", {}).get("train", "–")} recordings of 64
-units in every state, {tr.get("runs", {}).get("test", "–")} of 16 held-out units) and the same
-units' baselines (`datasets/flight-ema-check-baseline.toml`); tooth damage left out of the
-classifiers (not observable, below). Held-out units: clearance MAE
+`datasets/flight-ema-check.toml` and its preload-loss supplement
+`datasets/flight-ema-check-preload.toml` ({tr.get("runs", {}).get("train", "–")} recordings of
+64 units in every state, {tr.get("runs", {}).get("test", "–")} of 16 held-out units) and the
+same units' baselines (`datasets/flight-ema-check-baseline.toml`: two checks of each unit new,
+whose spread is each indicator's repeatability); the classes a check does not show left out of
+the classifiers and named in every check diagnosis: {", ".join(tr.get("not_observable", {})) or "none"}. Held-out units: clearance MAE
 {_um_text(held.get("clearance_mae"))}, coverage {_pct(held.get("clearance_coverage"))};
 macro-F1 (argmax) alone {_pct(held.get("macro_f1_alone"))}, against the unit's baseline
 {_pct(held.get("macro_f1_against_baseline"))}.

@@ -23,6 +23,7 @@ named in every check diagnosis instead.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -122,8 +123,11 @@ def train_check_model(
 
     Parameters
     ----------
-    check_dir, baseline_dir : path
-        Datasets of check recordings and of the same units' baselines (``[units]`` recipes).
+    check_dir : path or list of paths
+        Datasets of check recordings (``[units]`` recipes of the same units; several are
+        pooled, e.g. a supplement of a rare class).
+    baseline_dir : path
+        The same units' baselines.
     not_observable : dict or None
         Class → why no check shows it (measured), named in every check diagnosis.
     unseen_cases : tuple of str
@@ -137,16 +141,19 @@ def train_check_model(
         ``part``: the bundle's ``check`` dict (:meth:`CheckModel.from_part`); ``metrics``: the
         cross-validated and held-out numbers.
     """
+    import pandas as pd
+
     from prsm_health.datasets import Dataset
 
     from .estimators import ClearanceEstimator, FaultClassifier
     from .evaluation import cross_validated_metrics
 
-    checks, base = Dataset(check_dir), Dataset(baseline_dir)
-    for ds in (checks, base):
+    dirs = [check_dir] if isinstance(check_dir, (str, Path)) else list(check_dir)
+    checks, base = [Dataset(d) for d in dirs], Dataset(baseline_dir)
+    for ds in (*checks, base):
         if "unit_id" not in ds.runs:
             raise PRSMHealthError(f"{ds.path}: runs without unit_id: a recipe with [units]")
-    table = check_table(checks, progress)
+    table = pd.concat([check_table(ds, progress) for ds in checks], ignore_index=True)
     base_table = check_table(base, progress)
     from prsm_health.signals.check_indicators import CHECK_INDICATORS
 

@@ -13,9 +13,7 @@ from __future__ import annotations
 import importlib
 import io
 import json
-import os
 import re
-import tempfile
 import warnings
 import zipfile
 from datetime import datetime, timezone
@@ -25,6 +23,7 @@ from typing import Any
 import numpy as np
 import sklearn
 
+from prsm_health.core.atomic import write_atomic
 from prsm_health.core.errors import ModelVersionError, ParameterError, PRSMHealthError, require
 from prsm_health.core.jsonable import json_ready
 
@@ -129,26 +128,6 @@ def _bundle_bytes(model, header: dict) -> bytes:
     with zipfile.ZipFile(buffer, "a", compression=zipfile.ZIP_DEFLATED) as zf:
         zf.writestr(_HEADER_NAME, json.dumps(json_ready(header), indent=1))
     return buffer.getvalue()
-
-
-def write_atomic(path: Path, data: bytes, what: str = "model file") -> None:
-    """Write ``data`` to ``path`` through a temporary file and a rename: a reader sees the old
-    file or the whole new one, never half of it."""
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    except OSError as err:
-        raise PRSMHealthError(f"{path}: cannot write {what} ({err.strerror})") from None
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def save_model(path, model, *, metadata: dict) -> Path:

@@ -47,7 +47,7 @@ def save_prognostics_model(path, model: RULModel) -> Path:
         type(model).__name__,
         "must be a fitted RULModel",
     )
-    from prsm_health.diagnostics.model_files import write_atomic
+    from prsm_health.core.atomic import write_atomic
 
     text = json.dumps(model.to_dict(), indent=1, allow_nan=False)
     write_atomic(path, text.encode("utf-8"), "prognostics model")

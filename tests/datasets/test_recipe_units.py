@@ -64,10 +64,13 @@ def test_bad_units_are_recipe_errors_naming_the_key(units, needle):
         Recipe.from_dict(dict(BASE, units=units, sweep={"clearance": [1e-6]}))
 
 
-def test_the_shipped_check_recipes_share_their_units():
+@pytest.mark.parametrize("other", ["flight-ema-check-baseline", "flight-ema-check-preload"])
+def test_the_shipped_check_recipes_share_their_units(other):
     check = load_recipe(ROOT / "datasets" / "flight-ema-check.toml")
-    base = load_recipe(ROOT / "datasets" / "flight-ema-check-baseline.toml")
-    assert check.units["seed"] == base.units["seed"] and check.units["count"] == base.units["count"]
+    twin = load_recipe(ROOT / "datasets" / f"{other}.toml")
+    assert check.units["seed"] == twin.units["seed"] and check.units["count"] == twin.units["count"]
     for unit in (0, 17):
-        assert check.unit_build(unit) == base.unit_build(unit)
-    assert check.profile["check"] == "health-check"
+        built, twin_built = check.unit_build(unit), twin.unit_build(unit)
+        # the baseline also fixes the clearance as built; every key both draw is the same
+        assert built and all(twin_built[k] == v for k, v in built.items())
+    assert twin.profile["check"] == "health-check"
