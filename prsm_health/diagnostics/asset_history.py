@@ -73,19 +73,25 @@ def names_a_fault(diagnosis: Diagnosis) -> bool:
     return named and HEALTHY not in (diagnosis.class_set or [])
 
 
-def bundle_priors(bundle) -> tuple[dict | None, dict | None, list[str] | None]:
-    """What a model bundle's check part (:class:`~.check_model.CheckModel`) tells a unit's
-    history: (prior scale per indicator — the within-unit repeatability, training prior per
-    class, the indicators a baseline is of); None for what the bundle lacks (a bundle without
-    a check part: the defaults of :meth:`AssetHistory.record`)."""
-    check = getattr(bundle, "check", None) or {}
-    scale, prior = check.get("repeatability"), check.get("training_prior")
-    names = check.get("feature_names")
-    return (
-        dict(scale) if scale else None,
-        dict(prior) if prior else None,
-        list(names) if names else None,
-    )
+def bundle_priors(bundle, check: bool = True) -> tuple[dict | None, dict | None, list[str] | None]:
+    """What a model bundle tells a unit's history about one kind of recording: (prior scale per
+    indicator — the within-unit repeatability, training prior per class, the indicators a
+    baseline of that kind is of). A health check (``check``) and a bundle with a check part
+    (:class:`~.check_model.CheckModel`): the check model's; otherwise the window model's
+    indicators, no prior scale and no training prior (the defaults of
+    :meth:`AssetHistory.record`). A unit's check recordings and its in-service windows have
+    baselines of their own: their indicators differ."""
+    part = getattr(bundle, "check", None) or {}
+    if check and part:
+        scale, prior = part.get("repeatability"), part.get("training_prior")
+        names = part.get("feature_names")
+        return (
+            dict(scale) if scale else None,
+            dict(prior) if prior else None,
+            list(names) if names else None,
+        )
+    names = getattr(bundle, "feature_names", None)
+    return None, None, (list(names) if names else None)
 
 
 def file_recording_id(*paths: str | Path) -> str:
@@ -197,16 +203,20 @@ class AssetHistory:
         prior_scale: Mapping[str, float] | None = None,
         names: Sequence[str] | None = None,
     ) -> Baseline | None:
-        """The baseline fitted on the entries put in it (:meth:`Baseline.fit`); None until
-        :data:`BASELINE_RECORDINGS` of them. Its indicators: ``names`` (those the members
-        have), else every indicator finite in all of them; None too when the members have none
-        of ``names`` (recordings of another kind than the baseline asked for)."""
-        members = [e for e in self.entries if e.baseline]
+        """The baseline fitted on the entries put in it (:meth:`Baseline.fit`) that have any of
+        ``names`` (the baseline of one kind of recording: health checks, or in-service
+        windows); None until :data:`BASELINE_RECORDINGS` of them. Its indicators: ``names``
+        (those the members have), else every indicator finite in all of them."""
+        # the baseline of this kind of recording: its members that have these indicators
+        members = [
+            e
+            for e in self.entries
+            if e.baseline
+            and (
+                names is None or any(finite_or_none(e.indicators.get(n)) is not None for n in names)
+            )
+        ]
         if len(members) < BASELINE_RECORDINGS:
-            return None
-        if names is not None and not any(
-            finite_or_none(e.indicators.get(n)) is not None for e in members for n in names
-        ):
             return None
         return Baseline.fit(
             [e.indicators for e in members],
@@ -594,7 +604,9 @@ def diagnose_asset(
     from .diagnosis import diagnose  # the model's dependencies only when diagnosing
 
     validate_asset_id(asset_id)
-    prior_scale, training_prior, names = bundle_priors(bundle)
+    from .check_model import is_check
+
+    prior_scale, training_prior, names = bundle_priors(bundle, check=is_check(run))
     with store.locked(asset_id):
         history = store.load(asset_id)
         baseline = history.baseline(prior_scale, names)

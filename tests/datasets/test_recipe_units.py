@@ -64,7 +64,7 @@ def test_bad_units_are_recipe_errors_naming_the_key(units, needle):
         Recipe.from_dict(dict(BASE, units=units, sweep={"clearance": [1e-6]}))
 
 
-@pytest.mark.parametrize("other", ["flight-ema-check-baseline", "flight-ema-check-preload"])
+@pytest.mark.parametrize("other", ["flight-ema-check-baseline"])
 def test_the_shipped_check_recipes_share_their_units(other):
     check = load_recipe(ROOT / "datasets" / "flight-ema-check.toml")
     twin = load_recipe(ROOT / "datasets" / f"{other}.toml")

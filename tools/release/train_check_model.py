@@ -2,9 +2,8 @@
 
     python tools/release/train_check_model.py [--workers 2] [--work build] [--units 8]
 
-1. generates (resumably) the health-check recordings of datasets/flight-ema-check.toml, its
-   preload-loss supplement (datasets/flight-ema-check-preload.toml) and the same units'
-   baselines (datasets/flight-ema-check-baseline.toml) into WORK;
+1. generates (resumably) the health-check recordings of datasets/flight-ema-check.toml and the
+   same units' baselines (datasets/flight-ema-check-baseline.toml) into WORK;
 2. trains the check model (prsm_health.diagnostics.check_training: clearance, the class alone,
    the class against the unit's baseline) and puts it into models/default.skops;
 3. generates fresh units (prsm_health.diagnostics.check_evaluation.evaluation_recipes: three
@@ -51,14 +50,13 @@ def main(argv: list[str] | None = None) -> int:
     work = Path(args.work)
     training = load_recipe(ROOT / "datasets" / "flight-ema-check.toml")
     baseline = load_recipe(ROOT / "datasets" / "flight-ema-check-baseline.toml")
-    preload = load_recipe(ROOT / "datasets" / "flight-ema-check-preload.toml")
     metrics_path = DEFAULT_MODEL.with_name("default.metrics.json")
     metrics = json.loads(metrics_path.read_text())
     if not args.evaluate_only:
-        for recipe in (training, preload, baseline):
+        for recipe in (training, baseline):
             generate(recipe, work / recipe.name, workers=args.workers)
         part, trained = train_check_model(
-            [work / training.name, work / preload.name],
+            work / training.name,
             work / baseline.name,
             not_observable=NOT_OBSERVABLE,
             unseen_cases=UNSEEN_CASES,

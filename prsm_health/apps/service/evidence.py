@@ -212,7 +212,8 @@ def load_baseline(store: HistoryStore, bundle, asset_id: str | None) -> Baseline
     members = tuple(e.recording_id for e in history.entries if e.baseline)
     held, baseline = _cache(store).baseline(asset_id, members, bundle)
     if not held:
-        prior_scale, _, names = bundle_priors(bundle)
+        # the check baseline: only a health check is read against a baseline (diagnose)
+        prior_scale, _, names = bundle_priors(bundle, check=True)
         fitted = history.baseline(prior_scale, names)
         baseline = None if fitted is None else fitted.to_json()
         _cache(store).put_baseline(asset_id, members, bundle, baseline)
@@ -236,7 +237,9 @@ def record(
 ) -> bytes:
     """Record the recording in its asset's history and store it with the request's diagnosis
     rows and spectra, in one transaction; the answer, its diagnosis with ``asset``."""
-    prior_scale, training_prior, names = bundle_priors(bundle)
+    # the priors and baseline of this kind of recording (a check read phase by phase, or windows)
+    kind = bool(part.diagnosis.check_phases)
+    prior_scale, training_prior, names = bundle_priors(bundle, check=kind)
 
     def update(stored: StoredHistory) -> AssetUpdate:
         history = _history(store, part.asset_id, stored.version, stored.load)
