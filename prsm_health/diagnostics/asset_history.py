@@ -207,15 +207,7 @@ class AssetHistory:
         ``names`` (the baseline of one kind of recording: health checks, or in-service
         windows); None until :data:`BASELINE_RECORDINGS` of them. Its indicators: ``names``
         (those the members have), else every indicator finite in all of them."""
-        # the baseline of this kind of recording: its members that have these indicators
-        members = [
-            e
-            for e in self.entries
-            if e.baseline
-            and (
-                names is None or any(finite_or_none(e.indicators.get(n)) is not None for n in names)
-            )
-        ]
+        members = self.members(names)
         if len(members) < BASELINE_RECORDINGS:
             return None
         return Baseline.fit(
@@ -224,6 +216,15 @@ class AssetHistory:
             names=names,
             recordings=[e.recording_id for e in members],
         )
+
+    def members(self, names: Sequence[str] | None = None) -> list[AssetEntry]:
+        """The baseline's recordings of one kind: those put in it that have any of ``names``
+        (all of them when None)."""
+
+        def has(entry):
+            return any(finite_or_none(entry.indicators.get(n)) is not None for n in names)
+
+        return [e for e in self.entries if e.baseline and (names is None or has(e))]
 
     def entry(self, recording_id: str) -> AssetEntry | None:
         """The entry of ``recording_id``, or None."""
@@ -348,7 +349,7 @@ class AssetHistory:
                         "(CUSUM of the baseline distance)"
                     )
 
-        members = sum(e.baseline for e in self.entries) + in_baseline
+        members = len(self.members(names)) + in_baseline
         complete = members >= BASELINE_RECORDINGS
         if evidence is None and probabilities:
             shown = Evidence.start(tuple(probabilities))
@@ -408,7 +409,7 @@ class AssetHistory:
         ``names``), its evidence, its change statistic, and one row per recording (in the
         baseline?, distance, the leading class and its posterior then, the class named then)."""
         baseline = self.baseline(prior_scale, names)
-        members = sum(e.baseline for e in self.entries)
+        members = len(self.members(names))
         evidence = self.evidence
         rows = []
         for e in self.entries:

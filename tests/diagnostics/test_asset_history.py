@@ -280,3 +280,38 @@ def test_distance_is_finite_json(tmp_path):
     assert d.asset.baseline.distance is None and h.cusum == Cusum()
     assert np.isfinite(h.evidence.log_posterior).all()
     json.dumps(d.to_json()["asset"], allow_nan=False)
+
+
+def test_checks_and_windows_of_a_unit_keep_baselines_of_their_own():
+    # three in-service windows (indicators a, b) fill the windows' baseline; a health check
+    # (indicators check_x) then starts the checks' own baseline instead of being scored
+    # against indicators it does not have
+    h, _ = recorded(BASE)
+    assert h.baseline(PRIOR, ["a", "b"]) is not None
+    check = Diagnosis(
+        clearance=ClearanceInterval(10e-6, 8e-6, 12e-6),
+        fault_class="healthy",
+        class_probabilities={"healthy": 0.9, "wear": 0.1},
+        class_set=["healthy"],
+        observability=Observability(True, True),
+        indicators={"check_x": 1.0},
+        model=ModelReference("m", "1", "paper01", "flight-ema"),
+        check_phases={"reversal": "slow reversal"},
+    )
+    h, d = h.record("check-0", check, names=["check_x"])
+    assert h.entries[-1].baseline and d.asset.baseline.recordings == 1
+    assert h.baseline(None, ["check_x"]) is None  # one check: the checks' baseline not complete
+    assert h.baseline(PRIOR, ["a", "b"]).count == 3  # the windows' baseline unchanged
+
+
+def test_bundle_priors_are_those_of_the_recordings_kind():
+    class Bundle:
+        feature_names = ["a", "b"]
+        check = {
+            "repeatability": {"check_x": 0.5},
+            "training_prior": {"healthy": 1.0},
+            "feature_names": ["check_x"],
+        }
+
+    assert bundle_priors(Bundle(), check=True) == ({"check_x": 0.5}, {"healthy": 1.0}, ["check_x"])
+    assert bundle_priors(Bundle(), check=False) == (None, None, ["a", "b"])

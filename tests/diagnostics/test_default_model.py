@@ -21,7 +21,10 @@ def bundle():
 
 
 def test_size_and_card():
-    assert DEFAULT_MODEL.stat().st_size < 5e6
+    # two models in one file since issue [3/5] — the window model (≈ 4.9 MB) and the check
+    # part (≈ 4.4 MB: a conformal clearance estimator and two calibrated classifiers) — kept
+    # under 10 MB so the repository does not grow by more than that per retraining
+    assert DEFAULT_MODEL.stat().st_size < 10e6
     assert (ROOT / "models" / "MODEL_CARD.md").exists()
     metrics = json.loads((ROOT / "models" / "default.metrics.json").read_text())
     # The training script's held-out numbers (measured, not asserted elsewhere): recorded.
@@ -33,7 +36,9 @@ def test_size_and_card():
         "honesty",
         "sensitivity",
         "ablation",
+        "check",
     } <= set(metrics)
+    assert {"training", "evaluation"} <= set(metrics["check"])
 
 
 def _point_run(recipe, spec, **changes):
