@@ -18,7 +18,7 @@ DEMO := build/demo-run
 
 # The main job: validate the physics against the papers, generate the demo dataset, train a
 # model on it, simulate a new worn-actuator recording to MCAP and its health check to Parquet,
-# diagnose the recording, replay it.
+# diagnose the recording, read the health check phase by phase with the shipped model, replay.
 demo: $(STAMP)
 	mkdir -p $(DEMO)
 	$(BIN)/prsm-health validate > $(DEMO)/validation.txt && tail -n 1 $(DEMO)/validation.txt
@@ -30,8 +30,9 @@ demo: $(STAMP)
 	$(BIN)/prsm-health simulate --profile health-check --clearance 22e-6 --seed 99 \
 		--out $(DEMO)/check.parquet --plot $(DEMO)/check.png
 	$(BIN)/prsm-health diagnose $(DEMO)/recording.mcap --model $(DEMO)/model.skops --plot $(DEMO)/diagnosis.png
+	$(BIN)/prsm-health diagnose $(DEMO)/check.parquet > $(DEMO)/check-diagnosis.txt && head -n 4 $(DEMO)/check-diagnosis.txt
 	$(BIN)/prsm-health replay $(DEMO)/recording.mcap --model $(DEMO)/model.skops --out $(DEMO)/recording-diagnosed.mcap
-	@echo "demo outputs in $(DEMO)/ (validation.txt, recording.png, check.png, diagnosis.png, recording-diagnosed.mcap)"
+	@echo "demo outputs in $(DEMO)/ (validation.txt, recording.png, check.png, diagnosis.png, check-diagnosis.txt, recording-diagnosed.mcap)"
 
 # The dashboard's browser test (tests/service/test_dashboard_browser.py) drives Debian's
 # Chromium: installed here when missing (apt-get, as root). Without it that test fails;

@@ -48,6 +48,31 @@ def test_diagnose_says_of_what_the_observability_is_a_share(capsys):
     assert lines["class observable"].endswith("in 50 % of windows")
 
 
+def test_a_check_says_its_phases_and_why_it_cannot_tell(capsys):
+    result = SimpleNamespace(
+        clearance={"estimate": 24e-6, "lower": 0.0, "upper": 40e-6},
+        fault_class="cannot_tell",
+        class_set=["healthy", "spall"],
+        class_probabilities={"spall": 0.4, "healthy": 0.6},
+        observability={"clearance": False, "fault": False},
+        undecided=SimpleNamespace(
+            kind="not_observable",
+            missing=["a slow reversal under load"],
+            candidates=[],
+            next_recording="run the health check",
+        ),
+        check_phases={"no_load": "quiet", "high_load": "heavy"},
+        model={"name": "m", "version": "1"},
+        warnings=[],
+    )
+    rows = diagnosis_rows("c.parquet", result)
+    assert ("cannot tell", "not observable", "  (a slow reversal under load)") in rows
+    assert ("record next", "run the health check", "") in rows
+    assert ("check phases", "high_load: heavy", "") in rows
+    assert ("clearance observable", "no", "") in rows
+    assert not any(r[0] in ("windows", "out-of-distribution score") for r in rows)
+
+
 REPORT = {
     "model": {"name": "m", "version": "1"},
     "dataset": "d",

@@ -175,13 +175,28 @@ def diagnosis_rows(file: str, result) -> list:
         ),
     ]
     rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
-    rows += [
-        ("clearance observable", share(result.observability.get("clearance"), "windows"), ""),
-        ("class observable", share(result.observability.get("fault"), "windows"), ""),
-        ("out-of-distribution score", ood_verdict(result), ""),
-        ("windows", len(result.windows), ""),
-        ("model", f"{result.model['name']} v{result.model['version']}", ""),
-    ]
+    u = getattr(result, "undecided", None)
+    if u is not None:
+        told = ", ".join(u.missing or u.candidates)
+        rows += [("cannot tell", u.kind.replace("_", " "), f"  ({told})" if told else "")]
+        rows += [("record next", u.next_recording, "")]
+    if getattr(result, "check_phases", None):  # a check read phase by phase: no windows
+        seen = result.observability
+        rows += [
+            ("check phases", f"{role}: {phase}", "") for role, phase in result.check_phases.items()
+        ]
+        rows += [
+            ("clearance observable", "yes" if seen.get("clearance") else "no", ""),
+            ("class observable", "yes" if seen.get("fault") else "no", ""),
+        ]
+    else:
+        rows += [
+            ("clearance observable", share(result.observability.get("clearance"), "windows"), ""),
+            ("class observable", share(result.observability.get("fault"), "windows"), ""),
+            ("out-of-distribution score", ood_verdict(result), ""),
+            ("windows", len(result.windows), ""),
+        ]
+    rows += [("model", f"{result.model['name']} v{result.model['version']}", "")]
     rows += asset_rows(getattr(result, "asset", None))
     rows += [("warning", text, "") for text in result.warnings]
     return rows
