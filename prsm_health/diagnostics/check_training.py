@@ -246,13 +246,14 @@ def _held_out(part, table, changes, names, relative_names) -> dict:
     return out
 
 
-def add_check_model(model_path, part: dict) -> None:
-    """Put the check part into a saved model bundle (re-saved atomically, its metadata kept)."""
+def add_check_model(model_path, part: dict) -> Path:
+    """Save the check part of the bundle ``model_path`` beside it
+    (:func:`~prsm_health.diagnostics.diagnosis.check_part_path`, written atomically), where
+    :func:`~prsm_health.diagnostics.diagnosis.load_bundle` finds it; returns its path."""
+    from .diagnosis import check_part_path
     from .model_files import load_model, save_model
 
-    model, metadata = load_model(model_path)
+    model, _ = load_model(model_path)
     if not isinstance(model, dict) or "feature_names" not in model:
         raise PRSMHealthError(f"{model_path}: not a prsm_health diagnosis bundle")
-    model["check"] = part
-    keep = {k: v for k, v in metadata.items() if k not in ("versions", "saved_at")}
-    save_model(model_path, model, metadata=keep)
+    return save_model(check_part_path(model_path), part, metadata={"part": "check"})

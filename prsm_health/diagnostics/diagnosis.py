@@ -198,14 +198,24 @@ def load_bundle(
     model, metadata = load_model(path, allow_version_mismatch=allow_version_mismatch)
     if not isinstance(model, dict) or "feature_names" not in model:
         raise PRSMHealthError(f"{path}: not a prsm_health diagnosis bundle")
+    check = model.get("check")
+    if check is None and check_part_path(path).exists():
+        check, _ = load_model(check_part_path(path), allow_version_mismatch=allow_version_mismatch)
     return ModelBundle(
         model.get("clearance"),
         model.get("fault"),
         list(model["feature_names"]),
         metadata,
         model.get("guard"),
-        model.get("check"),
+        check,
     )
+
+
+def check_part_path(path: str | Path) -> Path:
+    """Where a bundle's check part lives: ``<name>.check.skops`` beside ``<name>.skops`` (a
+    file of its own, so neither file of the shipped model grows past 5 MiB)."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.check{path.suffix}")
 
 
 def _matrix(rows: list[dict], names: list[str]):
