@@ -185,18 +185,15 @@ def evaluate_check_model(bundle, datasets: dict, *, threshold: float = 0.9) -> d
     }
 
 
-def _observable_states(model) -> list[str]:
-    return [
-        s
-        for s in HEADLINE_STATES
-        if EVAL_STATES[s][0] not in model.not_observable and s not in model.not_observable
-    ]
+def _observable_states(not_observable) -> list[str]:
+    """The :data:`HEADLINE_STATES` whose class is not among ``not_observable``."""
+    return [s for s in HEADLINE_STATES if EVAL_STATES[s][0] not in not_observable]
 
 
 def _class_scores(records, key: str, model) -> dict:
     from sklearn.metrics import f1_score
 
-    shown = set(_observable_states(model))
+    shown = set(_observable_states(model.not_observable))
     rows = [r for r in records if r["state"] in shown]
     truth = np.array([r["fault_class"] for r in rows])
     pred = np.array([r[key] for r in rows])
@@ -232,7 +229,7 @@ def _class_scores(records, key: str, model) -> dict:
 def _accumulated(units, model, threshold) -> dict:
     from sklearn.metrics import f1_score, roc_auc_score
 
-    shown = set(_observable_states(model))
+    shown = set(_observable_states(model.not_observable))
     rows = [u for u in units if u["state"] in shown]
     truth = np.array([u["fault_class"] for u in rows])
     pred = np.array([u["named"] for u in rows])
@@ -317,7 +314,7 @@ the classifiers and named in every check diagnosis: {", ".join(tr.get("not_obser
 macro-F1 (argmax) alone {_pct(held.get("macro_f1_alone"))}, against the unit's baseline
 {_pct(held.get("macro_f1_against_baseline"))}.
 
-**Fresh units** ({acc["units"] // max(1, len(_observable_states_of(check)))} per state, a units
+**Fresh units** ({acc["units"] // max(1, len(_observable_states(check.get("training", {}).get("not_observable", {}))))} per state, a units
 seed never used in training): three baseline checks each, then five checks in each state at
 default severity. Fault macro-F1 over the states the check is built to show — healthy, wear,
 severe wear, lubrication, a nut spall, a roller spall, preload loss, less any named not
@@ -350,8 +347,3 @@ Five checks against the baseline, per unit:
 
 def _um_text(x) -> str:
     return "–" if x is None else f"{1e6 * x:.2f} µm"
-
-
-def _observable_states_of(check: dict) -> list[str]:
-    unseen = set(check.get("training", {}).get("not_observable", {}))
-    return [s for s in HEADLINE_STATES if EVAL_STATES[s][0] not in unseen]
