@@ -52,6 +52,11 @@ HEADLINE_STATES = (
     "spall_roller",
     "preload_loss",
 )
+#: A wrong answer is *confident* when its class probability exceeds this.
+CONFIDENT = 0.6
+#: Naming thresholds of the trade-off table (the diagnosis names from
+#: :data:`~prsm_health.diagnostics.answer.NAME_PROBABILITY` = 0.5 up).
+NAMING_THRESHOLDS = (0.5, 0.6, 0.7, 0.8)
 #: The unit as built in every evaluation recipe: a preloaded nut (so a preload loss is one),
 #: clearance as built 2–8 µm, the training recipe's uneven wear and installation ranges.
 AS_BUILT = {"preload": [2e-6, 5e-6], "clearance": [2e-6, 8e-6]}
@@ -159,6 +164,7 @@ def evaluate_check_model(bundle, datasets: dict, *, threshold: float = 0.9) -> d
                         "predicted_alone": alone.fault_class,
                         "top_alone": max(alone.class_probabilities.values()),
                         "predicted_against": against.fault_class,
+                        "top_against": max(against.class_probabilities.values()),
                         "clearance": 0.5 * (row.clearance_screw + row.clearance_nut),
                         "estimate": alone.clearance["estimate"],
                         "lower": alone.clearance["lower"],
@@ -220,9 +226,37 @@ def _class_scores(records, key: str, model) -> dict:
         "cannot_tell_fraction": float(np.mean(pred == CANNOT_TELL)),
         "confusion": confusion,
     }
-    if key == "predicted_alone":
-        top = np.array([r["top_alone"] for r in rows])
-        out["confident_wrong_fraction"] = float(np.mean(wrong & (top > 0.6)))
+    top_key = "top_alone" if key == "predicted_alone" else "top_against"
+    if all(top_key in r for r in rows):
+        top = np.array([r[top_key] for r in rows])
+        if key == "predicted_alone":
+            out["confident_wrong_fraction"] = float(np.mean(wrong & (top > CONFIDENT)))
+        out["naming_thresholds"] = _naming_thresholds(truth, pred, top, labels)
+    return out
+
+
+def _naming_thresholds(truth, pred, top, labels) -> list[dict]:
+    """The same answers had a class been named only from probability ``t`` up (below it
+    ``cannot_tell``): what a stricter naming rule costs in named healthy units and F1, and
+    what it saves in wrong names."""
+    from sklearn.metrics import f1_score
+
+    out = []
+    for t in NAMING_THRESHOLDS:
+        named = np.where(top >= t, pred, CANNOT_TELL)
+        healthy = truth == "healthy"
+        out.append(
+            {
+                "threshold": t,
+                "macro_f1": float(
+                    f1_score(truth, named, labels=labels, average="macro", zero_division=0)
+                ),
+                "healthy_named_healthy": float(np.mean(named[healthy] == "healthy"))
+                if healthy.any()
+                else None,
+                "wrong_fraction": float(np.mean((named != truth) & (named != CANNOT_TELL))),
+            }
+        )
     return out
 
 
@@ -296,6 +330,12 @@ def check_card_section(check: dict) -> str:
         for s in states
     )
     held = tr.get("held_out", {})
+    counts = ", ".join(f"{k} {v}" for k, v in tr.get("class_counts", {}).items()) or "–"
+    strict = "\n".join(
+        f"| {row['threshold']:.1f} | {_pct(row['macro_f1'])} | {_pct(row['healthy_named_healthy'])} "
+        f"| {_pct(row['wrong_fraction'])} |"
+        for row in single.get("naming_thresholds", [])
+    )
     auc = ", ".join(f"{k} {v:.3f}" for k, v in acc["spall_auc"].items()) or "–"
     return f"""
 ## Health-check recordings (the check part of the bundle)
@@ -306,10 +346,15 @@ def check_card_section(check: dict) -> str:
 the no-load stroke (preload), the torque at two speeds under one load with the housing
 temperature (lubricant), the slow reversal under load (clearance, lost motion), the high-load
 stroke (synchronous averages at the nut-pass and roller-spin periods: spalls). Trained on
-`datasets/flight-ema-check.toml` ({tr.get("runs", {}).get("train", "–")} recordings of 64 units in every state, {tr.get("runs", {}).get("test", "–")} of 16 held-out units) and the
-same units' baselines (`datasets/flight-ema-check-baseline.toml`: two checks of each unit new,
-whose spread is each indicator's repeatability); the classes a check does not show left out of
-the classifiers and named in every check diagnosis: {", ".join(tr.get("not_observable", {})) or "none"}. Held-out units: clearance MAE
+80 units ({tr.get("runs", {}).get("train", "–")} check recordings of 64 units, {tr.get("runs", {}).get("test", "–")} of 16 held-out units; per class
+{counts}): `datasets/flight-ema-check.toml` (every state, drawn independently of the unit),
+`flight-ema-check-aging.toml` (each unit at its as-built clearance with one new state) and
+`flight-ema-check-healthy.toml` (more healthy checks), with the same units' baselines
+(`flight-ema-check-baseline.toml`: two checks of each unit new, whose spread is each
+indicator's repeatability). Classes weighted equally; probabilities calibrated, and class sets
+set, on folds that keep a unit's checks together (a unit seen in both halves made the model as
+sure of a new unit as of a known one). The classes a check does not show are left out of the
+classifiers and named in every check diagnosis: {", ".join(tr.get("not_observable", {})) or "none"}. Held-out units: clearance MAE
 {_um_text(held.get("clearance_mae"))}, coverage {_pct(held.get("clearance_coverage"))};
 macro-F1 (argmax) alone {_pct(held.get("macro_f1_alone"))}, against the unit's baseline
 {_pct(held.get("macro_f1_against_baseline"))}.
@@ -336,6 +381,15 @@ One check alone, per state (rows: the unit's state; columns: the diagnosis):
 | state | {head} |
 |---|{"---|" * len(predicted)}
 {rows}
+
+A stricter naming rule (one check alone, a class named only from probability t up): what it
+costs in healthy units named healthy and in F1, what it saves in wrong names. The wrong names
+left at 0.5 are units whose fault leaves its signature inside the healthy units' scatter
+(docs/diagnostics.md, "Measured").
+
+| t | macro-F1 | healthy named healthy | wrong class |
+|---|---|---|---|
+{strict}
 
 Five checks against the baseline, per unit:
 

@@ -34,6 +34,12 @@ from .training import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target
 
 #: Cross-validation folds (by unit).
 CHECK_CV = 3
+#: The check classifiers: the window model's settings, classes weighted to equal total weight.
+#: The training checks are mostly faulty (a recipe draws every state) while a fleet is mostly
+#: healthy: with equal weights the probabilities are those of a uniform class prior — the
+#: training recipes' mix is no one's prior — and each class is learnt with the same care; the
+#: evidence accumulation then divides out a uniform prior (the part's ``training_prior``).
+CHECK_FAULT_PARAMS = dict(FAULT_PARAMS, class_weight="balanced")
 #: Classes no health check of the flight-ema instrumentation shows, and why (measured:
 #: tools/studies/duty_signatures.py and docs/faults.md "At realistic duty").
 NOT_OBSERVABLE = {
@@ -146,6 +152,24 @@ def train_check_model(
         ``part``: the bundle's ``check`` dict (:meth:`CheckModel.from_part`); ``metrics``: the
         cross-validated and held-out numbers.
     """
+    from threadpoolctl import threadpool_limits
+
+    # one OpenMP thread per booster, as train_model: small models, and spin-waiting threads
+    # on busy cores made a 2 s fit take minutes
+    with threadpool_limits(limits=1, user_api="openmp"):
+        return _train_check_model(
+            check_dir,
+            baseline_dir,
+            not_observable=not_observable,
+            unseen_cases=unseen_cases,
+            random_state=random_state,
+            progress=progress,
+        )
+
+
+def _train_check_model(
+    check_dir, baseline_dir, *, not_observable, unseen_cases, random_state, progress
+) -> tuple[dict, dict]:
     import pandas as pd
 
     from prsm_health.datasets import Dataset
@@ -176,8 +200,10 @@ def train_check_model(
     units = table.loc[fit_rows, "unit_id"].to_numpy()
     y_class = table.loc[fit_rows, "fault_class"].astype(str).to_numpy()
     y_clearance = clearance_target(table.loc[train])
+    classes, counts = np.unique(y_class, return_counts=True)
     metrics: dict = {
         "runs": {"train": int(train.sum()), "test": int((~train).sum())},
+        "class_counts": {str(c): int(k) for c, k in zip(classes, counts)},
         "baseline_runs": len(base_table),
         "indicators": names,
         "unseen_cases": list(unseen_cases),
@@ -188,7 +214,7 @@ def train_check_model(
         return ClearanceEstimator(**CLEARANCE_PARAMS, random_state=random_state)
 
     def classifier():
-        return FaultClassifier(**FAULT_PARAMS, random_state=random_state)
+        return FaultClassifier(**CHECK_FAULT_PARAMS, random_state=random_state)
 
     x_train = table.loc[train, names]
     metrics["clearance_cv"] = cross_validated_metrics(
@@ -198,19 +224,19 @@ def train_check_model(
     metrics["fault_cv"] = cross_validated_metrics(
         classifier, table.loc[fit_rows, names], y_class, groups=units, cv=CHECK_CV
     )
-    fault = classifier().fit(table.loc[fit_rows, names], y_class)
+    fault = classifier().fit(table.loc[fit_rows, names], y_class, groups=units)
     metrics["fault_relative_cv"] = cross_validated_metrics(
         classifier, changes.loc[fit_rows, relative_names], y_class, groups=units, cv=CHECK_CV
     )
-    fault_relative = classifier().fit(changes.loc[fit_rows, relative_names], y_class)
-    classes, counts = np.unique(y_class, return_counts=True)
+    fault_relative = classifier().fit(changes.loc[fit_rows, relative_names], y_class, groups=units)
     part = {
         "feature_names": names,
         "clearance": clearance,
         "fault": fault,
         "fault_relative": fault_relative,
         "repeatability": scatter,
-        "training_prior": {str(c): float(k / counts.sum()) for c, k in zip(classes, counts)},
+        # balanced class weights: the classifiers' prior is uniform, whatever the counts
+        "training_prior": {str(c): 1.0 / len(classes) for c in classes},
         "not_observable": dict(not_observable or {}),
         "clearance_range": [float(np.min(y_clearance)), float(np.max(y_clearance))],
     }

@@ -38,7 +38,7 @@ import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.calibration import CalibratedClassifierCV
 from sklearn.ensemble import HistGradientBoostingClassifier, HistGradientBoostingRegressor
-from sklearn.model_selection import KFold, StratifiedKFold, cross_val_predict
+from sklearn.model_selection import KFold, StratifiedGroupKFold, StratifiedKFold, cross_val_predict
 from sklearn.utils import check_random_state
 from sklearn.utils.class_weight import compute_sample_weight
 from sklearn.utils.multiclass import check_classification_targets
@@ -450,7 +450,8 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
     regression overfits below roughly a thousand calibration samples [1]_. Choose
     ``"isotonic"`` for large training sets.
 
-    On small data the number of calibration folds drops to the size of the smallest class;
+    On small data the number of calibration folds drops to the size of the smallest class (with
+    ``groups``, to the fewest groups a class is seen in);
     with fewer than 2 samples in some class the booster is fitted uncalibrated
     (``calibration_folds_ = 0``) and a warning is issued.
 
@@ -565,7 +566,7 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         )
         _check_hgb_params(self)
 
-    def fit(self, X, y):
+    def fit(self, X, y, groups=None):
         """Fit the booster and its probability calibration.
 
         Parameters
@@ -574,6 +575,12 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
             Features; NaN allowed (missing feature), inf not.
         y : array-like of shape (n_samples,)
             Class labels (at least 2 distinct).
+        groups : array-like of shape (n_samples,) or None
+            The unit (or recording) each sample comes from. Given, the calibration folds keep
+            a group's samples together (stratified group k-fold), so the probabilities and the
+            class-set thresholds are calibrated on units the fold model never saw — several
+            recordings of one unit in both halves of a fold would make them as confident on a
+            new unit as on a known one.
 
         Returns
         -------
@@ -610,14 +617,25 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
             sample_weight = compute_sample_weight(class_weight, y_idx)
         booster = HistGradientBoostingClassifier(**_hgb_params(self), random_state=seed)
         folds = int(min(self.calibration_cv, np.bincount(y_idx).min()))
+        if groups is not None:
+            groups = np.asarray(groups)
+            require(
+                len(groups) == len(y_idx), "groups", len(groups), f"one per sample ({len(y_idx)})"
+            )
+            # a class seen in fewer groups than folds leaves some fold without it
+            folds = min(folds, min(len(np.unique(groups[y_idx == k])) for k in np.unique(y_idx)))
         if folds >= 2:
-            cv = StratifiedKFold(n_splits=folds, shuffle=True, random_state=seed)
+            if groups is None:
+                cv = StratifiedKFold(n_splits=folds, shuffle=True, random_state=seed)
+            else:
+                cv = StratifiedGroupKFold(n_splits=folds, shuffle=True, random_state=seed)
+            splits = list(cv.split(X, y_idx, groups))
             self.model_ = CalibratedClassifierCV(
-                booster, method=self.calibration_method, cv=cv
+                booster, method=self.calibration_method, cv=splits
             ).fit(X, y_idx, sample_weight=sample_weight)
             self.calibration_folds_ = folds
             boosters = [c.estimator for c in self.model_.calibrated_classifiers_]
-            self.set_thresholds_ = self._set_thresholds(X, y_idx, cv)
+            self.set_thresholds_ = self._set_thresholds(X, y_idx, splits)
         else:
             warnings.warn(
                 "FaultClassifier: a class has a single sample, so probabilities are not calibrated",
@@ -631,14 +649,14 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         self.n_iter_ = max(int(b.n_iter_) for b in boosters)
         return self
 
-    def _set_thresholds(self, X, y_idx, cv) -> np.ndarray:
+    def _set_thresholds(self, X, y_idx, splits) -> np.ndarray:
         """Per-class conformal thresholds of the class set from the out-of-fold calibrated
         probabilities.
 
-        ``calibrated_classifiers_`` follow ``cv.split`` (deterministic: shuffled with a fixed
-        seed), so fold ``k``'s model predicts exactly the samples it did not see."""
+        ``calibrated_classifiers_`` follow ``splits`` in order, so fold ``k``'s model predicts
+        exactly the samples it did not see."""
         held_out = np.empty(len(y_idx))
-        for model, (_, test) in zip(self.model_.calibrated_classifiers_, cv.split(X, y_idx)):
+        for model, (_, test) in zip(self.model_.calibrated_classifiers_, splits):
             proba = np.clip(model.predict_proba(X[test]), 0.0, 1.0)
             proba /= proba.sum(axis=1, keepdims=True)
             held_out[test] = proba[np.arange(len(test)), y_idx[test]]

@@ -48,6 +48,12 @@ __all__ = [
 # --------------------------------------------------------------------------------------------
 
 
+def _takes_groups(estimator, groups) -> bool:
+    import inspect
+
+    return groups is not None and "groups" in inspect.signature(estimator.fit).parameters
+
+
 def _feature_names(estimator, X) -> list[str]:
     if isinstance(X, pd.DataFrame):
         return [str(c) for c in X.columns]
@@ -328,7 +334,10 @@ def cross_validated_metrics(
     folds = []
     for train, test in splits:
         with sparse_feature_errors(X, f"{len(splits)}-fold cross-validation"):
-            est = make().fit(_take(X, train), y[train])
+            est = make()
+            # an estimator that calibrates by group (FaultClassifier) keeps the folds' groups
+            fit_groups = {"groups": np.asarray(groups)[train]} if _takes_groups(est, groups) else {}
+            est = est.fit(_take(X, train), y[train], **fit_groups)
         X_test, y_test = _take(X, test), y[test]
         if classification:
             cols = np.searchsorted(classes, est.classes_)

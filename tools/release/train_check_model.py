@@ -2,10 +2,13 @@
 
     python tools/release/train_check_model.py [--workers 2] [--work build] [--units 8]
 
-1. generates (resumably) the health-check recordings of datasets/flight-ema-check.toml and the
-   same units' baselines (datasets/flight-ema-check-baseline.toml) into WORK;
-2. trains the check model (prsm_health.diagnostics.check_training: clearance, the class alone,
-   the class against the unit's baseline) and puts it into models/default.skops;
+1. generates (resumably) into WORK the health-check recordings of datasets/flight-ema-check.toml
+   (units in every state), the same units' baselines (flight-ema-check-baseline.toml), their
+   checks as they age from the baseline (flight-ema-check-aging.toml) and their further healthy
+   checks (flight-ema-check-healthy.toml);
+2. trains the check model on the three pooled (prsm_health.diagnostics.check_training:
+   clearance, the class alone, the class against the unit's baseline) and saves it beside
+   models/default.skops (models/default.check.skops);
 3. generates fresh units (prsm_health.diagnostics.check_evaluation.evaluation_recipes: three
    baseline checks and five checks per state each) and scores the diagnosis on them — one check
    alone, and five checks against the unit's baseline with the evidence accumulated;
@@ -50,13 +53,17 @@ def main(argv: list[str] | None = None) -> int:
     work = Path(args.work)
     training = load_recipe(ROOT / "datasets" / "flight-ema-check.toml")
     baseline = load_recipe(ROOT / "datasets" / "flight-ema-check-baseline.toml")
+    supplements = [
+        load_recipe(ROOT / "datasets" / f"flight-ema-check-{name}.toml")
+        for name in ("aging", "healthy")
+    ]
     metrics_path = DEFAULT_MODEL.with_name("default.metrics.json")
     metrics = json.loads(metrics_path.read_text())
     if not args.evaluate_only:
-        for recipe in (training, baseline):
+        for recipe in (training, baseline, *supplements):
             generate(recipe, work / recipe.name, workers=args.workers)
         part, trained = train_check_model(
-            work / training.name,
+            [work / r.name for r in (training, *supplements)],
             work / baseline.name,
             not_observable=NOT_OBSERVABLE,
             unseen_cases=UNSEEN_CASES,
