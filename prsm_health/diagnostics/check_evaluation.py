@@ -57,6 +57,24 @@ CONFIDENT = 0.6
 #: Naming thresholds of the trade-off table (the diagnosis names from
 #: :data:`~prsm_health.diagnostics.answer.NAME_PROBABILITY` = 0.5 up).
 NAMING_THRESHOLDS = (0.5, 0.6, 0.7, 0.8)
+#: What the sensitivity table splits the checks by: label → how the card names it (the
+#: documented ranges drawn per check or per unit by the recipes).
+SENSITIVITY_FACTORS = {
+    "instrumentation.nut_axial_accel.noise_density_ug": "accelerometer noise [µg/√Hz]",
+    "instrumentation.nut_position.noise": "LVDT noise [µm RMS]",
+    "instrumentation.drive_torque.noise": "torque noise [mN·m RMS]",
+    "temperature": "temperature [°C]",
+    "wear_spread": "uneven wear between rollers [-]",
+    "drive_train.payload_mass": "payload [kg]",
+    "drive_train.coupling_stiffness": "coupling stiffness [kN·m/rad]",
+}
+#: Display scale of each factor (SI inside; the card in the units above).
+_FACTOR_SCALE = {
+    "instrumentation.nut_position.noise": (1e6, 0.0),
+    "instrumentation.drive_torque.noise": (1e3, 0.0),
+    "temperature": (1.0, -273.15),
+    "drive_train.coupling_stiffness": (1e-3, 0.0),
+}
 #: The unit as built in every evaluation recipe: a preloaded nut (so a preload loss is one),
 #: clearance as built 2–8 µm, the training recipe's uneven wear and installation ranges.
 AS_BUILT = {"preload": [2e-6, 5e-6], "clearance": [2e-6, 8e-6]}
@@ -169,6 +187,9 @@ def evaluate_check_model(bundle, datasets: dict, *, threshold: float = 0.9) -> d
                         "estimate": alone.clearance["estimate"],
                         "lower": alone.clearance["lower"],
                         "upper": alone.clearance["upper"],
+                        "conditions": {
+                            k: float(row[k]) for k in SENSITIVITY_FACTORS if k in row.index
+                        },
                     }
                 )
             posterior = evidence.posterior()
@@ -186,6 +207,7 @@ def evaluate_check_model(bundle, datasets: dict, *, threshold: float = 0.9) -> d
         "against_baseline_single": _class_scores(records, "predicted_against", model),
         "accumulated": _accumulated(units, model, threshold),
         "clearance": _clearance(records),
+        "sensitivity": _sensitivity(records, model),
         "records": records,
         "units": units,
     }
@@ -289,6 +311,43 @@ def _accumulated(units, model, threshold) -> dict:
     }
 
 
+def _sensitivity(records, model) -> list[dict]:
+    """One check alone, the headline states, split into thirds of each
+    :data:`SENSITIVITY_FACTORS` range: share named right, share named wrong, clearance MAE."""
+    shown = set(_observable_states(model.not_observable))
+    rows = [r for r in records if r["state"] in shown and r.get("conditions")]
+    out = []
+    for factor in SENSITIVITY_FACTORS:
+        values = np.array([r["conditions"].get(factor, np.nan) for r in rows], float)
+        if not np.isfinite(values).any():
+            continue
+        edges = np.nanquantile(values, [0.0, 1 / 3, 2 / 3, 1.0])
+        scale, offset = _FACTOR_SCALE.get(factor, (1.0, 0.0))
+        for k in range(3):
+            upper = values <= edges[k + 1] if k == 2 else values < edges[k + 1]
+            inside = (values >= edges[k]) & upper
+            chosen = [r for r, keep in zip(rows, inside) if keep]
+            if not chosen:
+                continue
+            right = np.mean([r["predicted_alone"] == r["fault_class"] for r in chosen])
+            wrong = np.mean(
+                [r["predicted_alone"] not in (r["fault_class"], CANNOT_TELL) for r in chosen]
+            )
+            mae = np.mean([abs(r["estimate"] - r["clearance"]) for r in chosen])
+            out.append(
+                {
+                    "factor": factor,
+                    "low": float(edges[k] * scale + offset),
+                    "high": float(edges[k + 1] * scale + offset),
+                    "n": len(chosen),
+                    "named_right": float(right),
+                    "wrong": float(wrong),
+                    "clearance_mae": float(mae),
+                }
+            )
+    return out
+
+
 def _clearance(records) -> dict:
     y = np.array([r["clearance"] for r in records], float)
     est = np.array([r["estimate"] for r in records], float)
@@ -331,6 +390,11 @@ def check_card_section(check: dict) -> str:
     )
     held = tr.get("held_out", {})
     counts = ", ".join(f"{k} {v}" for k, v in tr.get("class_counts", {}).items()) or "–"
+    sensitivity = "\n".join(
+        f"| {SENSITIVITY_FACTORS[row['factor']]} | {row['low']:.3g} – {row['high']:.3g} | {row['n']} "
+        f"| {_pct(row['named_right'])} | {_pct(row['wrong'])} | {_um_text(row['clearance_mae'])} |"
+        for row in ev.get("sensitivity", [])
+    )
     strict = "\n".join(
         f"| {row['threshold']:.1f} | {_pct(row['macro_f1'])} | {_pct(row['healthy_named_healthy'])} "
         f"| {_pct(row['wrong_fraction'])} |"
@@ -390,6 +454,15 @@ left at 0.5 are units whose fault leaves its signature inside the healthy units'
 | t | macro-F1 | healthy named healthy | wrong class |
 |---|---|---|---|
 {strict}
+
+Sensitivity (one check alone, the headline states, each factor's drawn range cut into thirds;
+the others drawn as usual). The sensors' noise and the temperature are drawn per check; uneven
+wear, payload and coupling once per unit, so their thirds are groups of the 8 units — a
+comparison of units, not a controlled change:
+
+| factor | range | checks | named right | wrong class | clearance MAE |
+|---|---|---|---|---|---|
+{sensitivity}
 
 Five checks against the baseline, per unit:
 
