@@ -221,7 +221,11 @@ def _observable_states(not_observable) -> list[str]:
 def _class_scores(records, key: str, model) -> dict:
     from sklearn.metrics import f1_score
 
-    shown = set(_observable_states(model.not_observable))
+    # a class only the unit's baseline shows is not scored on checks read alone
+    hidden = dict(model.not_observable)
+    if key == "predicted_alone":
+        hidden.update(getattr(model, "baseline_only", {}))
+    shown = set(_observable_states(hidden))
     rows = [r for r in records if r["state"] in shown]
     truth = np.array([r["fault_class"] for r in rows])
     pred = np.array([r[key] for r in rows])
@@ -314,7 +318,7 @@ def _accumulated(units, model, threshold) -> dict:
 def _sensitivity(records, model) -> list[dict]:
     """One check alone, the headline states, split into thirds of each
     :data:`SENSITIVITY_FACTORS` range: share named right, share named wrong, clearance MAE."""
-    shown = set(_observable_states(model.not_observable))
+    shown = set(_observable_states({**model.not_observable, **getattr(model, "baseline_only", {})}))
     rows = [r for r in records if r["state"] in shown and r.get("conditions")]
     out = []
     for factor in SENSITIVITY_FACTORS:
@@ -418,7 +422,9 @@ stroke (synchronous averages at the nut-pass and roller-spin periods: spalls). T
 indicator's repeatability). Classes weighted equally; probabilities calibrated, and class sets
 set, on folds that keep a unit's checks together (a unit seen in both halves made the model as
 sure of a new unit as of a known one). The classes a check does not show are left out of the
-classifiers and named in every check diagnosis: {", ".join(tr.get("not_observable", {})) or "none"}. Held-out units: clearance MAE
+classifiers and named in every check diagnosis: {", ".join(tr.get("not_observable", {})) or "none"}; those
+only the change against the unit's baseline shows are left out of the classifier that reads a
+check alone, and named in its diagnoses: {", ".join(tr.get("baseline_only", {})) or "none"}. Held-out units: clearance MAE
 {_um_text(held.get("clearance_mae"))}, coverage {_pct(held.get("clearance_coverage"))};
 macro-F1 (argmax) alone {_pct(held.get("macro_f1_alone"))}, against the unit's baseline
 {_pct(held.get("macro_f1_against_baseline"))}.
@@ -427,7 +433,8 @@ macro-F1 (argmax) alone {_pct(held.get("macro_f1_alone"))}, against the unit's b
 seed never used in training): three baseline checks each, then five checks in each state at
 default severity. Fault macro-F1 over the states the check is built to show — healthy, wear,
 severe wear, lubrication, a nut spall, a roller spall, preload loss, less any named not
-observable above (`cannot_tell` a miss; screw spalls and tooth damage in the tables below):
+observable above (`cannot_tell` a miss; screw spalls and tooth damage in the tables below; a
+check alone is not scored on the classes only the baseline shows):
 
 | reading | n | macro-F1 | healthy named healthy | wrong class | confident wrong | `cannot_tell` |
 |---|---|---|---|---|---|---|

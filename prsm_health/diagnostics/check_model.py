@@ -21,7 +21,7 @@ the warnings with the measured reason, never merged silently into another class.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -72,6 +72,9 @@ class CheckModel:
         accumulation divides it out).
     not_observable : dict
         Class → why a check cannot show it (measured).
+    baseline_only : dict
+        Class → why one check alone cannot show it, though its change against the unit's
+        baseline does (measured): ``fault_relative`` knows the class, ``fault`` does not.
     clearance_range : (float, float) [m]
     """
 
@@ -83,6 +86,7 @@ class CheckModel:
     training_prior: dict
     not_observable: dict
     clearance_range: tuple[float, float]
+    baseline_only: dict = field(default_factory=dict)
 
     @classmethod
     def from_part(cls, part: dict) -> CheckModel:
@@ -95,6 +99,7 @@ class CheckModel:
             dict(part.get("training_prior", {})),
             dict(part.get("not_observable", {})),
             tuple(part.get("clearance_range", (math.nan, math.nan))),
+            dict(part.get("baseline_only", {})),
         )
 
     def relative_names(self) -> list[str]:
@@ -198,6 +203,12 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
             undecided = ambiguous(class_set, baseline=relative, check=True)
     for cls, reason in model.not_observable.items():
         notes.append(f"not observable by this check: {cls} — {reason}")
+    if not relative:
+        for cls, reason in model.baseline_only.items():
+            notes.append(
+                f"not observable by one check alone: {cls} — {reason}; against this unit's "
+                "baseline (its first health checks) it is"
+            )
     if baseline is None and model.fault_relative is not None:
         notes.append(
             "read alone: no baseline of this unit (its first health checks); against a "

@@ -66,7 +66,7 @@ from .angle_domain import (
     subtract_synchronous,
     synchronous_average,
 )
-from .features import extract_features, run_design
+from .features import extract_features, lost_motion_step, run_design
 from .spectra import welch_psd
 
 #: The roles a check's phases are found for, in order.
@@ -124,6 +124,7 @@ def _indicator_table() -> dict[str, str]:
         "efficiency": "-",
     }
     units.update({f"check_reversal_{k}": reversal_units[k] for k in REVERSAL_FEATURES})
+    units["check_reversal_lost_motion_step"] = "m"
     units.update({f"check_highload_snr_{k}": "-" for k in SNR_PERIODS})
     units.update(
         {
@@ -399,6 +400,15 @@ def _reversal(phase: Run, design: PRSMDesign, out: dict) -> None:
         return
     for name in REVERSAL_FEATURES:
         out[f"check_reversal_{name}"] = float(values[name])
+    # the lost motion again, as the fitted jump between the flank sides: it averages the
+    # LVDT's noise out, which the percentile spread above grows with
+    if {"nut_position", "screw_angle", "screw_speed"} <= set(channels):
+        out["check_reversal_lost_motion_step"] = lost_motion_step(
+            channels["nut_position"],
+            channels["screw_angle"],
+            speed_ratios(design).nut,
+            np.sign(channels["screw_speed"]),
+        )
 
 
 def _high_load(phase: Run, design: PRSMDesign, gear_ratio: float, out: dict) -> str | None:

@@ -111,6 +111,17 @@ def test_against_the_baseline_the_change_model_answers(check_run):
     assert not any("read alone" in w for w in d.warnings)
 
 
+def test_a_class_only_the_baseline_shows_is_named_so_when_a_check_is_read_alone(check_run):
+    model = bundle()
+    model.check["baseline_only"] = {"preload_loss": "the lost motion of units as built spreads"}
+    alone = diagnose(check_run, model)
+    note = "not observable by one check alone: preload_loss"
+    assert any(w.startswith(note) for w in alone.warnings)
+    baseline = Baseline.fit([alone.indicators] * 3, prior_scale=model.check["repeatability"])
+    against = diagnose(check_run, model, baseline=baseline)
+    assert not any(w.startswith(note) for w in against.warnings)
+
+
 def test_a_check_without_its_high_load_phase_cannot_show_a_spall(check_run):
     d = diagnose(without_phase(check_run, "heavy"), bundle())
     assert d.fault_class == CANNOT_TELL

@@ -129,6 +129,7 @@ def test_torque_ratio_temperature_and_centroid(reading):
     # reversal indicators read (lost motion of a rigid nut: the LVDT follows the angle)
     assert values["check_reversal_torque_rattle_rate"] > 0
     assert values["check_reversal_lost_motion"] == pytest.approx(0.0, abs=1e-9)
+    assert values["check_reversal_lost_motion_step"] == pytest.approx(0.0, abs=1e-9)
     assert math.isnan(values["check_reversal_efficiency"])  # no load cell
 
 

@@ -30,6 +30,8 @@ from prsm_health.diagnostics.check_evaluation import (
     generate_evaluation,
 )
 from prsm_health.diagnostics.check_training import (
+    BASELINE_ONLY,
+    BASELINE_ONLY_CASES,
     NOT_OBSERVABLE,
     UNSEEN_CASES,
     add_check_model,
@@ -67,6 +69,8 @@ def main(argv: list[str] | None = None) -> int:
             work / baseline.name,
             not_observable=NOT_OBSERVABLE,
             unseen_cases=UNSEEN_CASES,
+            baseline_only=BASELINE_ONLY,
+            baseline_only_cases=BASELINE_ONLY_CASES,
             progress=True,
         )
         add_check_model(DEFAULT_MODEL, part)
