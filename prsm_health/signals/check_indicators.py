@@ -66,7 +66,8 @@ from .angle_domain import (
     subtract_synchronous,
     synchronous_average,
 )
-from .features import extract_features, lost_motion_step, run_design
+from .features import extract_features, run_design
+from .lost_motion import lost_motion_step
 from .spectra import welch_psd
 
 #: The roles a check's phases are found for, in order.

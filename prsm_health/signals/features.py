@@ -50,13 +50,8 @@ from prsm_health.physics.kinematics import defect_frequencies, speed_ratios
 
 from .envelope_analysis import defect_lines_batch
 from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
-from .kernels import (
-    hysteresis_crossings,
-    moment_sums,
-    screw_power_sums,
-    step_polynomial_normal_equations,
-    subtract_polynomial,
-)
+from .kernels import hysteresis_crossings, moment_sums, screw_power_sums
+from .lost_motion import lost_motion_spread
 from .spectra import amplitude_spectrum, peak_frequency, welch_psd
 
 SHORT = {
@@ -624,7 +619,7 @@ def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> Non
             else:  # the load's sign, from the load cell or else the drive torque
                 force = load if load is not None else slow_torque
                 side = np.sign(force - 0.5 * (np.max(force) + np.min(force)))
-            out["lost_motion"] = _lost_motion(
+            out["lost_motion"] = lost_motion_spread(
                 ch["nut_position"], ch["screw_angle"], nut_per_rad, side
             )
 
@@ -682,61 +677,6 @@ def _gear(runs, design: PRSMDesign, ratios, rows) -> None:
             for k, (w, name) in enumerate((w, name) for w, _ in found for name in present):
                 for key in TSA_INDICATORS:
                     rows[w][f"{SHORT[name]}_tsa_{period}_{key}"] = float(values[key][k])
-
-
-def _lost_motion(position: np.ndarray, angle: np.ndarray, lead: float, side: np.ndarray) -> float:
-    """Spread (1st–99th percentile) of the nut's lag behind the rigid kinematics [m]
-    (:func:`_lag_fit`: the lag with the sensor's nonlinearity and the lead error removed)."""
-    residual, _ = _lag_fit(position, angle, lead, side)
-    low, high = np.percentile(residual, [1, 99])
-    return float(high - low)
-
-
-def lost_motion_step(position, angle, lead: float, side) -> float:
-    """The jump of the nut's lag between the two flank sides, from the step fitted with
-    :func:`_lag_fit` [m]: 2·|c_s|, the step being ±c_s on ``side`` = ±1.
-
-    Every sample of the reversal enters the fit, so the position sensor's noise averages out;
-    the percentile spread of :func:`_lost_motion` (the window indicator ``lost_motion``) grows
-    with it instead — measured on one unit's health check: 103 µm at 2 µm RMS of LVDT noise,
-    126 µm at 10 µm, while the play and the elastic lag did not change. NaN when the nut did
-    not move or the run holds one side only.
-    """
-    side = np.asarray(side, float)
-    if not (np.any(side > 0) and np.any(side < 0)):
-        return math.nan
-    _, step = _lag_fit(np.asarray(position, float), np.asarray(angle, float), lead, side)
-    return 2.0 * abs(step)
-
-
-def _lag_fit(position: np.ndarray, angle: np.ndarray, lead: float, side: np.ndarray):
-    """(lag, step): the nut's lag behind the rigid kinematics (position − lead·angle) with a
-    smooth function of the position removed, and the fitted step on the flank side [m].
-
-    The lag jumps by the play at each reversal. A smooth function of the position — the
-    position sensor's nonlinearity (an LVDT's ±0.25 % of full scale is hundreds of µm over a
-    stroke) and the screw's cumulative lead error — is removed: a 7th-degree polynomial in the
-    position, fitted together with a step on the flank side (``side`` = ±1: the sign of the
-    speed or of the load) so that it does not absorb the jumps, and only the polynomial
-    subtracted. NaN step when the nut did not move.
-    """
-    residual = position - lead * angle
-    lo, hi = float(np.min(position)), float(np.max(position))
-    step = math.nan
-    if hi > lo:
-        # Chebyshev polynomials of the position mapped onto [-1, 1]: the same degree-7 space as
-        # plain powers, but nearly orthogonal, so the 9 × 9 normal equations are well
-        # conditioned and cost a fraction of an SVD least-squares solve of 20,000 rows; summed
-        # block by block by a kernel (a 20,000 × 9 basis was most of the time)
-        position = np.ascontiguousarray(position, float)
-        side = np.ascontiguousarray(side, float)
-        gram, rhs = np.empty((9, 9)), np.empty(9)
-        step_polynomial_normal_equations(position, side, residual, lo, hi, 7, gram, rhs)
-        # (least squares on the small system: a step collinear with the polynomial stays solvable)
-        coef = np.linalg.lstsq(gram, rhs, rcond=None)[0]
-        subtract_polynomial(position, residual, lo, hi, coef[:8], residual)
-        step = float(coef[8])
-    return residual, step
 
 
 def _reverses(x: np.ndarray) -> bool:

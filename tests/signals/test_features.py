@@ -14,12 +14,11 @@ from prsm_health.signals.features import (
     FEATURES,
     GROUPS,
     TRUTH_FEATURES,
-    _lost_motion,
     extract_features,
     indicator_groups,
-    lost_motion_step,
     windows,
 )
+from prsm_health.signals.lost_motion import lost_motion_spread, lost_motion_step
 
 RATE = 20_000.0
 D = preset("paper01")
@@ -160,7 +159,7 @@ def test_lost_motion_step_averages_the_position_noise_out():
         measured = pos - 15e-6 * side + s_curve + sigma * rng.normal(size=n)
         step = lost_motion_step(measured, angle, speed_ratios(D).nut, side)
         assert step == pytest.approx(30e-6, abs=0.5e-6)
-        spreads.append(_lost_motion(measured, angle, speed_ratios(D).nut, side))
+        spreads.append(lost_motion_spread(measured, angle, speed_ratios(D).nut, side))
     assert spreads[1] > spreads[0] + 10e-6  # the spread: +≈ 18 µm from the noise alone
     assert math.isnan(lost_motion_step(pos, angle, speed_ratios(D).nut, np.ones(n)))  # one side
 
