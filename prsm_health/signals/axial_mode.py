@@ -34,15 +34,19 @@ R. Singh, "Non-linear frequency response characteristics of an impact pair", J. 
 
 from __future__ import annotations
 
+import hashlib
 import math
-from dataclasses import replace
+from dataclasses import asdict, replace
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
+import scipy
 from scipy.ndimage import uniform_filter1d
 
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.drive_train import DriveTrain
+from prsm_health.core.disk_cache import cached_float
 from prsm_health.core.errors import require
 
 from .spectra import welch_psd
@@ -131,8 +135,41 @@ def _nut_modes(design: PRSMDesign, load: float, drive_train: DriveTrain, law_sca
     return values, peak
 
 
+@lru_cache(maxsize=1)
+def _model_fingerprint() -> str:
+    """Hash of the code the contact mode is computed by: this module and the layers that build
+    the simulator's model (core, actuator, physics, simulation), with numpy's and scipy's
+    versions (their eigensolvers)."""
+    package = Path(__file__).resolve().parents[1]
+    files = sorted(
+        p
+        for layer in ("core", "actuator", "physics", "simulation")
+        for p in (package / layer).rglob("*.py")
+    )
+    digest = hashlib.sha256(f"numpy {np.__version__} scipy {scipy.__version__}".encode())
+    for path in [*files, Path(__file__).resolve()]:
+        digest.update(path.relative_to(package).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
 @lru_cache(maxsize=512)
 def _contact_mode(design: PRSMDesign, load: float, drive_train: DriveTrain) -> float:
+    # Each mode takes ≈ 0.1–0.4 s (two linearisations) and a process's first window needs ten
+    # (the duty band's corners, the reference): kept on disk, a new process (a CLI command, a
+    # service's diagnosis process) reads them in milliseconds.
+    key = {
+        "design": asdict(design),
+        "load": load,
+        "drive_train": asdict(drive_train),
+        "code": _model_fingerprint(),
+    }
+    return cached_float(
+        "contact-mode", key, lambda: _computed_contact_mode(design, load, drive_train)
+    )
+
+
+def _computed_contact_mode(design: PRSMDesign, load: float, drive_train: DriveTrain) -> float:
     values, peak = _nut_modes(design, load, drive_train, 1.0)
     stiffer, _ = _nut_modes(design, load, drive_train, 1.0 + SENSITIVITY_STEP)
     f = values.imag / (2 * math.pi)
@@ -386,10 +423,17 @@ def contact_band(
 
 
 @lru_cache(maxsize=32)
-def _duty_band(design: PRSMDesign, drive_train: DriveTrain) -> tuple[float, float]:
+def _dynamic_rating(design: PRSMDesign) -> float:
+    # C_a, once per design: its thread-load solution takes ≈ 20–60 ms, and every window's
+    # reference frequency needs it
     from prsm_health.physics.load_rating import load_ratings
 
-    rating = load_ratings(design).dynamic
+    return float(load_ratings(design).dynamic)
+
+
+@lru_cache(maxsize=32)
+def _duty_band(design: PRSMDesign, drive_train: DriveTrain) -> tuple[float, float]:
+    rating = _dynamic_rating(design)
     loads = (DUTY_LOAD_SHARES[0] * rating, DUTY_LOAD_SHARES[1] * rating)
     return contact_band(
         design, loads, DUTY_CLEARANCES, drive_train=drive_train, ramp_time=DUTY_RAMP_TIME
@@ -459,9 +503,8 @@ def reference_frequency(
     Paper 01 §3.3; paper 04 (Hertzian thread stiffness).
     """
     from prsm_health.actuator.states import DEFAULT_LOAD_SHARE
-    from prsm_health.physics.load_rating import load_ratings
 
-    rating = load_ratings(design).dynamic
+    rating = _dynamic_rating(design)
     if load is None or not math.isfinite(load):
         load = DEFAULT_LOAD_SHARE * rating
     steps = math.log(max(abs(load), 1.0) / rating) / math.log(REFERENCE_STEP)

@@ -44,6 +44,7 @@ TINY_FLEET = {
     "profile": {"load_profile": "reversing"},
     "options": {"contact_law": "hertz"},
     "life": {"units": 3, "snapshots": 4},
+    "batch_size": 6,  # one batch per worker
 }
 
 
@@ -89,7 +90,7 @@ def history(tmp_path_factory):
 @pytest.fixture(scope="module")
 def fleet(tmp_path_factory):
     out = tmp_path_factory.mktemp("fleet") / "tiny-fleet"
-    generate(Recipe.from_dict(copy.deepcopy(TINY_FLEET)), out, workers=1, progress=False)
+    generate(Recipe.from_dict(copy.deepcopy(TINY_FLEET)), out, workers=2, progress=False)
     return out
 
 

@@ -39,6 +39,7 @@ FLEET = {
     "profile": {"load_profile": "reversing"},
     "options": {"contact_law": "hertz"},
     "life": {"units": 4, "snapshots": 3},
+    "batch_size": 6,  # one batch per worker
 }
 BASE = preset("paper01")
 #: paper01 renamed, with a nut twice as heavy: another mechanism.
@@ -54,7 +55,7 @@ def run(capsys, *argv):
 @pytest.fixture(scope="module")
 def fleet(tmp_path_factory):
     out = tmp_path_factory.mktemp("fleet") / "tiny-fleet"
-    generate(Recipe.from_dict(copy.deepcopy(FLEET)), out, workers=1, progress=False)
+    generate(Recipe.from_dict(copy.deepcopy(FLEET)), out, workers=2, progress=False)
     return out
 
 
@@ -141,7 +142,7 @@ def test_a_fleet_of_another_design_needs_its_own_diagnosis_model(tmp_path, capsy
     recipe["instrumentation"] = "ideal"
     # the heavier nut's contacts are stiffer than paper01's default step allows
     recipe["options"] = {"contact_law": "hertz", "max_step": "auto"}
-    generate(Recipe.from_dict(recipe, base=tmp_path), tmp_path / "own", workers=1, progress=False)
+    generate(Recipe.from_dict(recipe, base=tmp_path), tmp_path / "own", workers=2, progress=False)
     code, out, err = run(
         capsys, "train", tmp_path / "own", "--target", "rul", "--out", tmp_path / "p.json"
     )

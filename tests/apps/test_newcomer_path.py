@@ -35,6 +35,7 @@ duration = 0.5
 sample_rate = 20000
 seed = 11
 test_fraction = 0.25
+batch_size = 3  # 8 batches: both workers busy to the end (3 batches of 8 leave one idle)
 [profile]
 load = 2000.0
 load_profile = "reversing"
@@ -57,6 +58,7 @@ duration = 0.5
 sample_rate = 20000
 seed = 5
 test_fraction = 0.25
+batch_size = 3
 [profile]
 load_profile = "reversing"
 [options]

@@ -42,6 +42,22 @@ def test_size_and_card():
     assert {"training", "evaluation"} <= set(metrics["check"])
 
 
+def test_loaded_again_the_shipped_model_is_a_copy_not_rebuilt(bundle, reversing_run, monkeypatch):
+    # load_model keeps what it rebuilt from a file's bytes for the process (auditing and
+    # rebuilding the two files takes seconds) and hands each caller a deep copy of its own
+    import skops.io
+
+    def rebuild(*_, **__):
+        raise AssertionError("rebuilt again from the same bytes")
+
+    monkeypatch.setattr(skops.io, "loads", rebuild)
+    again = load_bundle()
+    assert again.clearance is not bundle.clearance and again.fault is not bundle.fault
+    assert again.check is not bundle.check and again.metadata == bundle.metadata
+    run = reversing_run(20e-6)
+    assert diagnose(run, again).to_json() == diagnose(run, bundle).to_json()
+
+
 def _point_run(recipe, spec, **changes):
     """The run of a recipe point with changes to its source (another design, profile, …)."""
     one = point_recipe(recipe, spec.point, **changes).runs()[0]

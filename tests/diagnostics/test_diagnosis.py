@@ -29,6 +29,7 @@ RECIPE = textwrap.dedent(
     instrumentation = "ideal"
     seed = 5
     test_fraction = 0.2
+    batch_size = 4  # 10 batches: both workers busy to the end (5 batches of 8 leave one idle)
     [profile]
     load_profile = "reversing"
     load_amplitude = 300.0

@@ -157,6 +157,37 @@ def test_band_without_the_drive_train_covers_the_payloads_and_linkages(monkeypat
     assert axial_mode.duty_band(D, DriveTrain()) == (10.0, 50.0)
 
 
+def test_contact_mode_cached_on_disk_is_the_computed_one(tmp_path, monkeypatch):
+    # A new process (a CLI command, a service's diagnosis process) reads the linearisations from
+    # the cache directory: the value read is the value computed, bitwise; a corrupt entry or
+    # another version of the code is computed again.
+    monkeypatch.setenv("PRSM_HEALTH_CACHE_DIR", str(tmp_path))
+    drive_train = axial_mode._loaded_drive_train(None)
+    computed = axial_mode._computed_contact_mode(D, 1000.0, drive_train)
+    calls = []
+
+    def compute(*args):
+        calls.append(args)
+        return computed
+
+    monkeypatch.setattr(axial_mode, "_computed_contact_mode", compute)
+
+    def in_a_new_process():
+        axial_mode._contact_mode.cache_clear()
+        return axial_mode._contact_mode(D, 1000.0, drive_train)
+
+    assert in_a_new_process() == computed and len(calls) == 1  # computed, then stored
+    (entry,) = (tmp_path / "contact-mode").glob("*.json")
+    assert in_a_new_process() == computed and len(calls) == 1  # read back
+    entry.write_bytes(b'{"key": "{\\"code\\": ')  # a half-written file
+    assert in_a_new_process() == computed and len(calls) == 2  # computed again, rewritten
+    assert in_a_new_process() == computed and len(calls) == 2
+    monkeypatch.setattr(axial_mode, "_model_fingerprint", lambda: "another version")
+    assert in_a_new_process() == computed and len(calls) == 3
+    assert len(list((tmp_path / "contact-mode").glob("*.json"))) == 2
+    axial_mode._contact_mode.cache_clear()
+
+
 # ----------------------------------------------------------------- tracking
 def _resonance(f0: float, zeta: float, gain: float, n: int, rng) -> np.ndarray:
     """Acceleration of a single-degree-of-freedom resonance driven by white force."""

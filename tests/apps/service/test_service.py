@@ -1,9 +1,10 @@
 """HTTP diagnostics service, tested against real uvicorn servers on 127.0.0.1.
 
 Servers run in background threads of this process (one model load for the module) on a socket
-bound to port 0, except the restart test, which runs ``serve`` in two successive subprocesses
-on the same database file. The schema-driven fuzz run (schemathesis) checks that no generated
-request, valid or not, gets a 5xx answer and that every answer matches the OpenAPI document.
+bound to port 0, except in the restart test, which runs ``prsm-health serve`` in two successive
+subprocesses on the same database file, and in the Ctrl-C test (with diagnosis processes). The
+schema-driven fuzz run (schemathesis) checks that no generated request, valid or not, gets a 5xx
+answer and that every answer matches the OpenAPI document.
 """
 
 import json
@@ -45,6 +46,7 @@ from prsm_health.io.parquet import write_run_parquet
 
 TOKEN = "test-token-3f9a1c0e"
 CONTRACT_KEYS = {"clearance", "fault_class", "class_probabilities", "indicators", "model"}
+ARROW = {"content-type": "application/vnd.apache.arrow.stream"}
 
 
 # ----------------------------------------------------------------------------- fixtures
@@ -490,47 +492,51 @@ def _free_port() -> int:
 
 
 @contextmanager
-def _serve_process(db: Path, env_token: str):
-    """``serve`` in a subprocess, token from the environment variable."""
+def _command_line_service(db: Path, log: Path, *, processes: str = "0", token: str = ""):
+    """``prsm-health serve`` in a subprocess on ``db`` (``token`` through the environment
+    variable), yielded warm — the model loaded and a diagnosis walked once in the server and in
+    each diagnosis process — as (client, url). Leaving stops it with Ctrl-C, which must end it
+    with exit status 0, no traceback and nothing leaked (the resource tracker would warn of
+    leftover shared memory segments); its stderr is written to ``log``."""
     port = _free_port()
-    code = (
-        "import sys; from prsm_health.apps.service import serve; "
-        f"serve('127.0.0.1', {port}, db_path=sys.argv[1], log_level='warning')"
-    )
-    env = {**os.environ, "PRSM_HEALTH_TOKEN": env_token}
-    proc = subprocess.Popen([sys.executable, "-c", code, str(db)], env=env)
+    cmd = [sys.executable, "-m", "prsm_health.apps.cli", "serve", "--port", str(port)]
+    cmd += ["--db", str(db), "--processes", processes, "--log-level", "warning"]
+    env = {**os.environ, "PRSM_HEALTH_TOKEN": token}  # empty: no token
     url = f"http://127.0.0.1:{port}"
-    headers = {"Authorization": f"Bearer {env_token}"}
-    try:
-        deadline = time.monotonic() + 90
-        while True:
-            try:
-                if httpx.get(f"{url}/v1/health", headers=headers, timeout=2).status_code == 200:
-                    break
-            except httpx.TransportError:
-                pass
-            if proc.poll() is not None or time.monotonic() > deadline:
-                raise RuntimeError("service process did not start")
-            time.sleep(0.1)
-        with httpx.Client(base_url=url, headers=headers, timeout=60) as c:
-            yield c, url
-    finally:
-        proc.send_signal(signal.SIGINT)
+    headers = {"Authorization": f"Bearer {token}"} if token else {}
+    with open(log, "wb") as err:
+        proc = subprocess.Popen(cmd, env=env, stderr=err, stdout=subprocess.DEVNULL)
         try:
-            proc.wait(timeout=30)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+            deadline = time.monotonic() + 120
+            while True:
+                try:
+                    if httpx.get(f"{url}/v1/health", headers=headers, timeout=2).json()["warm"]:
+                        break
+                except httpx.TransportError:
+                    pass
+                assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
+                time.sleep(0.2)
+            with httpx.Client(base_url=url, headers=headers, timeout=60) as client:
+                yield client, url
+        finally:
+            proc.send_signal(signal.SIGINT)
+            code = proc.wait(timeout=60)
+    text = log.read_text()
+    assert code == 0 and "Traceback" not in text and "leaked" not in text, text
 
 
-@pytest.mark.slow
+@pytest.mark.slow  # the command-line service in two successive subprocesses
 def test_history_survives_a_restart(recording, tmp_path):
-    db = tmp_path / "history.sqlite"
-    with _serve_process(db, "env-token-1234") as (c, url):
+    # and Ctrl-C stops the service without diagnosis processes cleanly, after a JSON and an
+    # Arrow body were diagnosed (with processes: test_ctrl_c_stops_the_command_line_service…)
+    db, token = tmp_path / "history.sqlite", "env-token-1234"
+    with _command_line_service(db, tmp_path / "first.txt", token=token) as (c, url):
         assert httpx.get(f"{url}/v1/health").status_code == 401  # env token enforced
         stored = c.post("/v1/diagnose", json=_body(recording, asset_id="press-3"))
         assert stored.status_code == 200, stored.text
-    with _serve_process(db, "env-token-1234") as (c, _):
+        arrow = write_run_arrow(recording.without_truth())
+        assert c.post("/v1/diagnose", content=arrow, headers=ARROW).status_code == 200
+    with _command_line_service(db, tmp_path / "second.txt", token=token) as (c, _):
         h = c.get("/v1/assets/press-3/history")
         assert h.status_code == 200
         assert h.json()["count"] == 1
@@ -705,11 +711,10 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
         bad = c.post("/v1/diagnose", json={**body, "sample_rate": 0.5})
         assert bad.status_code == 422 and "sample_rate" in bad.json()["error"]
         # a binary body crosses to the process as bytes and is decoded there
-        arrow = {"content-type": "application/vnd.apache.arrow.stream"}
         binary = c.post(
             "/v1/diagnose",
             content=write_run_arrow(recording.without_truth()),
-            headers=arrow,
+            headers=ARROW,
             params={"asset_id": "pump-7"},
         )
         assert binary.status_code == 200
@@ -719,7 +724,7 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
         # the bodies crossed through shared memory segments, kept for the next requests
         segments = set(app.state.workers._bodies.names)
         assert segments and all(n.startswith(SHARED_BODY_PREFIX) for n in segments)
-        garbage = c.post("/v1/diagnose", content=b"garbage" * 20, headers=arrow)
+        garbage = c.post("/v1/diagnose", content=b"garbage" * 20, headers=ARROW)
         assert garbage.status_code == 422 and garbage.json()["error"].startswith("arrow body: ")
         assert c.get("/v1/assets/pump-7/history").json()["count"] == 2
         pids = [p.pid for p in app.state.workers._processes._processes.values()]
@@ -747,36 +752,12 @@ def test_diagnosis_processes_answer_as_the_threads_do(bundle, recording, files, 
             os.kill(pid, 0)
 
 
-@pytest.mark.slow  # starts the command-line service in a subprocess
-@pytest.mark.parametrize("processes", ["0", "2"])
-def test_ctrl_c_stops_the_command_line_service_without_a_traceback(tmp_path, processes, recording):
-    port = _free_port()
-    cmd = [sys.executable, "-m", "prsm_health.apps.cli", "serve", "--port", str(port)]
-    cmd += ["--db", str(tmp_path / "h.sqlite"), "--processes", processes, "--log-level", "warning"]
-    log = tmp_path / "stderr.txt"
-    with open(log, "wb") as err:
-        proc = subprocess.Popen(cmd, stderr=err, stdout=subprocess.DEVNULL)
-        try:
-            deadline = time.monotonic() + 120
-            while True:  # warm: the diagnosis processes, if any, have loaded the model
-                try:
-                    if httpx.get(f"http://127.0.0.1:{port}/v1/health", timeout=2).json()["warm"]:
-                        break
-                except httpx.TransportError:
-                    pass
-                assert proc.poll() is None and time.monotonic() < deadline, log.read_text()
-                time.sleep(0.2)
-            # a body large enough to cross to a diagnosis process through shared memory
-            r = httpx.post(
-                f"http://127.0.0.1:{port}/v1/diagnose",
-                content=write_run_arrow(recording.without_truth()),
-                headers={"content-type": "application/vnd.apache.arrow.stream"},
-                timeout=60,
-            )
-            assert r.status_code == 200, r.text
-        finally:
-            proc.send_signal(signal.SIGINT)
-            code = proc.wait(timeout=60)
-    text = log.read_text()
-    # nothing leaked (the resource tracker would warn of leftover shared memory segments)
-    assert code == 0 and "Traceback" not in text and "leaked" not in text, text
+@pytest.mark.slow  # the command-line service and its two diagnosis processes
+def test_ctrl_c_stops_the_command_line_service_without_a_traceback(tmp_path, recording):
+    # with diagnosis processes (without them: the two stops of test_history_survives_a_restart)
+    service = _command_line_service(tmp_path / "h.sqlite", tmp_path / "err.txt", processes="2")
+    with service as (c, _):
+        # a body large enough to cross to a diagnosis process through shared memory
+        arrow = write_run_arrow(recording.without_truth())
+        r = c.post("/v1/diagnose", content=arrow, headers=ARROW)
+        assert r.status_code == 200, r.text
