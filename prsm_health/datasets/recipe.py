@@ -394,11 +394,12 @@ class Recipe:
         check(isinstance(build, dict), "units.build", build, "must be a table of [min, max]")
         for key, value in build.items():
             check(
-                key in UNIT_BUILD or key.split(".")[0] in ("options", "drive_train"),
+                key in UNIT_BUILD
+                or key.split(".")[0] in ("options", "drive_train", "instrumentation"),
                 f"units.build.{key}",
                 value,
-                f"must be one of {', '.join(UNIT_BUILD)} or an options./drive_train. field "
-                "(what a unit is built and installed with)",
+                f"must be one of {', '.join(UNIT_BUILD)} or an options./drive_train./"
+                "instrumentation. field (what a unit is built and installed with)",
             )
             check(is_range(value), f"units.build.{key}", value, "must be [min, max]")
         for key, minimum in (("count", 1), ("seed", 0)):

@@ -4,8 +4,8 @@ recordings of a unit read against its own baseline with the evidence accumulated
 :func:`evaluation_recipes` derives, from a check training recipe, recipes of *fresh* units (a
 ``[units]`` seed never used in training): each unit recorded three times new and healthy (its
 baseline) and five times in each state of :data:`EVAL_STATES` at default severity, as built
-(its preload, uneven wear, installation the same in all its recordings), the temperature and
-the sensors' noise and errors drawn per recording. :func:`evaluate_check_model` diagnoses every
+(its preload, uneven wear, installation and the noise levels of its sensors the same in all
+its recordings), the temperature and the sensors' noise, gains and offsets drawn per recording. :func:`evaluate_check_model` diagnoses every
 recording through :func:`prsm_health.diagnostics.diagnosis.diagnose` — alone, and against the
 unit's baseline — and accumulates each unit's evidence
 (:class:`~prsm_health.diagnostics.baseline.Evidence`).
@@ -57,6 +57,9 @@ CONFIDENT = 0.6
 #: Naming thresholds of the trade-off table (the diagnosis names from
 #: :data:`~prsm_health.diagnostics.answer.NAME_PROBABILITY` = 0.5 up).
 NAMING_THRESHOLDS = (0.5, 0.6, 0.7, 0.8)
+#: Posterior thresholds of the accumulated evidence's trade-off table (the diagnosis names from
+#: :data:`~prsm_health.diagnostics.baseline.EVIDENCE_NAME_PROBABILITY` = 0.9).
+EVIDENCE_THRESHOLDS = (0.7, 0.8, 0.9, 0.95)
 #: What the sensitivity table splits the checks by: label → how the card names it (the
 #: documented ranges drawn per check or per unit by the recipes).
 SENSITIVITY_FACTORS = {
@@ -304,6 +307,19 @@ def _accumulated(units, model, threshold) -> dict:
         well = [u["posterior"].get("spall", 0.0) for u in units if u["state"] == "healthy"]
         if sick and well:
             auc[state] = float(roc_auc_score([1] * len(sick) + [0] * len(well), sick + well))
+    trade_off = []
+    for t in EVIDENCE_THRESHOLDS:
+        named = np.array([_named(u["posterior"], t) for u in rows])
+        trade_off.append(
+            {
+                "threshold": t,
+                "macro_f1": float(
+                    f1_score(truth, named, labels=labels, average="macro", zero_division=0)
+                ),
+                "wrong_fraction": float(np.mean((named != truth) & (named != CANNOT_TELL))),
+                "cannot_tell_fraction": float(np.mean(named == CANNOT_TELL)),
+            }
+        )
     return {
         "units": len(rows),
         "threshold": threshold,
@@ -312,7 +328,14 @@ def _accumulated(units, model, threshold) -> dict:
         "cannot_tell_fraction": float(np.mean(pred == CANNOT_TELL)),
         "spall_auc": auc,
         "confusion": confusion,
+        "thresholds": trade_off,
     }
+
+
+def _named(posterior: dict, threshold: float) -> str:
+    """The class a posterior names at ``threshold`` (as :meth:`Evidence.named`)."""
+    best = max(posterior, key=posterior.get)
+    return best if posterior[best] >= threshold else CANNOT_TELL
 
 
 def _sensitivity(records, model) -> list[dict]:
@@ -404,6 +427,11 @@ def check_card_section(check: dict) -> str:
         f"| {_pct(row['wrong_fraction'])} |"
         for row in single.get("naming_thresholds", [])
     )
+    evidence_rule = "\n".join(
+        f"| {row['threshold']:.2f} | {_pct(row['macro_f1'])} | {_pct(row['wrong_fraction'])} "
+        f"| {_pct(row['cannot_tell_fraction'])} |"
+        for row in acc.get("thresholds", [])
+    )
     auc = ", ".join(f"{k} {v:.3f}" for k, v in acc["spall_auc"].items()) or "–"
     return f"""
 ## Health-check recordings (the check part of the bundle)
@@ -413,7 +441,8 @@ def check_card_section(check: dict) -> str:
 (`prsm-health simulate --profile health-check`; docs/diagnostics.md) is read phase by phase:
 the no-load stroke (preload), the torque at two speeds under one load with the housing
 temperature (lubricant), the slow reversal under load (clearance, lost motion), the high-load
-stroke (synchronous averages at the nut-pass and roller-spin periods: spalls). Trained on
+stroke (synchronous averages of the vibration and of its envelope at the nut-pass,
+roller-spin and carrier periods: spalls). Trained on
 80 units ({tr.get("runs", {}).get("train", "–")} check recordings of 64 units, {tr.get("runs", {}).get("test", "–")} of 16 held-out units; per class
 {counts}): `datasets/flight-ema-check.toml` (every state, drawn independently of the unit),
 `flight-ema-check-aging.toml` (each unit at its as-built clearance with one new state) and
@@ -463,9 +492,9 @@ left at 0.5 are units whose fault leaves its signature inside the healthy units'
 {strict}
 
 Sensitivity (one check alone, the headline states, each factor's drawn range cut into thirds;
-the others drawn as usual). The sensors' noise and the temperature are drawn per check; uneven
-wear, payload and coupling once per unit, so their thirds are groups of the 8 units — a
-comparison of units, not a controlled change:
+the others drawn as usual). The temperature is drawn per check; the sensors' noise levels (the
+parts installed on a unit), uneven wear, payload and coupling once per unit, so their thirds are
+groups of the 8 units — a comparison of units, not a controlled change:
 
 | factor | range | checks | named right | wrong class | clearance MAE |
 |---|---|---|---|---|---|
@@ -476,6 +505,13 @@ Five checks against the baseline, per unit:
 | state | {" | ".join(named)} |
 |---|{"---|" * len(named)}
 {acc_rows}
+
+The evidence's naming rule (five checks against the baseline, a class named from posterior t
+up; the diagnosis uses {acc["threshold"]}): what a looser or stricter rule does to the same units.
+
+| t | macro-F1 | wrong class | `cannot_tell` |
+|---|---|---|---|
+{evidence_rule}
 """
 
 

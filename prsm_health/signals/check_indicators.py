@@ -22,7 +22,9 @@ so a user-defined check is read the same way. Four roles:
 * ``high_load`` — the constant phase with the largest |load|: the spalls, read in the angle
   domain (:mod:`prsm_health.signals.angle_domain`) on the nut axial acceleration band-passed
   to :data:`IMPACT_BAND`, the reduction's orders removed: synchronous-average SNRs at the nut
-  pass, the roller spin, the carrier and the screw revolution; kurtosis, crest factor and RMS
+  pass, the roller spin, the carrier and the screw revolution, and of its squared envelope at
+  the nut pass, the roller spin and the carrier (an impact train stays periodic in the
+  envelope when the resonance it rings is not phase-locked); kurtosis, crest factor and RMS
   of that residual; the stroke-position profile (a screw spall).
 
 :func:`check_indicators` returns every indicator of :data:`CHECK_INDICATORS`, NaN where the
@@ -41,7 +43,10 @@ References
 See :mod:`prsm_health.signals.angle_domain` (order tracking, synchronous averages) and
 :mod:`prsm_health.signals.features` (lost motion). Spectral centroid: the power-weighted mean
 frequency of a Welch PSD (Welch 1967). Kurtosis of the residual after the discrete components
-are removed: Randall & Antoni 2011 §3.
+are removed: Randall & Antoni 2011 §3. Synchronous averages of the squared envelope:
+P. D. McFadden, M. M. Toozhy, "Application of synchronous averaging to vibration monitoring of
+rolling element bearings", Mechanical Systems and Signal Processing 14(6) (2000) 891–906;
+the squared envelope of the band-passed signal: Randall & Antoni 2011 §2.2.
 """
 
 from __future__ import annotations
@@ -68,7 +73,7 @@ from .angle_domain import (
 )
 from .features import extract_features, run_design
 from .lost_motion import lost_motion_step
-from .spectra import welch_psd
+from .spectra import hilbert_envelope, welch_psd
 
 #: The roles a check's phases are found for, in order.
 ROLES = ("no_load", "torque_pair", "reversal", "high_load")
@@ -100,6 +105,14 @@ CENTROID_SEGMENT = 512
 IMPACT_BAND = (2000.0, 8000.0)
 #: The angle-domain periods of the high-load indicators (:func:`prsm_periods`).
 SNR_PERIODS = ("nut_pass", "roller_spin", "carrier", "screw")
+#: The periods of the envelope's synchronous averages: the spalls on the nut and on a roller
+#: (a roller spall recurs at the roller spin and, the roller orbiting, at the carrier period).
+#: The squared envelope keeps an impact train periodic where the band's waveform is not: the
+#: resonance each impact rings at is a kHz wave whose phase the resolver's angle error and the
+#: contact's slip shift from impact to impact, so the raw average cancels it. Measured on
+#: fresh units (docs/diagnostics.md): healthy against 0.5 mm spalls, ROC AUC of the raw /
+#: envelope SNR 0.94 / 0.995 (roller spin, roller spall) and 0.90 / 0.997 (carrier, nut spall).
+ENVELOPE_PERIODS = ("nut_pass", "roller_spin", "carrier")
 #: Position bins of the stroke profile, as a share of the engaged length (threads × pitch): a
 #: screw spall is met while the nut is within ± half of it, so it spans ≈ 4 bins.
 POSITION_BIN_SHARE = 0.25
@@ -127,6 +140,7 @@ def _indicator_table() -> dict[str, str]:
     units.update({f"check_reversal_{k}": reversal_units[k] for k in REVERSAL_FEATURES})
     units["check_reversal_lost_motion_step"] = "m"
     units.update({f"check_highload_snr_{k}": "-" for k in SNR_PERIODS})
+    units.update({f"check_highload_envelope_snr_{k}": "-" for k in ENVELOPE_PERIODS})
     units.update(
         {
             "check_highload_kurtosis": "-",
@@ -429,6 +443,11 @@ def _high_load(phase: Run, design: PRSMDesign, gear_ratio: float, out: dict) -> 
             y, _ = subtract_synchronous(y, angle, periods["motor"])
         for name in SNR_PERIODS:
             out[f"check_highload_snr_{name}"] = synchronous_average(y, angle, periods[name]).snr
+        envelope = hilbert_envelope(y) ** 2
+        envelope -= np.mean(envelope)  # its mean is no periodic content
+        for name in ENVELOPE_PERIODS:
+            average = synchronous_average(envelope, angle, periods[name])
+            out[f"check_highload_envelope_snr_{name}"] = average.snr
     except PRSMHealthError as exc:  # the angle stopped or turned back, too short
         return f"no angle domain in the phase: {exc}"
     rms = float(np.sqrt(np.mean(y * y)))

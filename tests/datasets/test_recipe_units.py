@@ -13,14 +13,27 @@ BASE = dict(name="units", design="paper01", duration=0.01, sample_rate=20000, se
 UNITS = {
     "count": 4,
     "seed": 9,
-    "build": {"preload": [0.0, 5e-6], "drive_train.payload_mass": [5.0, 20.0]},
+    "build": {
+        "preload": [0.0, 5e-6],
+        "drive_train.payload_mass": [5.0, 20.0],
+        # the accelerometer installed on the unit: its noise level, not its noise
+        "instrumentation.nut_axial_accel.noise_density_ug": [20.0, 60.0],
+    },
 }
 
 
 def recipe(seed=1, samples=12, **changes):
     sweep = {"mode": "lhs", "samples": samples, "clearance": [0.0, 40e-6]}
     return Recipe.from_dict(
-        dict(BASE, seed=seed, units=UNITS, test_fraction=0.25, sweep=sweep, **changes)
+        dict(
+            BASE,
+            seed=seed,
+            units=UNITS,
+            test_fraction=0.25,
+            sweep=sweep,
+            instrumentation="flight-ema",
+            **changes,
+        )
     )
 
 
@@ -33,8 +46,11 @@ def test_a_units_recipe_records_each_unit_as_built_with_its_own_sensor_noise():
         assert scenario.seed == twin.seed  # the same build
         assert scenario.health.preload == twin.health.preload
         assert scenario.drive_train.payload_mass == twin.drive_train.payload_mass
-        assert scenario.sensor_seed == spec.seed  # its own sensors
+        accel = scenario.instrumentation.nut_axial_accel
+        assert accel.noise_density == twin.instrumentation.nut_axial_accel.noise_density
+        assert scenario.sensor_seed == spec.seed  # its own sensors' noise
     assert len({s.seed for s in scenarios}) == 4
+    assert len({s.instrumentation.nut_axial_accel.noise_density for s in scenarios}) == 4
     assert len({s.health.clearance_screw for s in scenarios}) == 12  # swept per run
 
 

@@ -94,3 +94,21 @@ def test_the_card_section_shows_the_tables(records):
     assert "| 0.8 | " in text
     assert "accelerometer noise [µg/√Hz] | 20 – 28.3 | 2 |" in text  # tercile edge of 20…60
     assert "spall_nut 1.000" in text
+
+
+def test_the_evidence_rule_trade_off_names_each_unit_from_its_posterior():
+    units = [
+        {"state": "healthy", "fault_class": "healthy", "named": "healthy",
+         "posterior": {"healthy": 0.97, "spall": 0.03}},
+        {"state": "spall_nut", "fault_class": "spall", "named": "cannot_tell",
+         "posterior": {"healthy": 0.15, "spall": 0.85}},
+        {"state": "spall_roller", "fault_class": "spall", "named": "cannot_tell",
+         "posterior": {"healthy": 0.75, "spall": 0.25}},  # a wrong name below 0.8
+    ]  # fmt: skip
+    by_t = {r["threshold"]: r for r in _accumulated(units, MODEL, 0.9)["thresholds"]}
+    assert by_t[0.7]["wrong_fraction"] == pytest.approx(1 / 3)
+    assert by_t[0.7]["cannot_tell_fraction"] == 0.0
+    assert by_t[0.8]["wrong_fraction"] == 0.0
+    assert by_t[0.8]["cannot_tell_fraction"] == pytest.approx(1 / 3)
+    assert by_t[0.9]["cannot_tell_fraction"] == pytest.approx(2 / 3)
+    assert by_t[0.95]["macro_f1"] == by_t[0.9]["macro_f1"]

@@ -231,7 +231,6 @@ def test_classifier_class_weight_by_label():
         FaultClassifier(class_weight={"helthy": 2.0}).fit(X, y)
 
 
-
 def test_classifier_calibrated_by_group_is_not_overconfident_on_new_groups():
     # 40 "units", 6 near-identical recordings each, a class drawn per unit and a feature that
     # identifies the unit but says nothing of its class: on new units the truth is a coin toss.
@@ -252,6 +251,7 @@ def test_classifier_calibrated_by_group_is_not_overconfident_on_new_groups():
     assert confidence["grouped"] < confidence["split"] - 0.1
     with pytest.raises(ParameterError, match="groups"):
         FaultClassifier().fit(X, y, groups=units[:10])
+
 
 # ------------------------------------------------------------------------------------------
 # Permutation importance

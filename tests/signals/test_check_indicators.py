@@ -36,10 +36,10 @@ PHASES = (
 CENTROID_TONE = 800.0  # Hz: the no-load phase's axial "resonance"
 
 
-def _check_run(phases=PHASES, *, record=True, load_cell=False, drop=()):
+def _check_run(phases=PHASES, *, record=True, load_cell=False, drop=(), locked=True):
     """A check recording: speed, angle, torque, position, temperature and a nut acceleration
     made per phase; ``record`` False drops motion/speed/load from the check record (an older
-    file)."""
+    file); ``locked`` False gives the high-load burst's ringing a random phase at each pass."""
     rng = np.random.default_rng(5)
     bounds, t0 = [], 0.0
     for k, (name, motion, speed, load, duration, _) in enumerate(phases):
@@ -73,7 +73,11 @@ def _check_run(phases=PHASES, *, record=True, load_cell=False, drop=()):
     delta = phase == 3
     nut_pass = prsm_periods(DESIGN, 3.0)["nut_pass"]
     u = np.mod(-angle[delta], nut_pass) / nut_pass
-    accel[delta] += np.exp(-(((u - 0.5) / 0.05) ** 2)) * np.sin(2 * np.pi * 72 * u)
+    ringing = 2 * np.pi * 72 * u
+    if not locked:  # the resonance an impact rings is not phase-locked to the angle
+        passes = np.floor(-angle[delta] / nut_pass).astype(int)
+        ringing += rng.uniform(0, 2 * np.pi, passes.max() - passes.min() + 1)[passes - passes.min()]
+    accel[delta] += np.exp(-(((u - 0.5) / 0.05) ** 2)) * np.sin(ringing)
     accel[delta] += 0.05 * rng.standard_normal(int(delta.sum()))
     channels = {
         "screw_angle": angle,
@@ -144,6 +148,29 @@ def test_high_load_phase_reads_a_nut_pass_burst(reading):
     assert values["check_highload_crest"] > 3.0
     assert np.isfinite(values["check_highload_position_snr"])
     assert values["check_highload_position_contrast"] >= 1.0
+
+
+def test_envelope_averages_keep_an_impact_train_whose_ringing_is_not_phase_locked(reading):
+    locked = reading.indicators
+    unlocked = check_indicators(_check_run(locked=False), DESIGN).indicators
+    # locked: both averages see the burst at the nut pass
+    assert locked["check_highload_envelope_snr_nut_pass"] > 5.0
+    # a random ringing phase per pass: the waveform's average cancels (its expected SNR is
+    # the burst's energy left over n passes, ≈ 1/n of the locked one's, n ≈ 40 passes here)
+    # while the squared envelope — the Gaussian window squared, the same at every pass —
+    # stays periodic; noise 0.05 against a burst of 1: the envelope SNR stays ≫ 1
+    assert unlocked["check_highload_snr_nut_pass"] < 0.1 * locked["check_highload_snr_nut_pass"]
+    assert unlocked["check_highload_envelope_snr_nut_pass"] > 5.0
+    # (not equal to the locked one: the filter's edge reshapes a burst whose phase jumps)
+    assert (
+        unlocked["check_highload_envelope_snr_nut_pass"]
+        > 0.5 * (locked["check_highload_envelope_snr_nut_pass"])
+    )
+    # at the roller spin (5 spins = 7 nut passes) the envelope is not periodic either
+    assert (
+        unlocked["check_highload_envelope_snr_roller_spin"]
+        < 0.5 * (unlocked["check_highload_envelope_snr_nut_pass"])
+    )
 
 
 def test_missing_phases_say_which_condition_is_absent():
