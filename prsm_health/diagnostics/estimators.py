@@ -38,7 +38,13 @@ import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin, RegressorMixin
 from sklearn.calibration import CalibratedClassifierCV
 from sklearn.ensemble import HistGradientBoostingClassifier, HistGradientBoostingRegressor
-from sklearn.model_selection import KFold, StratifiedGroupKFold, StratifiedKFold, cross_val_predict
+from sklearn.model_selection import (
+    GroupKFold,
+    KFold,
+    StratifiedGroupKFold,
+    StratifiedKFold,
+    cross_val_predict,
+)
 from sklearn.utils import check_random_state
 from sklearn.utils.class_weight import compute_sample_weight
 from sklearn.utils.multiclass import check_classification_targets
@@ -107,6 +113,20 @@ def _hgb_params(est) -> dict:
 # --------------------------------------------------------------------------------------------
 # Clearance regression with a conformal prediction interval
 # --------------------------------------------------------------------------------------------
+
+
+def _calibration_units(groups: np.ndarray, n_cal: int, rng) -> tuple[np.ndarray, np.ndarray]:
+    """(calibration, training) sample indices: whole groups, drawn in random order until the
+    calibration part holds about ``n_cal`` samples (at least one group on each side)."""
+    units = rng.permutation(np.unique(groups))
+    require(
+        len(units) >= 2, "groups", len(units), "at least 2 units (one to fit, one to calibrate)"
+    )
+    sizes = np.array([np.count_nonzero(groups == u) for u in units])
+    # the first k units whose samples come nearest to n_cal, 1 ≤ k ≤ len(units) − 1
+    k = int(np.clip(np.argmin(np.abs(np.cumsum(sizes) - n_cal)) + 1, 1, len(units) - 1))
+    held = np.isin(groups, units[:k])
+    return np.flatnonzero(held), np.flatnonzero(~held)
 
 
 class ClearanceEstimator(RegressorMixin, BaseEstimator):
@@ -275,7 +295,7 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
         )
         _check_hgb_params(self)
 
-    def fit(self, X, y):
+    def fit(self, X, y, groups=None):
         """Fit the quantile and point models and calibrate the interval.
 
         Parameters
@@ -284,6 +304,13 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
             Features; NaN allowed (missing feature), inf not.
         y : array-like of shape (n_samples,)
             Target, e.g. a clearance [m].
+        groups : array-like of shape (n_samples,) or None
+            The unit of each sample: the calibration part then holds whole units, and the
+            out-of-fold residuals come from folds by unit. Recordings of one unit share its
+            build and sensors, so their errors are alike: calibrated on units it was also
+            fitted on, the interval is as narrow as for a unit it knows and too narrow for a
+            new one (the conformal guarantee needs calibration samples exchangeable with the
+            new unit's).
 
         Returns
         -------
@@ -301,9 +328,15 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
                 "ClearanceEstimator needs at least 2 samples (one to fit, one to calibrate)",
             )
         rng = check_random_state(self.random_state)
-        order = rng.permutation(n)
         n_cal = min(max(int(round(self.calibration_fraction * n)), 1), n - 1)
-        cal, train = order[:n_cal], order[n_cal:]
+        if groups is None:
+            order = rng.permutation(n)
+            cal, train = order[:n_cal], order[n_cal:]
+        else:
+            groups = np.asarray(groups)
+            require(len(groups) == n, "groups", len(groups), f"one per sample ({n})")
+            cal, train = _calibration_units(groups, n_cal, rng)
+            n_cal = len(cal)
         seed = int(rng.randint(_SEED_MAX))
         ys = np.asarray(y, dtype=np.float64) * self.scale
 
@@ -313,12 +346,17 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
         if self.quantiles_of == "residual":
             # Out-of-fold residuals: in-sample boosting residuals would be optimistic.
             folds = min(5, len(train))
+            cv = KFold(folds, shuffle=True, random_state=seed)
+            if groups is not None:
+                folds = min(folds, len(np.unique(groups[train])))
+                cv = GroupKFold(folds)
             if folds >= 2:
                 oof = cross_val_predict(
                     HistGradientBoostingRegressor(loss=self.point_loss, **common),
                     X[train],
                     ys[train],
-                    cv=KFold(folds, shuffle=True, random_state=seed),
+                    cv=cv,
+                    groups=None if groups is None else groups[train],
                 )
             else:
                 oof = np.full(len(train), float(np.mean(ys[train])))

@@ -110,8 +110,8 @@ SNR_PERIODS = ("nut_pass", "roller_spin", "carrier", "screw")
 #: The squared envelope keeps an impact train periodic where the band's waveform is not: the
 #: resonance each impact rings at is a kHz wave whose phase the resolver's angle error and the
 #: contact's slip shift from impact to impact, so the raw average cancels it. Measured on
-#: fresh units (docs/diagnostics.md): healthy against 0.5 mm spalls, ROC AUC of the raw /
-#: envelope SNR 0.94 / 0.995 (roller spin, roller spall) and 0.90 / 0.997 (carrier, nut spall).
+#: fresh units (docs/angle-domain.md): healthy against 0.5 mm spalls, ROC AUC of the raw /
+#: envelope SNR 0.90–0.96 / 0.99–1.00 (roller spin, roller spall; carrier, nut spall).
 ENVELOPE_PERIODS = ("nut_pass", "roller_spin", "carrier")
 #: Position bins of the stroke profile, as a share of the engaged length (threads × pitch): a
 #: screw spall is met while the nut is within ± half of it, so it spans ≈ 4 bins.

@@ -112,3 +112,19 @@ def test_the_evidence_rule_trade_off_names_each_unit_from_its_posterior():
     assert by_t[0.8]["cannot_tell_fraction"] == pytest.approx(1 / 3)
     assert by_t[0.9]["cannot_tell_fraction"] == pytest.approx(2 / 3)
     assert by_t[0.95]["macro_f1"] == by_t[0.9]["macro_f1"]
+
+
+def test_two_state_checks_are_a_degraded_lubricant_under_another_label():
+    import pandas as pd
+
+    from prsm_health.diagnostics.check_training import two_states
+
+    table = pd.DataFrame(
+        {
+            "fault_class": ["spall", "lubrication", "spall", "healthy", "wear"],
+            "lubricant_degradation": [0.7, 0.7, 0.2, 0.49, 0.1],
+            "lubricant_starvation": [0.0, 0.0, 0.0, 0.0, 0.6],  # starved is degraded too
+            "friction_scale": [1.0, 1.0, 1.0, 1.0, 1.0],
+        }
+    )
+    assert two_states(table).tolist() == [True, False, False, False, True]

@@ -605,3 +605,29 @@ def test_classifier_class_sets_hold_the_classes_it_cannot_separate():
     assert sets[~alike].sum(axis=1).mean() < 1.2
     with pytest.raises(ParameterError, match="set_coverage"):
         FaultClassifier(set_coverage=1.0).fit(X, y)
+
+
+@pytest.mark.parametrize("quantiles_of", ["target", "residual"])
+def test_clearance_interval_calibrated_by_group_covers_new_groups(quantiles_of):
+    # 40 "units", 6 recordings each: the target is the unit's own offset, which a feature that
+    # identifies the unit lets the model memorise and new units do not share. Calibrated on
+    # samples of units it was fitted on, the interval is as narrow as for a known unit;
+    # calibrated on whole held-out units it covers new units. Coverage of 200 new units,
+    # seeds 5–7 (target quantiles): split 0.61–0.70, grouped 0.89–0.97; hence the margins.
+    rng = np.random.default_rng(5)
+    units = np.repeat(np.arange(40), 6)
+    centre, offset = rng.normal(size=(40, 3)), rng.normal(size=40)
+    X = centre[units] + 0.01 * rng.normal(size=(240, 3))
+    y = offset[units] + 0.05 * rng.normal(size=240)
+    new_x, new_y = rng.normal(size=(200, 3)), rng.normal(size=200)
+    coverage = {}
+    for key, groups in (("split", None), ("grouped", units)):
+        est = ClearanceEstimator(
+            max_iter=30, min_samples_leaf=3, scale=1.0, quantiles_of=quantiles_of
+        ).fit(X, y, groups=groups)
+        lo, hi = est.predict_interval(new_x)
+        coverage[key] = float(np.mean((new_y >= lo) & (new_y <= hi)))
+    assert coverage["grouped"] > 0.8
+    assert coverage["grouped"] > coverage["split"] + 0.1
+    with pytest.raises(ParameterError, match="groups"):
+        ClearanceEstimator().fit(X, y, groups=units[:10])
