@@ -25,6 +25,8 @@ import math
 from dataclasses import asdict, dataclass, fields, replace
 from typing import ClassVar
 
+import numpy as np
+
 from prsm_health.core.errors import require, require_known_keys, require_range
 
 SPALL_LOCATIONS = ("screw", "nut", "roller")
@@ -312,10 +314,21 @@ class FaultThresholds:
             return "wear"
         if health.preload > 0 and by_kind.get("preload_loss", 0.0) >= self.preload_loss:
             return "preload_loss"
-        lubricant = max(health.lubricant_degradation, health.lubricant_starvation)
-        if health.friction_scale >= self.lubrication or lubricant >= self.lubricant:
+        lubricant = (
+            health.friction_scale,
+            health.lubricant_degradation,
+            health.lubricant_starvation,
+        )
+        if self.lubricant_degraded(*lubricant):
             return "lubrication"
         return "healthy"
+
+    def lubricant_degraded(self, friction_scale, degradation, starvation):
+        """Whether the lubricant is in the ``lubrication`` class's state, whatever class takes
+        precedence: friction scale ≥ ``lubrication`` or degradation or starvation ≥
+        ``lubricant`` (numbers or arrays, elementwise)."""
+        lubricant = np.maximum(degradation, starvation)
+        return (np.asarray(friction_scale) >= self.lubrication) | (lubricant >= self.lubricant)
 
     def as_dict(self) -> dict:
         return asdict(self)

@@ -315,6 +315,13 @@ def _normalised(log_p: np.ndarray) -> np.ndarray:
     return log_p - (top + math.log(float(np.sum(np.exp(log_p - top)))))
 
 
+def named_class(posterior: Mapping[str, float], threshold: float) -> str:
+    """The most probable class of ``posterior`` (class → probability) when it reaches
+    ``threshold``, else ``cannot_tell``."""
+    best = max(posterior, key=posterior.get)
+    return best if posterior[best] >= threshold else CANNOT_TELL
+
+
 @dataclass(frozen=True)
 class Evidence:
     """The class evidence accumulated over a unit's recordings: a log posterior per class.
@@ -446,9 +453,7 @@ class Evidence:
 
     def named(self, threshold: float = EVIDENCE_NAME_PROBABILITY) -> str:
         """The class whose posterior reaches ``threshold``, else ``cannot_tell``."""
-        posterior = self.posterior()
-        best = max(posterior, key=posterior.get)
-        return best if posterior[best] >= threshold else CANNOT_TELL
+        return named_class(self.posterior(), threshold)
 
     def to_json(self) -> dict:
         """Plain JSON values; :meth:`from_json` restores an equal value."""

@@ -5,10 +5,10 @@ recordings of a unit read against its own baseline with the evidence accumulated
 ``[units]`` seed never used in training): each unit recorded three times new and healthy (its
 baseline) and five times in each state of :data:`EVAL_STATES` at default severity, as built
 (its preload, uneven wear, installation and the noise levels of its sensors the same in all
-its recordings), the temperature and the sensors' noise, gains and offsets drawn per recording. :func:`evaluate_check_model` diagnoses every
-recording through :func:`prsm_health.diagnostics.diagnosis.diagnose` — alone, and against the
-unit's baseline — and accumulates each unit's evidence
-(:class:`~prsm_health.diagnostics.baseline.Evidence`).
+its recordings), the temperature and the sensors' noise, gains and offsets drawn per
+recording. :func:`evaluate_check_model` diagnoses every recording through
+:func:`prsm_health.diagnostics.diagnosis.diagnose` — alone, and against the unit's baseline —
+and accumulates each unit's evidence (:class:`~prsm_health.diagnostics.baseline.Evidence`).
 """
 
 from __future__ import annotations
@@ -307,9 +307,11 @@ def _accumulated(units, model, threshold) -> dict:
         well = [u["posterior"].get("spall", 0.0) for u in units if u["state"] == "healthy"]
         if sick and well:
             auc[state] = float(roc_auc_score([1] * len(sick) + [0] * len(well), sick + well))
+    from .baseline import named_class
+
     trade_off = []
     for t in EVIDENCE_THRESHOLDS:
-        named = np.array([_named(u["posterior"], t) for u in rows])
+        named = np.array([named_class(u["posterior"], t) for u in rows])
         trade_off.append(
             {
                 "threshold": t,
@@ -330,12 +332,6 @@ def _accumulated(units, model, threshold) -> dict:
         "confusion": confusion,
         "thresholds": trade_off,
     }
-
-
-def _named(posterior: dict, threshold: float) -> str:
-    """The class a posterior names at ``threshold`` (as :meth:`Evidence.named`)."""
-    best = max(posterior, key=posterior.get)
-    return best if posterior[best] >= threshold else CANNOT_TELL
 
 
 def _sensitivity(records, model) -> list[dict]:

@@ -92,21 +92,23 @@ def two_states(table) -> np.ndarray:
     thresholds, :class:`~prsm_health.actuator.faults.FaultThresholds`) under another class
     (a spall, wear, a preload loss take precedence in the run's label).
 
-    The recipes draw the lubricant independently of the fault case, so a third of the training
-    checks are such; labelled with the other class, they teach the classifiers that a degraded
+    The training recipe draws the lubricant independently of the fault case, so a quarter of
+    the training checks were such; labelled with the other class, they teach the classifiers that a degraded
     lubricant's signature is evidence of a spall or a preload loss (measured: against the
     baseline, lubrication units then read preload loss 0.2–0.5 at every check). They train the
     clearance estimator, not the classifiers, whose classes are single states."""
     from prsm_health.actuator.faults import FaultThresholds
 
-    limits = FaultThresholds()
-    lubricant = np.zeros(len(table))
-    for column in ("lubricant_degradation", "lubricant_starvation"):
-        if column in table:
-            lubricant = np.maximum(lubricant, table[column].fillna(0.0).to_numpy(float))
-    degraded = lubricant >= limits.lubricant
-    if "friction_scale" in table:
-        degraded |= table["friction_scale"].fillna(1.0).to_numpy(float) >= limits.lubrication
+    def column(name, default):
+        if name not in table:
+            return np.full(len(table), default)
+        return table[name].fillna(default).to_numpy(float)
+
+    degraded = FaultThresholds().lubricant_degraded(
+        column("friction_scale", 1.0),
+        column("lubricant_degradation", 0.0),
+        column("lubricant_starvation", 0.0),
+    )
     return degraded & (table["fault_class"].astype(str).to_numpy() != "lubrication")
 
 

@@ -118,11 +118,12 @@ def _hgb_params(est) -> dict:
 def _calibration_units(groups: np.ndarray, n_cal: int, rng) -> tuple[np.ndarray, np.ndarray]:
     """(calibration, training) sample indices: whole groups, drawn in random order until the
     calibration part holds about ``n_cal`` samples (at least one group on each side)."""
-    units = rng.permutation(np.unique(groups))
+    units, sizes = np.unique(groups, return_counts=True)
     require(
         len(units) >= 2, "groups", len(units), "at least 2 units (one to fit, one to calibrate)"
     )
-    sizes = np.array([np.count_nonzero(groups == u) for u in units])
+    order = rng.permutation(len(units))
+    units, sizes = units[order], sizes[order]
     # the first k units whose samples come nearest to n_cal, 1 ≤ k ≤ len(units) − 1
     k = int(np.clip(np.argmin(np.abs(np.cumsum(sizes) - n_cal)) + 1, 1, len(units) - 1))
     held = np.isin(groups, units[:k])
@@ -346,16 +347,16 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
         if self.quantiles_of == "residual":
             # Out-of-fold residuals: in-sample boosting residuals would be optimistic.
             folds = min(5, len(train))
-            cv = KFold(folds, shuffle=True, random_state=seed)
             if groups is not None:
                 folds = min(folds, len(np.unique(groups[train])))
-                cv = GroupKFold(folds)
             if folds >= 2:
                 oof = cross_val_predict(
                     HistGradientBoostingRegressor(loss=self.point_loss, **common),
                     X[train],
                     ys[train],
-                    cv=cv,
+                    cv=KFold(folds, shuffle=True, random_state=seed)
+                    if groups is None
+                    else GroupKFold(folds),
                     groups=None if groups is None else groups[train],
                 )
             else:

@@ -631,3 +631,13 @@ def test_clearance_interval_calibrated_by_group_covers_new_groups(quantiles_of):
     assert coverage["grouped"] > coverage["split"] + 0.1
     with pytest.raises(ParameterError, match="groups"):
         ClearanceEstimator().fit(X, y, groups=units[:10])
+
+
+def test_clearance_estimator_fits_two_samples_with_residual_quantiles():
+    # one sample to fit, one to calibrate: too few for out-of-fold residuals, which then fall
+    # back to the training mean instead of asking a k-fold split of one sample
+    with pytest.warns(UserWarning):
+        est = ClearanceEstimator(quantiles_of="residual", min_samples_leaf=1).fit(
+            np.arange(4.0).reshape(2, 2), [1e-6, 2e-6]
+        )
+    assert np.all(np.isfinite(est.predict(np.arange(4.0).reshape(2, 2))))
