@@ -56,7 +56,8 @@ from .wear import (
 LUBRICANT_REFERENCE_TEMPERATURE = 343.15
 LUBRICANT_HALVING = 15.0
 FAILURE_MODES = ("wear", "spall")
-_DEGRADATION_GRID = np.linspace(0.0, 1.0, 101)
+#: Lubricant degradations the wear rates are tabulated on (0 new … 1 depleted).
+DEGRADATION_GRID = np.linspace(0.0, 1.0, 101)
 #: Steps of the age grid a unit's wear is accumulated on (up to 4× its expected life).
 _AGE_STEPS = 2000
 #: The duty cycle's default load spectrum, as shares of the design's basic dynamic axial load
@@ -335,6 +336,7 @@ class UnitLife:
     ages: np.ndarray  # [h], the grid the wear is accumulated on
     worn_screw: np.ndarray  # [m] wear of b_screw at those ages
     worn_nut: np.ndarray
+    duty_hours: np.ndarray  # [h] at those ages: operating hours × the usage intensity
     spall: Spall | None  # where and how the spall is, its length at initiation
     spall_age: float  # [h], inf without one
     spall_doubling: float  # [h]
@@ -405,17 +407,104 @@ class UnitLife:
             "failure_mode": self.failure_mode,
             "clearance_mean_true": float(self.clearance(age)),
             "spall_length_true": float(self.spall_length(age)),
+            "duty_hours": float(np.interp(age, self.ages, self.duty_hours)),
+            "duty_load": self.load_scale,
         }
 
 
 def _cumulative(rate: np.ndarray) -> np.ndarray:
     # ∫₀^d rate dd′ on the degradation grid (trapezoid)
-    steps = 0.5 * (rate[1:] + rate[:-1]) * np.diff(_DEGRADATION_GRID)
+    steps = 0.5 * (rate[1:] + rate[:-1]) * np.diff(DEGRADATION_GRID)
     return np.concatenate([[0.0], np.cumsum(steps)])
 
 
 def _with_length(spall: Spall, length: float) -> Spall:
     return replace(spall, length=length)
+
+
+@dataclass(frozen=True)
+class WearRates:
+    """A unit's ageing rates under a duty cycle, per operating hour (SI otherwise).
+
+    ``clearance[side]``: growth rate of the half-clearance b of the screw or nut engagement
+    [m/h] at each lubricant degradation of :data:`DEGRADATION_GRID`; ``damage[surface]``:
+    ISO 281 L10 lives consumed per operating hour (screw, roller, nut).
+    """
+
+    clearance: dict
+    damage: dict
+
+
+def wear_rates(
+    design: PRSMDesign,
+    duty: DutyCycle,
+    *,
+    lubricant_name: str = DEFAULT_LUBRICANT,
+    temperature: float | None = None,
+    wear: WearParameters | None = None,
+    wear_scale: float = 1.0,
+    load_scale: float = 1.0,
+    geometry: PartGeometry | None = None,
+) -> WearRates:
+    """Clearance growth and fatigue damage rates of a unit under ``duty`` (resolved: loads in
+    newtons), its loads times ``load_scale`` and its wear coefficient times ``wear_scale``, at
+    ``temperature`` [K] (default the duty's): the Archard rate of each engagement
+    (:func:`~prsm_health.physics.wear.clearance_growth_rate`, on the asperity share of the
+    lubricant's film) and the stress cycles over the L10 life of each surface, summed over the
+    load spectrum weighted by its time shares and the motion fraction."""
+    geometry = geometry or PartGeometry.of(design)
+    wear = wear or WearParameters()
+    temperature = duty.temperature if temperature is None else temperature
+    zeros = np.zeros_like(DEGRADATION_GRID)
+    rates = {"screw": zeros.copy(), "nut": zeros.copy()}
+    damage = dict.fromkeys(SURFACES, 0.0)
+    k = wear.coefficient(DEGRADATION_GRID) * wear_scale
+    for load, share in zip(duty.loads, duty.shares):
+        load = load * load_scale
+        weight = share * duty.motion_fraction * 3600.0  # seconds in this state per hour
+        contacts = contact_states(design, geometry, load, duty.speed)
+        for side, contact in contacts.items():
+            film = stribeck_curve(
+                design,
+                lubricant_name,
+                [contact.entrainment_speed],
+                axial_load=load,
+                temperature=temperature,
+                degradation=DEGRADATION_GRID,
+            )
+            shares = asperity_share(film.film_ratio)
+            rates[side] += weight * np.array(
+                [
+                    clearance_growth_rate(
+                        geometry,
+                        contact,
+                        side,
+                        stroke=duty.stroke,
+                        asperity_share=float(f),
+                        coefficient=float(kk),
+                    )
+                    for f, kk in zip(shares, k)
+                ]
+            )
+        per_second = stress_cycle_rates(geometry, contacts, duty.stroke)
+        pressure = {
+            "screw": contacts["screw"].max_pressure,
+            "roller": max(contacts["screw"].max_pressure, contacts["nut"].max_pressure),
+            "nut": contacts["nut"].max_pressure,
+        }
+        for surface in SURFACES:
+            damage[surface] += (
+                weight * per_second[surface] / float(l10_cycles(wear, pressure[surface]))
+            )
+    return WearRates(clearance=rates, damage=damage)
+
+
+def lubricant_life_at(life_at_reference: float, temperature: float) -> float:
+    """Hours until the additives are used up at ``temperature`` [K], from the life at 70 °C:
+    halved per 15 K above, doubled per 15 K below (module docstring)."""
+    return life_at_reference * 2.0 ** (
+        (LUBRICANT_REFERENCE_TEMPERATURE - temperature) / LUBRICANT_HALVING
+    )
 
 
 def unit_life(
@@ -443,55 +532,20 @@ def unit_life(
     survival = float(draws[4])
     k_scale = math.exp(sc.wear_coefficient * rng.standard_normal())
     life_scale = math.exp(sc.lubricant_life * rng.standard_normal())
-    t_lube = (
-        duty.lubricant_life
-        * life_scale
-        * 2.0 ** ((LUBRICANT_REFERENCE_TEMPERATURE - temperature) / LUBRICANT_HALVING)
-    )
+    t_lube = lubricant_life_at(duty.lubricant_life * life_scale, temperature)
     temperature = min(max(temperature, 223.15), 473.15)
 
-    rates = {"screw": np.zeros_like(_DEGRADATION_GRID), "nut": np.zeros_like(_DEGRADATION_GRID)}
-    damage = dict.fromkeys(SURFACES, 0.0)  # L10 lives consumed per operating hour
-    cycles = dict.fromkeys(SURFACES, 0.0)
-    for load, share in zip(duty.loads, duty.shares):
-        load = load * load_scale
-        weight = share * duty.motion_fraction * 3600.0  # seconds in this state per hour
-        contacts = contact_states(design, geometry, load, duty.speed)
-        for side, contact in contacts.items():
-            film = stribeck_curve(
-                design,
-                spec.lubricant,
-                [contact.entrainment_speed],
-                axial_load=load,
-                temperature=temperature,
-                degradation=_DEGRADATION_GRID,
-            )
-            shares = asperity_share(film.film_ratio)
-            k = wear.coefficient(_DEGRADATION_GRID) * k_scale
-            rates[side] += weight * np.array(
-                [
-                    clearance_growth_rate(
-                        geometry,
-                        contact,
-                        side,
-                        stroke=duty.stroke,
-                        asperity_share=float(f),
-                        coefficient=float(kk),
-                    )
-                    for f, kk in zip(shares, k)
-                ]
-            )
-        per_second = stress_cycle_rates(geometry, contacts, duty.stroke)
-        pressure = {
-            "screw": contacts["screw"].max_pressure,
-            "roller": max(contacts["screw"].max_pressure, contacts["nut"].max_pressure),
-            "nut": contacts["nut"].max_pressure,
-        }
-        for surface in SURFACES:
-            cycles[surface] += weight * per_second[surface]
-            damage[surface] += (
-                weight * per_second[surface] / float(l10_cycles(wear, pressure[surface]))
-            )
+    duty_rates = wear_rates(
+        design,
+        duty,
+        lubricant_name=spec.lubricant,
+        temperature=temperature,
+        wear=wear,
+        wear_scale=k_scale,
+        load_scale=load_scale,
+        geometry=geometry,
+    )
+    rates, damage = duty_rates.clearance, duty_rates.damage
 
     # Deterministic wear first (exact on the degradation grid), to size the age grid; then the
     # unit's wandering usage intensity along it.
@@ -503,7 +557,7 @@ def unit_life(
         mid = 0.5 * (ages[1:] + ages[:-1])
         d_mid = np.minimum(mid / t_lube, 1.0)
         worn = {
-            side: np.concatenate([[0.0], np.cumsum(np.interp(d_mid, _DEGRADATION_GRID, r) * usage)])
+            side: np.concatenate([[0.0], np.cumsum(np.interp(d_mid, DEGRADATION_GRID, r) * usage)])
             for side, r in rates.items()
         }
         life = UnitLife(
@@ -520,6 +574,7 @@ def unit_life(
             ages=ages,
             worn_screw=worn["screw"],
             worn_nut=worn["nut"],
+            duty_hours=np.concatenate([[0.0], np.cumsum(usage)]),
             spall=None,
             spall_age=math.inf,
             spall_doubling=math.inf,
@@ -577,7 +632,7 @@ def _expected_failure(rates: dict, b0: float, t_lube: float, spec: LifeSpec) -> 
     aged = _cumulative(mean_rate) * t_lube  # wear by the time the lubricant is at d
     needed = spec.failure_clearance - b0
     if needed <= aged[-1]:
-        return float(np.interp(needed, aged, _DEGRADATION_GRID)) * t_lube
+        return float(np.interp(needed, aged, DEGRADATION_GRID)) * t_lube
     if mean_rate[-1] <= 0:
         return spec.max_age
     return min(t_lube + (needed - aged[-1]) / mean_rate[-1], spec.max_age)

@@ -187,17 +187,35 @@ def fit_prognostics_model(
     )
     # fit validates each unit's history against the model: histories of another design fail
     model.fit(train, {u: failure[u] for u in train["unit_id"].unique()})
+    life = dataset.manifest.get("recipe", {}).get("life")
+    limit = None
+    methods = ("degradation", "similarity")
+    if life and design is not None:
+        from prsm_health.physics.life import LifeSpec
+
+        from .ageing_model import rate_tables
+        from .ageing_rul import AgeingRUL
+
+        spec = LifeSpec.from_dict(life)
+        limit = spec.failure_clearance
+        model.ageing_ = AgeingRUL.fit(
+            rate_tables(design, spec),
+            spec,
+            train,
+            seed=0 if random_state is None else random_state,
+            horizon=model.horizon_,
+        )
+        methods += ("physics",)
     predictions, summary = None, {}
     if evaluate and not test.empty:
         predictions, summary = evaluate_units(
-            test, {u: failure[u] for u in test["unit_id"].unique()}, model, alpha=alpha
+            test,
+            {u: failure[u] for u in test["unit_id"].unique()},
+            model,
+            alpha=alpha,
+            methods=methods,
+            progress=progress,
         )
-    life = dataset.manifest.get("recipe", {}).get("life")
-    limit = None
-    if life:
-        from prsm_health.physics.life import LifeSpec
-
-        limit = LifeSpec.from_dict(life).failure_clearance
     report = FitReport(
         design=name,
         design_fingerprint=fingerprint,

@@ -10,6 +10,8 @@ from prsm_health.core.errors import (
     PRSMHealthError,
 )
 
+from .history import DUTY_COLUMNS
+
 
 def fleet_histories(
     dataset,
@@ -41,7 +43,8 @@ def fleet_histories(
         (which design: :func:`~prsm_health.actuator.design_files.design_fingerprint`),
         ``fault_class``, and the labels a
         prognosis is scored against: ``split``, ``rul_hours``, ``failure_age_hours``,
-        ``failure_mode``, ``clearance_mean_true`` — sorted by unit and age.
+        ``failure_mode``, ``clearance_mean_true`` — and the duty log (``duty_hours``,
+        ``duty_load``) where the dataset records it; sorted by unit and age.
 
     Raises
     ------
@@ -104,6 +107,9 @@ def fleet_histories(
     )
     for label in ("split", "rul_hours", "failure_age_hours", "failure_mode", "clearance_mean_true"):
         out[label] = chosen[label].to_numpy()
+    for column in DUTY_COLUMNS:  # the duty log, in datasets that record it
+        if column in chosen.columns:
+            out[column] = chosen[column].to_numpy(float)
     return out.reset_index(drop=True)
 
 

@@ -21,7 +21,14 @@ Z90 = 1.6448536269514722
 #: Required columns of a history: age [h], clearance estimate and its 90 % interval [m].
 HISTORY_COLUMNS = ("age_hours", "clearance", "clearance_lower", "clearance_upper")
 #: Optional columns a history may carry (checked when present).
-OPTIONAL_COLUMNS = ("design", "design_fingerprint", "fault_class", "unit_id")
+OPTIONAL_COLUMNS = (
+    "design",
+    "design_fingerprint",
+    "fault_class",
+    "unit_id",
+    "duty_hours",
+    "duty_load",
+)
 
 
 class HistoryError(ParameterError):
@@ -249,6 +256,48 @@ def _check_design(history: pd.DataFrame, model) -> None:
         field="history.design",
         value=name,
     )
+
+
+#: The duty log's columns a history may carry (docs/prognostics.md): the unit's duty hours
+#: (operating hours × its usage intensity, cumulative) and its load factor (× the duty the
+#: prognostics model was built for) at each diagnosis.
+DUTY_COLUMNS = ("duty_hours", "duty_load")
+
+
+def duty_arrays(history: pd.DataFrame) -> dict:
+    """The duty log of a history as the physics model's inputs over the interval before each
+    diagnosis: ``usage_rate`` (duty hours per operating hour) and ``load``; absent columns are
+    None. Refuses non-finite or negative values and duty hours that run backwards."""
+    out = {"load": None, "usage_rate": None}
+    t = history["age_hours"].to_numpy(dtype=np.float64)
+    for column in DUTY_COLUMNS:
+        if column not in history.columns:
+            continue
+        values = pd.to_numeric(history[column], errors="coerce").to_numpy(dtype=np.float64)
+        bad = np.flatnonzero(~np.isfinite(values) | (values < 0))
+        if bad.size:
+            raise HistoryError(
+                f"row {int(bad[0])}: {column} {_show(history[column].iloc[bad[0]])} is not a "
+                "finite value >= 0",
+                f"history.{column}",
+                history[column].iloc[bad[0]],
+            )
+        if column == "duty_load":
+            out["load"] = values
+            continue
+        steps = np.diff(np.concatenate([[0.0], values]))
+        back = np.flatnonzero(steps < 0)
+        if back.size:
+            raise HistoryError(
+                f"row {int(back[0])}: duty_hours {values[back[0]]:.6g} h is below the row "
+                "before it (duty hours only grow)",
+                "history.duty_hours",
+                float(values[back[0]]),
+            )
+        spans = np.diff(np.concatenate([[0.0], t]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out["usage_rate"] = np.where(spans > 0, steps / spans, np.nan)
+    return out
 
 
 def history_arrays(history: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

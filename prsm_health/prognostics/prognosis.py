@@ -7,6 +7,9 @@ from dataclasses import dataclass, field
 
 from prsm_health.core.jsonable import json_ready
 
+#: Quantiles of every prognosis' RUL: lower bound, estimate (median), upper bound.
+QUANTILES = (0.05, 0.5, 0.95)
+
 
 @dataclass(frozen=True)
 class Prognosis:

@@ -66,18 +66,30 @@ from .degradation import (
     profile_phi,
     sample_gaussian,
     transform,
-    weighted_quantiles,
     wls_by_unit,
     y_threshold,
 )
-from .history import Z90, HistoryError, history_arrays, model_design, one_line, validate_history
-from .prognosis import Prognosis
+from .history import (
+    Z90,
+    HistoryError,
+    duty_arrays,
+    history_arrays,
+    model_design,
+    one_line,
+    validate_history,
+)
+from .prognosis import QUANTILES, Prognosis
+from .similarity import similarity_rul
 
 #: Methods :meth:`RULModel.predict` accepts. ``"degradation"`` uses the form chosen at
 #: fit time; ``"degradation-exponential"`` / ``"degradation-linear"`` force a form.
-METHODS = ("degradation", "degradation-exponential", "degradation-linear", "similarity")
-#: Quantiles reported: lower bound, estimate (median), upper bound.
-QUANTILES = (0.05, 0.5, 0.95)
+METHODS = (
+    "degradation",
+    "degradation-exponential",
+    "degradation-linear",
+    "similarity",
+    "physics",
+)
 #: RUL is capped at this multiple of the training fleet's longest life [-] (the horizon):
 #: posterior samples that never reach the threshold (wear rate <= 0) or reach it later get it.
 HORIZON_FACTOR = 3.0
@@ -91,16 +103,6 @@ MIN_TRAINING_UNITS = 3
 _FORMAT = "prsm_health-prognostics"
 _FORMAT_VERSION = 1
 _FORMS = ("exponential", "linear")
-# Similarity alignment: the aligned first diagnosis may lie this fraction of a library unit's
-# life before the unit's first age (its curve extrapolated back). Forbidding it (shifts >= 0
-# only) lets slow units align and penalizes fast or high-starting ones: an upward RUL bias.
-_ALIGN_BEFORE_START = 0.5
-# Similarity alignment: coarse grid of aligned ages, then a fine grid around the best.
-_ALIGN_GRID = 161
-_ALIGN_REFINE = 41
-# Similarity bandwidth: from the excess distance of the k-th nearest library unit,
-# k = max(2, ceil(U/5)).
-_BANDWIDTH_NEIGHBOUR_FRACTION = 0.2
 
 
 def _package_version() -> str:
@@ -153,24 +155,16 @@ class RULModel:
     ``b <= 0`` never cross and get the horizon). When the latest clearance estimate is at or
     above the threshold the RUL is 0 with a warning.
 
-    Similarity model [2]_: the library curves are the training units' per-unit fits of the
-    chosen form; the alignment distance of library unit i is the weighted sum of squares
-    ``d_i = min_shift sum_j (S_j - c_i(t_j + shift))^2 / (sd_j^2 + r_i^2)`` (``sd_j`` the
-    diagnosis' measurement standard deviation, ``r_i^2`` the unit's residual variance about its
-    curve beyond its measurement noise; the aligned current age ranges from the history's span
-    minus half the unit's life, the curve extrapolated back before its first age, to 1.5 x
-    the unit's life: a grid of 161 ages refined on 41 points around the best). With
-    ``e_i = d_i - min d``, the weight is the Gaussian kernel
-    ``w_i = exp(-e_i / (2 h))``: for ``h = 1`` the likelihood ratio of the history under unit i
-    against the best unit; the bandwidth ``h = max(1, e_(k) / 2)``, ``e_(k)`` the k-th smallest
-    excess, ``k = max(2, ceil(U / 5))``, tempers it so that the k-th nearest unit keeps at least
-    ``exp(-1)`` of the best one's weight (a likelihood over tens of diagnoses would otherwise
-    single out one library unit and give an interval of zero width).
-    ``RUL_i = T_i - aligned current age`` clipped to [0, horizon].
+    Similarity model [2]_: :mod:`prsm_health.prognostics.similarity` (the alignment, the kernel).
+
+    Physics model (``"physics"``, when fitted by :func:`~prsm_health.prognostics.fit_prognostics_model`
+    on a fleet dataset, whose ``[life]`` recipe gives the physics): the PRSM's ageing as a
+    progpy model, a particle filter on the diagnoses, progpy's Monte Carlo prediction
+    (:mod:`prsm_health.prognostics.ageing_rul`).
 
     Parameters
     ----------
-    method : {"degradation", "similarity", "degradation-exponential", "degradation-linear"}
+    method : {"degradation", "similarity", "physics", "degradation-exponential", "degradation-linear"}
         Default method of :meth:`predict`.
     threshold : float, default 30e-6
         Clearance at which a unit fails [m], > 0.
@@ -458,7 +452,7 @@ class RULModel:
         self._require_fitted()
         method = self._resolve_method(method)
         clean = validate_history(history, self)
-        return self._predict_arrays(*history_arrays(clean), method)
+        return self._predict_arrays(*history_arrays(clean), method, duty_arrays(clean))
 
     def predict_prefixes(self, history: pd.DataFrame, method=None, min_rows: int = 2) -> list:
         """Prognoses at every prefix of the history, each from the rows up to it only.
@@ -485,7 +479,16 @@ class RULModel:
             min_rows,
             "must be an integer >= 2",
         )
-        t, value, sd = history_arrays(validate_history(history, self))
+        clean = validate_history(history, self)
+        t, value, sd = history_arrays(clean)
+        if method == "physics":  # one pass of the filter gives every prefix's prediction
+            ruls = self._ageing().predict_prefix_arrays(
+                t, value, sd, min_rows=min_rows, **duty_arrays(clean)
+            )
+            return [
+                self._prognosis(t[:k], value[:k], sd[:k], *self._physics(rul))
+                for k, rul in zip(range(min_rows, len(t) + 1), ruls)
+            ]
         return [
             self._predict_arrays(t[:k], value[:k], sd[:k], method)
             for k in range(min_rows, len(t) + 1)
@@ -496,9 +499,21 @@ class RULModel:
         require(method in METHODS, "method", method, f"must be one of {', '.join(METHODS)}")
         return method
 
-    def _predict_arrays(self, t, value, sd, method) -> Prognosis:
+    def _predict_arrays(self, t, value, sd, method, duty=None) -> Prognosis:
+        if method == "similarity":
+            rul, model = self._similarity(t, value, sd)
+            more = []
+        elif method == "physics":
+            result = self._ageing().predict_arrays(t, value, sd, **(duty or {}))
+            rul, model, more = self._physics(result)
+        else:
+            form = self.form_ if method == "degradation" else method.split("-", 1)[1]
+            rul, model, more = self._degradation(form, t, value, sd)
+        return self._prognosis(t, value, sd, rul, model, more)
+
+    def _prognosis(self, t, value, sd, rul, model, more) -> Prognosis:
         thr = float(self.threshold)
-        warnings = self._history_warnings(t, value, sd)
+        warnings = self._history_warnings(t, value, sd) + list(more)
         indicator = {
             "name": "clearance",
             "unit": "m",
@@ -509,12 +524,6 @@ class RULModel:
             "upper": (value + Z90 * sd).tolist(),
             "current": float(value[-1]),
         }
-        if method == "similarity":
-            rul, model = self._similarity(t, value, sd)
-        else:
-            form = self.form_ if method == "degradation" else method.split("-", 1)[1]
-            rul, model, more = self._degradation(form, t, value, sd)
-            warnings.extend(more)
         if value[-1] >= thr:
             warnings.insert(
                 0,
@@ -613,71 +622,68 @@ class RULModel:
         rul_hours = {"estimate": float(mid), "lower": float(low), "upper": float(high)}
         return rul_hours, model, warnings
 
-    def _similarity(self, t, value, sd):
-        form = self.form_
-        state = self.forms_[form]
-        thr = float(self.threshold)
-        phi = state["phi"]
-        params = state["params"]
-        lives = self.failure_ages_
-        n_units, n = len(lives), len(t)
-        tiny = (1e-8 * thr) ** 2
-        weights = 1.0 / (sd[None, :] ** 2 + state["residual_var"][:, None] + tiny)  # (U, n)
-        # aligned current ages from (history span - half the unit's life) to 1.5 x its life
-        bottom = (t[-1] - t[0]) - _ALIGN_BEFORE_START * lives
-        top = np.maximum(1.5 * lives, bottom + 1e-3 * lives)
+    def _ageing_or_none(self):
+        return getattr(self, "ageing_", None)
 
-        back = (t[-1] - t) / self.t_scale_  # scaled time of each diagnosis before the latest
-        if form == "exponential":  # exp(a + b (A - back)) = exp(a + b A) exp(-b back)
-            decay = np.exp(-params[:, 1, None] * back[None, :])  # (U, n)
+    def _ageing(self):
+        ageing = self._ageing_or_none()
+        if ageing is None:
+            raise PRSMHealthError(
+                "this prognostics model has no physics part: fit it with "
+                "fit_prognostics_model on a fleet dataset (its [life] recipe gives the physics)"
+            )
+        return ageing
 
-        def distances(aligned):  # aligned current ages (U, G) -> weighted squared distance
-            now = aligned / self.t_scale_
-            if form == "exponential":
-                level = np.exp(np.minimum(params[:, 0, None] + params[:, 1, None] * now, 700.0))
-                fitted = phi + level[:, :, None] * decay[:, None, :]
-            else:  # not named `curve`: that would hide the module's function in this scope
-                fitted = curve(
-                    form,
-                    params[:, 0, None, None],
-                    params[:, 1, None, None],
-                    now[:, :, None] - back[None, None, :],
-                    phi,
-                    thr,
-                )
-            return np.einsum("un,ugn->ug", weights, (value[None, None, :] - fitted) ** 2)
-
-        grid = (
-            bottom[:, None] + (top - bottom)[:, None] * np.linspace(0.0, 1.0, _ALIGN_GRID)[None, :]
-        )
-        d = distances(grid)
-        best = np.argmin(d, axis=1)
-        rows = np.arange(n_units)
-        low = grid[rows, np.maximum(best - 1, 0)]
-        high = grid[rows, np.minimum(best + 1, _ALIGN_GRID - 1)]
-        fine = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, _ALIGN_REFINE)[None, :]
-        d_fine = distances(fine)
-        pick = np.argmin(d_fine, axis=1)
-        aligned = fine[rows, pick]
-        excess = d_fine[rows, pick]
-        excess = excess - excess.min()
-        k = max(2, math.ceil(_BANDWIDTH_NEIGHBOUR_FRACTION * n_units))
-        bandwidth = max(1.0, 0.5 * float(np.sort(excess)[min(k, n_units) - 1]))
-        w = np.exp(-excess / (2.0 * bandwidth))
-        rul = np.clip(lives - aligned, 0.0, self.horizon_)
-        low_q, mid, high_q = weighted_quantiles(rul, w, QUANTILES)
-        model = self._base_model_dict("similarity")
+    def _physics(self, result: dict):
+        """A physics prediction (:class:`~prsm_health.prognostics.ageing_rul.AgeingRUL`) as
+        (RUL, model dict, warnings)."""
+        ageing = self._ageing()
+        rul = {k: result[k] for k in ("estimate", "lower", "upper")}
+        model = self._base_model_dict("physics")
         model.update(
             {
-                "form": form,
-                "bandwidth": bandwidth,
-                "effective_units": float(w.sum() ** 2 / np.sum(w**2)),
-                "nearest_unit": self.units_[int(np.argmin(excess))],
-                "history_points": n,
+                "states": [
+                    "b_screw",
+                    "b_nut",
+                    "degradation",
+                    "usage",
+                    "log_wear",
+                    "log_lubricant_life",
+                ],
+                "posterior": result["posterior"],
+                "failure_clearance": ageing.tables["failure_clearance"],
+                "n_particles": ageing.n_particles,
+                "n_samples": ageing.n_samples,
+                "capped_fraction": result["capped_fraction"],
             }
         )
-        rul_hours = {"estimate": float(mid), "lower": float(low_q), "upper": float(high_q)}
-        return rul_hours, model
+        warnings = []
+        if result["capped_fraction"] > CAPPED_WARNING_FRACTION:
+            warnings.append(
+                f"{result['capped_fraction']:.0%} of the predicted units do not reach the wear "
+                f"limit within the horizon; their RUL is capped at {ageing.horizon:.4g} h"
+            )
+        return rul, model, warnings
+
+    def _similarity(self, t, value, sd):
+        state = self.forms_[self.form_]
+        rul, details = similarity_rul(
+            state["params"],
+            state["residual_var"],
+            form=self.form_,
+            phi=state["phi"],
+            threshold=float(self.threshold),
+            lives=self.failure_ages_,
+            t_scale=self.t_scale_,
+            horizon=self.horizon_,
+            t=t,
+            value=value,
+            sd=sd,
+        )
+        model = self._base_model_dict("similarity")
+        model.update(details)
+        model["nearest_unit"] = self.units_[model.pop("nearest")]
+        return rul, model
 
     # ---------------------------------------------------------------------------- persistence
 
@@ -708,6 +714,7 @@ class RULModel:
                 "selection_rule": "lower leave-one-unit-out RMSE of RUL on the training fleet",
                 "loo_rmse": dict(self.loo_rmse_),
                 "forms": self.forms_,
+                "ageing": None if self._ageing_or_none() is None else self.ageing_.to_dict(),
             }
         return json_ready(out)
 
@@ -761,6 +768,10 @@ class RULModel:
                     if not all(np.all(np.isfinite(v)) for v in forms[name].values()):
                         raise ValueError("non-finite parameter")
                 model.forms_ = forms
+                if fitted.get("ageing") is not None:
+                    from .ageing_rul import AgeingRUL
+
+                    model.ageing_ = AgeingRUL.from_dict(fitted["ageing"])
         except ParameterError as err:
             raise PRSMHealthError(f"malformed prognostics model ({one_line(err)})") from None
         except (KeyError, TypeError, ValueError, AttributeError) as err:

@@ -1,4 +1,7 @@
-"""Prognostic metrics (Saxena et al. 2010) on hand-made arrays, and the fleet evaluation."""
+"""Prognostic metrics (Saxena et al. 2010) on hand-made arrays, and the fleet evaluation.
+
+The cross-checks against progpy's own metrics are in test_metrics_progpy.py.
+"""
 
 import math
 
@@ -143,6 +146,17 @@ def test_evaluate_units_table_and_summary():
         covered = (part["lower"] <= part["true_rul"]) & (part["true_rul"] <= part["upper"])
         assert s["coverage"] == pytest.approx(covered.mean())
         assert 0.0 <= s["prognostic_horizon"] <= max(lives.values())
+        # progpy's CRA and monotonicity, per unit then averaged (Saxena 2010 section 6.3;
+        # Coble & Hines 2009), against the plain formulas
+        cra, mono = [], []
+        for _, u in part.sort_values("age_hours").groupby("unit_id"):
+            keep = u["true_rul"] > 0
+            cra.append(np.mean(1 - np.abs(err[u.index][keep]) / u["true_rul"][keep]))
+            steps = np.sign(np.diff(u["estimate"].to_numpy()))
+            mono.append(abs(steps.sum()) / steps.size)
+        assert s["cra"] == pytest.approx(np.mean(cra), rel=1e-12)
+        assert s["monotonicity"] == pytest.approx(np.mean(mono), rel=1e-12)
+        assert s["cra"] <= 1.0 and 0.0 <= s["monotonicity"] <= 1.0
 
 
 def test_evaluate_units_refusals():

@@ -39,7 +39,13 @@ from .options import (
 
 #: The methods ``prognose --method`` offers (prsm_health.prognostics.METHODS, which imports
 #: pandas and scipy).
-PROGNOSIS_METHODS = ("degradation", "similarity", "degradation-exponential", "degradation-linear")
+PROGNOSIS_METHODS = (
+    "degradation",
+    "similarity",
+    "physics",
+    "degradation-exponential",
+    "degradation-linear",
+)
 #: The default instrumentation profile (prsm_health.simulation.instrumentation, which imports
 #: scipy).
 DEFAULT_PROFILE = "flight-ema"
@@ -740,7 +746,8 @@ def _add_prognose(command) -> None:
         choices=PROGNOSIS_METHODS,
         default=None,
         default_text="the model's default method",
-        help="degradation (the form chosen at fit time), similarity, or a forced degradation form",
+        help="degradation (the form chosen at fit time), similarity, physics (the ageing model "
+        "and a particle filter, models fitted on a fleet dataset), or a forced degradation form",
     )
     _add_json(g, "the prognosis")
     g.set_defaults(handler="prognose:prognose")

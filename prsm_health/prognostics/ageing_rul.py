@@ -1,0 +1,329 @@
+"""RUL by the PRSM's ageing model: progpy's particle filter on a unit's diagnoses, progpy's
+Monte Carlo predictor to the wear limit.
+
+:class:`AgeingRUL` holds the model's physics (the rate tables of
+:func:`~prsm_health.prognostics.ageing_model.rate_tables`, from the fleet recipe's ``[life]``),
+what it learnt from a training fleet — the diagnosis' calibration against the true clearance
+and the prior of the units' two uncertain parameters — and predicts a unit's RUL:
+
+1. **Estimation** (progpy ``ParticleFilter``; Daigle & Goebel 2013's joint state–parameter
+   estimation): ``n_particles`` particles drawn from the prior (as-built clearance uniform on
+   the recipe's range, the usage at its stationary law, ``log_wear`` and
+   ``log_lubricant_life`` Gaussian) start at age 0 and are propagated to each diagnosis,
+   weighted by its likelihood — the diagnosis' 90 % interval, scaled by the calibration's
+   ``noise_scale``, as the measurement's standard deviation — and resampled.
+2. **Prediction** (progpy ``MonteCarlo``): ``n_samples`` of the particles simulated under the
+   unit's expected duty (``load``, × the recipe's loads) until their mean half-clearance
+   reaches the limit; RUL = time of event − age; median and 5–95 % quantiles; samples that do
+   not reach it within the horizon get the horizon.
+
+Fitting (:meth:`AgeingRUL.fit`): the calibration is an ordinary least-squares line of the
+diagnosed clearance on the true mean clearance over the training snapshots (``bias``,
+``gain``) and the RMS of its standardised residuals (``noise_scale``); the prior is empirical
+Bayes — each training unit filtered from a broad prior over its whole history, the prior's
+mean and covariance those of the units' posterior means plus their mean posterior covariance.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from prsm_health.core.errors import require
+
+from .history import Z90, duty_arrays
+from .prognosis import QUANTILES
+
+#: Broad prior of (log_wear, log_lubricant_life) the training units are filtered from.
+BROAD_PRIOR_SD = (1.0, 0.7)
+#: Random-walk rate of the parameter particles in the filter [1/√h] (they would otherwise
+#: collapse onto a few values after resampling; 0.005·√1000 h ≈ 0.16 in ln per 1000 h).
+PARAMETER_DRIFT = 0.005
+
+
+def _systematic_resample(rng):
+    """Systematic resampling (Kitagawa 1996) from ``rng``: progpy's default draws from NumPy's
+    global generator, which would make a prediction depend on the caller's other draws."""
+
+    def resample(weights):
+        n = len(weights)
+        positions = (rng.random() + np.arange(n)) / n
+        cumulative = np.cumsum(weights)
+        cumulative[-1] = 1.0
+        return np.searchsorted(cumulative, positions)
+
+    return resample
+
+
+class AgeingRUL:
+    """The ageing model's RUL predictor (module docstring).
+
+    Parameters
+    ----------
+    tables : dict
+        :func:`~prsm_health.prognostics.ageing_model.rate_tables` of the fleet recipe.
+    initial_clearance : (float, float) [m]
+        The as-built half-clearance range (the recipe's ``life.scatter.initial_clearance``).
+    prior_mean, prior_cov
+        Gaussian prior of (log_wear, log_lubricant_life).
+    bias, gain, noise_scale
+        The diagnosis' calibration (module docstring).
+    horizon : float [h]
+        RUL cap.
+    n_particles, n_samples : int
+        Particles of the filter; of them, samples of the prediction.
+    seed : int
+        Every prediction restarts from it.
+    """
+
+    def __init__(
+        self,
+        tables: dict,
+        *,
+        initial_clearance=(3e-6, 8e-6),
+        prior_mean=(0.0, 0.0),
+        prior_cov=((BROAD_PRIOR_SD[0] ** 2, 0.0), (0.0, BROAD_PRIOR_SD[1] ** 2)),
+        bias: float = 0.0,
+        gain: float = 1.0,
+        noise_scale: float = 1.0,
+        horizon: float = 1e5,
+        n_particles: int = 300,
+        n_samples: int = 100,
+        seed: int = 0,
+    ):
+        self.tables = {
+            k: (np.asarray(v) if k.startswith("rate_") else v) for k, v in tables.items()
+        }
+        self.initial_clearance = tuple(float(v) for v in initial_clearance)
+        self.prior_mean = np.asarray(prior_mean, dtype=float).reshape(2)
+        self.prior_cov = np.asarray(prior_cov, dtype=float).reshape(2, 2)
+        self.bias, self.gain, self.noise_scale = float(bias), float(gain), float(noise_scale)
+        self.horizon = float(horizon)
+        self.n_particles, self.n_samples, self.seed = int(n_particles), int(n_samples), int(seed)
+
+    # ------------------------------------------------------------------ the model and filter
+    def model(self, seed: int):
+        from .ageing_model import PRSMAgeing
+
+        return PRSMAgeing(
+            **self.tables,
+            bias=self.bias,
+            gain=self.gain,
+            reference_clearance=float(np.mean(self.initial_clearance)),
+            seed=seed,
+        )
+
+    def _prior_particles(self, rng, mean, cov) -> dict:
+        n = self.n_particles
+        b0 = rng.uniform(*self.initial_clearance, n)
+        params = rng.multivariate_normal(mean, cov, n)
+        return {
+            "b_screw": b0,
+            "b_nut": b0.copy(),
+            "degradation": np.zeros(n),
+            "usage": rng.standard_normal(n),
+            "log_wear": params[:, 0],
+            "log_lubricant_life": params[:, 1],
+        }
+
+    def filtered(self, t, value, sd, *, load=None, usage_rate=None):
+        """Filter a history: yields ``(k, model, filter)`` after each diagnosis k (ages ``t``
+        [h], diagnosed clearances ``value`` [m], their standard deviations ``sd`` [m]; the
+        duty log over the interval before each diagnosis, where known — the load factor
+        ``load`` (default 1) and the ``usage_rate``, :func:`~prsm_health.prognostics.history.duty_arrays`)."""
+        from progpy.state_estimators import ParticleFilter
+        from progpy.uncertain_data import UnweightedSamples
+
+        rng = np.random.default_rng(self.seed)
+        model = self.model(int(rng.integers(2**31)))
+        model.parameters["parameter_drift"] = PARAMETER_DRIFT
+        x0 = self._prior_particles(rng, self.prior_mean, self.prior_cov)
+        samples = UnweightedSamples(
+            [{k: float(v[i]) for k, v in x0.items()} for i in range(self.n_particles)],
+            _type=model.StateContainer,
+        )
+        filt = ParticleFilter(
+            model,
+            samples,
+            t0=0.0,  # no num_particles: progpy would redraw them from NumPy's global generator
+            resample_fcn=_systematic_resample(rng),
+            measurement_noise={"clearance": 1e-6},
+        )
+        loads = np.ones(len(t)) if load is None else np.asarray(load, dtype=float)
+        rates = np.full(len(t), np.nan) if usage_rate is None else np.asarray(usage_rate, float)
+        for k, (age, z, s) in enumerate(zip(t, value, sd)):
+            noise = max(float(s) * self.noise_scale, 1e-9)
+            filt.parameters["measurement_noise"] = {"clearance": noise}
+            if age <= filt.t:  # a diagnosis at age 0, or two at one age: weight only
+                age = filt.t + 1e-6
+            step = min(50.0, age - filt.t)
+            u = {"load": float(loads[k]), "usage_rate": float(rates[k])}
+            filt.estimate(float(age), u, {"clearance": float(z)}, dt=step)
+            yield k, model, filt
+
+    def _predict_from(self, model, filt, age: float, load: float) -> dict:
+        from progpy.predictors import MonteCarlo
+        from progpy.uncertain_data import UnweightedSamples
+
+        # the samples drawn from the model's generator: progpy's own draw uses NumPy's global one
+        keep = model.rng.choice(self.n_particles, min(self.n_samples, self.n_particles), False)
+        particles = filt.particles
+        samples = UnweightedSamples(
+            [{k: float(np.ravel(particles[k])[i]) for k in particles.keys()} for i in keep],
+            _type=model.StateContainer,
+        )
+        model.parameters["parameter_drift"] = 0.0  # the unit's parameters, not their jitter
+        try:
+            with warnings.catch_warnings():  # progpy's MonteCarlo calls its own deprecated pop
+                warnings.simplefilter("ignore", DeprecationWarning)
+                result = MonteCarlo(model).predict(
+                    samples,
+                    lambda t, x=None: model.InputContainer({"load": load, "usage_rate": math.nan}),
+                    n_samples=len(keep),
+                    dt=model.prediction_step,
+                    horizon=self.horizon,
+                    save_freq=self.horizon,
+                    t0=float(age),
+                )
+        finally:
+            model.parameters["parameter_drift"] = PARAMETER_DRIFT
+        toe = np.array(
+            [math.inf if s["wear"] is None else float(s["wear"]) for s in result.time_of_event]
+        )
+        rul = np.clip(toe - age, 0.0, self.horizon)
+        low, mid, high = np.quantile(rul, QUANTILES)
+        return {
+            "estimate": float(mid),
+            "lower": float(low),
+            "upper": float(high),
+            "capped_fraction": float(np.mean(rul >= self.horizon)),
+        }
+
+    def predict_arrays(self, t, value, sd, *, load=None, usage_rate=None, future_load=None) -> dict:
+        """The RUL after the whole history (:meth:`predict_prefix_arrays`' last)."""
+        return self.predict_prefix_arrays(
+            t,
+            value,
+            sd,
+            load=load,
+            usage_rate=usage_rate,
+            future_load=future_load,
+            min_rows=len(t),
+        )[-1]
+
+    def predict_prefix_arrays(
+        self, t, value, sd, *, load=None, usage_rate=None, future_load=None, min_rows: int = 2
+    ) -> list[dict]:
+        """The RUL after each prefix of ≥ ``min_rows`` diagnoses, in one pass of the filter
+        (each prediction sees the diagnoses up to it only). The future duty: ``future_load``,
+        default the latest logged load (1 without a log); its usage, the usage state's
+        process."""
+        require(len(t) >= 1, "history", len(t), "needs at least one diagnosis")
+        out = []
+        for k, model, filt in self.filtered(t, value, sd, load=load, usage_rate=usage_rate):
+            if k + 1 >= min_rows:
+                ahead = future_load
+                if ahead is None:
+                    ahead = 1.0 if load is None else float(np.asarray(load)[k])
+                rul = self._predict_from(model, filt, float(filt.t), ahead)
+                rul["posterior"] = self._posterior_summary(filt)
+                out.append(rul)
+        return out
+
+    @staticmethod
+    def _posterior_summary(filt) -> dict:
+        p = filt.particles
+        mean = 0.5 * (np.asarray(p["b_screw"]) + np.asarray(p["b_nut"]))
+        return {
+            "clearance_mean_m": float(np.mean(mean)),
+            "log_wear": [float(np.mean(p["log_wear"])), float(np.std(p["log_wear"]))],
+            "log_lubricant_life": [
+                float(np.mean(p["log_lubricant_life"])),
+                float(np.std(p["log_lubricant_life"])),
+            ],
+        }
+
+    # ------------------------------------------------------------------ fitting
+    @classmethod
+    def fit(
+        cls,
+        tables: dict,
+        spec,
+        histories,
+        *,
+        seed: int = 0,
+        horizon: float | None = None,
+        n_particles: int = 300,
+        n_samples: int = 100,
+    ):
+        """Calibration and empirical-Bayes prior from training units (module docstring).
+
+        ``histories``: the training units' diagnoses (``unit_id``, ``age_hours``,
+        ``clearance``, ``clearance_lower``, ``clearance_upper``; ``clearance_mean_true`` for
+        the calibration — without it the diagnosis is taken as unbiased) and
+        ``failure_age_hours``.
+        """
+        lives = histories.groupby("unit_id")["failure_age_hours"].first()
+        horizon = horizon or 3.0 * float(lives.max())
+        sd = (histories["clearance_upper"] - histories["clearance_lower"]).to_numpy() / (2 * Z90)
+        bias, gain, scale = 0.0, 1.0, 1.0
+        if "clearance_mean_true" in histories.columns:
+            true = histories["clearance_mean_true"].to_numpy(float)
+            z = histories["clearance"].to_numpy(float)
+            gain, bias = np.polyfit(true, z, 1)
+            residual = (z - (bias + gain * true)) / np.maximum(sd, 1e-9)
+            scale = float(np.sqrt(np.mean(residual**2)))
+        est = cls(
+            tables,
+            initial_clearance=spec.scatter.initial_clearance,
+            bias=bias,
+            gain=gain,
+            noise_scale=scale,
+            horizon=horizon,
+            n_particles=n_particles,
+            n_samples=n_samples,
+            seed=seed,
+        )
+        means, covs = [], []
+        for _, unit in histories.sort_values(["unit_id", "age_hours"]).groupby("unit_id"):
+            t = unit["age_hours"].to_numpy(float)
+            u_sd = (unit["clearance_upper"] - unit["clearance_lower"]).to_numpy() / (2 * Z90)
+            duty = duty_arrays(unit)
+            *_, (_, _, filt) = est.filtered(t, unit["clearance"].to_numpy(float), u_sd, **duty)
+            params = np.column_stack(
+                [
+                    np.asarray(filt.particles["log_wear"]),
+                    np.asarray(filt.particles["log_lubricant_life"]),
+                ]
+            )
+            means.append(params.mean(axis=0))
+            covs.append(np.cov(params.T))
+        means = np.array(means)
+        est.prior_mean = means.mean(axis=0)
+        est.prior_cov = np.cov(means.T) + np.mean(covs, axis=0)
+        return est
+
+    # ------------------------------------------------------------------ persistence
+    def to_dict(self) -> dict:
+        return {
+            "tables": {
+                k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.tables.items()
+            },
+            "initial_clearance": list(self.initial_clearance),
+            "prior_mean": self.prior_mean.tolist(),
+            "prior_cov": self.prior_cov.tolist(),
+            "bias": self.bias,
+            "gain": self.gain,
+            "noise_scale": self.noise_scale,
+            "horizon": self.horizon,
+            "n_particles": self.n_particles,
+            "n_samples": self.n_samples,
+            "seed": self.seed,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> AgeingRUL:
+        d = dict(d)
+        return cls(d.pop("tables"), **d)
