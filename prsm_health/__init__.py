@@ -13,7 +13,7 @@ Public API (SI units throughout), imported lazily so ``import prsm_health`` stay
   :func:`diagnose` → :class:`Diagnosis`
 - ageing and prognostics: :class:`LifeSpec`, :func:`fleet_lives` (wear, lubricant ageing and
   fatigue over operating hours), :func:`diagnose_runs`, :func:`fleet_histories`,
-  :class:`RULModel` (formerly ``PrognosticsModel``), :func:`load_prognostics_model`, :func:`read_history`,
+  :class:`RULModel`, :func:`load_prognostics_model`, :func:`read_history`,
   :func:`prognose` → :class:`Prognosis`
 - static stiffness: :mod:`prsm_health.physics.stiffness`; validation: :func:`prsm_health.validation.collect`
 """
@@ -86,9 +86,6 @@ _EXPORTS = {
 #: Public names that differ from the defining module's name for them.
 _ALIASES = {
     "load_model": (".diagnostics.diagnosis", "load_bundle"),
-    # the RUL model's name before 0.1's layout: progpy's PrognosticsModel is another thing
-    # (a state-space model), so the class is RULModel; scripts of 0.1 keep working
-    "PrognosticsModel": (".prognostics", "RULModel"),
 }
 
 __all__ = sorted([*_EXPORTS, *_ALIASES, "__version__"])
