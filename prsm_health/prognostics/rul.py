@@ -637,19 +637,14 @@ class RULModel:
     def _physics(self, result: dict):
         """A physics prediction (:class:`~prsm_health.prognostics.ageing_rul.AgeingRUL`) as
         (RUL, model dict, warnings)."""
+        from .ageing_model import PRSMAgeing  # progpy: imported only where prognostics run
+
         ageing = self._ageing()
         rul = {k: result[k] for k in ("estimate", "lower", "upper")}
         model = self._base_model_dict("physics")
         model.update(
             {
-                "states": [
-                    "b_screw",
-                    "b_nut",
-                    "degradation",
-                    "usage",
-                    "log_wear",
-                    "log_lubricant_life",
-                ],
+                "states": list(PRSMAgeing.states),
                 "posterior": result["posterior"],
                 "failure_clearance": ageing.tables["failure_clearance"],
                 "n_particles": ageing.n_particles,
