@@ -109,6 +109,11 @@ class DutyCycle:
         Lubricant temperature in service.
     lubricant_life : float [h]
         Operating hours until the lubricant's additives are used up, at 70 °C.
+    change_age : float [h] or None
+        From this age on the unit works at ``change_load`` × its loads (a new mission, a
+        heavier surface); None: the same duty all its life.
+    change_load : float [-]
+        The loads' factor after ``change_age``.
     """
 
     speed: float = 100.0
@@ -118,6 +123,8 @@ class DutyCycle:
     motion_fraction: float = 0.3
     temperature: float = 323.15
     lubricant_life: float = 2000.0
+    change_age: float | None = None
+    change_load: float = 1.0
 
     def __post_init__(self):
         require(
@@ -155,6 +162,9 @@ class DutyCycle:
         require_range("life.duty.motion_fraction", self.motion_fraction, 1e-4, 1.0)
         require_range("life.duty.temperature", self.temperature, 223.15, 473.15, unit="K")
         require_range("life.duty.lubricant_life", self.lubricant_life, 1.0, 1e7, unit="h")
+        if self.change_age is not None:
+            require_range("life.duty.change_age", self.change_age, 0.0, 1e7, unit="h")
+        require_range("life.duty.change_load", self.change_load, 0.1, 10.0)
 
     @property
     def is_resolved(self) -> bool:
@@ -168,9 +178,10 @@ class DutyCycle:
         if not isinstance(ratings, dict):
             ratings = {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)}
         loads = tuple(parse_force(v).newtons(ratings, "life.duty.loads") for v in self.loads)
+        most = max(1.0, self.change_load if self.change_age is not None else 1.0)
         for given, value in zip(self.loads, loads):
             require(
-                "C_0a" not in ratings or abs(value) <= ratings["C_0a"],
+                "C_0a" not in ratings or abs(value) * most <= ratings["C_0a"],
                 "life.duty.loads",
                 given.text() if isinstance(given, ForceSpec) else given,
                 f"is {value:.4g} N, above the design's static load rating C_0a = "
@@ -344,6 +355,15 @@ class UnitLife:
     failure_mode: str
     failure_clearance: float
     failure_spall_length: float
+    change_age: float | None = None  # [h], the duty's change (DutyCycle.change_age)
+    change_load: float = 1.0
+
+    def duty_change(self, age) -> np.ndarray:
+        """The loads' factor at ``age`` from the duty's change (1 before it)."""
+        age = np.asarray(age, dtype=float)
+        if self.change_age is None:
+            return np.ones_like(age)
+        return np.where(age >= self.change_age, self.change_load, 1.0)
 
     def degradation(self, age) -> np.ndarray:
         return np.minimum(np.asarray(age, dtype=float) / self.lubricant_life, 1.0)
@@ -408,7 +428,7 @@ class UnitLife:
             "clearance_mean_true": float(self.clearance(age)),
             "spall_length_true": float(self.spall_length(age)),
             "duty_hours": float(np.interp(age, self.ages, self.duty_hours)),
-            "duty_load": self.load_scale,
+            "duty_load": self.load_scale * float(self.duty_change(age)),
         }
 
 
@@ -546,6 +566,18 @@ def unit_life(
         geometry=geometry,
     )
     rates, damage = duty_rates.clearance, duty_rates.damage
+    after = None  # the rates from the duty's change on
+    if duty.change_age is not None:
+        after = wear_rates(
+            design,
+            duty,
+            lubricant_name=spec.lubricant,
+            temperature=temperature,
+            wear=wear,
+            wear_scale=k_scale,
+            load_scale=load_scale * duty.change_load,
+            geometry=geometry,
+        )
 
     # Deterministic wear first (exact on the degradation grid), to size the age grid; then the
     # unit's wandering usage intensity along it.
@@ -556,10 +588,13 @@ def unit_life(
         usage = _usage_increments(rng, np.diff(ages), sc.usage, sc.usage_time)
         mid = 0.5 * (ages[1:] + ages[:-1])
         d_mid = np.minimum(mid / t_lube, 1.0)
-        worn = {
-            side: np.concatenate([[0.0], np.cumsum(np.interp(d_mid, DEGRADATION_GRID, r) * usage)])
-            for side, r in rates.items()
-        }
+        worn = {}
+        for side, r in rates.items():
+            rate = np.interp(d_mid, DEGRADATION_GRID, r)
+            if after is not None:
+                changed = np.interp(d_mid, DEGRADATION_GRID, after.clearance[side])
+                rate = np.where(mid >= duty.change_age, changed, rate)
+            worn[side] = np.concatenate([[0.0], np.cumsum(rate * usage)])
         life = UnitLife(
             unit_id=unit_id,
             seed=int(
@@ -582,6 +617,8 @@ def unit_life(
             failure_mode="wear",
             failure_clearance=spec.failure_clearance,
             failure_spall_length=spec.failure_spall_length,
+            change_age=duty.change_age,
+            change_load=duty.change_load,
         )
         wear_failure = _crossing(life, spec.failure_clearance)
         if math.isfinite(wear_failure) or span >= spec.max_age:
@@ -597,6 +634,12 @@ def unit_life(
         spall_age = (math.log(survival) / math.log(0.9)) ** (1 / WEIBULL_SLOPE) / total ** (
             1 / WEIBULL_SLOPE
         )
+    if after is not None and spall_age > duty.change_age:
+        # damage D_i = d_i·t_c + d'_i·(t − t_c) after the change: Σ D_i^e is monotone in t
+        spall_age = _changed_spall_age(damage, after.damage, duty.change_age, survival)
+        damage = after.damage  # the duty the spall starts and grows under
+        hazard = {s: damage[s] ** WEIBULL_SLOPE for s in SURFACES}
+        total = sum(hazard.values())
     if spall_age < min(wear_failure, spec.max_age):
         pick = rng.random() * total
         surface = next(s for s in SURFACES if (pick := pick - hazard[s]) <= 0 or s == SURFACES[-1])
@@ -623,6 +666,29 @@ def unit_life(
         failure_age=failure,
         failure_mode="spall" if spall_failure < wear_failure else "wear",
     )
+
+
+def _changed_spall_age(before: dict, after: dict, change_age: float, survival: float) -> float:
+    """Age [h] at which the surfaces' ISO 281 survival exp(ln 0.9·Σ D_i^e) reaches
+    ``survival`` when each surface's damage rate changes from ``before`` to ``after`` at
+    ``change_age`` (bisection: the hazard only grows)."""
+    target = math.log(survival) / math.log(0.9)
+
+    def hazard(t):
+        return sum(
+            (before[s] * change_age + after[s] * (t - change_age)) ** WEIBULL_SLOPE
+            for s in SURFACES
+        )
+
+    low, high = change_age, 2.0 * change_age + 1.0
+    while hazard(high) < target:
+        if high > 1e12:
+            return math.inf
+        high *= 2.0
+    for _ in range(100):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if hazard(mid) < target else (low, mid)
+    return high
 
 
 def _expected_failure(rates: dict, b0: float, t_lube: float, spec: LifeSpec) -> float:

@@ -362,3 +362,28 @@ def test_the_life_duty_is_the_duty_the_fleet_records():
     assert (shares @ loads**3) ** (1 / 3) == pytest.approx(
         np.mean(recorded**3) ** (1 / 3), rel=0.05
     )
+
+
+def test_a_duty_change_wears_faster_from_its_age_on():
+    from dataclasses import replace
+
+    from prsm_health.physics.life import _changed_spall_age
+
+    spec = LifeSpec(units=2)
+    doubled = replace(spec, duty=replace(spec.duty, change_age=500.0, change_load=2.0))
+    for unit in range(2):
+        base, changed = unit_life(DESIGN, spec, unit, 5), unit_life(DESIGN, doubled, unit, 5)
+        # the same unit and usage draws: identical until the change, faster after it
+        assert float(changed.clearance(400.0)) == float(base.clearance(400.0))
+        assert float(changed.clearance(900.0)) > float(base.clearance(900.0))
+        assert changed.failure_age < base.failure_age
+        assert changed.labels(600.0)["duty_load"] == pytest.approx(2 * base.load_scale)
+        assert changed.labels(400.0)["duty_load"] == pytest.approx(base.load_scale)
+    # the piecewise fatigue hazard reduces to ISO 281's closed form when nothing changes
+    rates = {"screw": 2e-4, "roller": 1e-4, "nut": 5e-5}
+    closed = (math.log(0.3) / math.log(0.9)) ** (1 / WEIBULL_SLOPE) / sum(
+        v**WEIBULL_SLOPE for v in rates.values()
+    ) ** (1 / WEIBULL_SLOPE)
+    assert _changed_spall_age(rates, rates, 100.0, 0.3) == pytest.approx(closed, rel=1e-9)
+    with pytest.raises(ParameterError, match="life.duty.change_load"):
+        LifeSpec.from_dict({"duty": {"change_age": 10.0, "change_load": 50.0}})
