@@ -82,8 +82,11 @@ def test_json_report_and_the_saved_model(fitted):
     assert report["design_fingerprint"] == design_fingerprint("paper01")
     assert report["threshold_learnt"] and report["threshold"] > 0
     assert len(report["train_units"]) == 3 and len(report["test_units"]) == 1
-    assert report["snapshots"] == 12 and set(report["summary"]) == {"degradation", "similarity"}
+    # a fleet dataset carries its [life] recipe: the physics method is fitted and scored too
+    methods = {"degradation", "similarity", "physics"}
+    assert report["snapshots"] == 12 and set(report["summary"]) == methods
     model = load_prognostics_model(path)
+    assert model.ageing_ is not None
     assert model.design_id == ("paper01", design_fingerprint("paper01"))
     assert model.threshold == pytest.approx(report["threshold"], rel=1e-12)
 
