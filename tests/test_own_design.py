@@ -168,9 +168,12 @@ def test_a_prognostics_model_for_a_fleet_of_ones_own_design(tmp_path):
     assert model.design_id == ("acme-ema-24", design_fingerprint(MINE))
     assert report.threshold_learnt and report.threshold > 0
     assert len(report.train_units) == 3 and len(report.test_units) == 1
-    assert set(report.summary) == {"degradation", "similarity"}
+    # the physics method too: its rates are the own design's (the fleet's [life] recipe)
+    assert set(report.summary) == {"degradation", "similarity", "physics"}
     unit = histories[histories["unit_id"] == report.test_units[0]]
     assert prognose(unit.drop(columns="unit_id"), model).rul_hours["estimate"] >= 0
+    physics = prognose(unit.drop(columns="unit_id"), model, method="physics")
+    assert physics.model["name"] == "physics" and physics.rul_hours["estimate"] >= 0
     # a paper01 history is another design
     with pytest.raises(PRSMHealthError, match="another design"):
         prognose(unit.assign(design_fingerprint=design_fingerprint("paper01")), model)
