@@ -101,6 +101,18 @@ def model_file(tmp_path_factory):
         )
         lives[uid] = life
     model = RULModel(n_samples=2000).fit(pd.concat(parts, ignore_index=True), lives)
+    # the physics method (progpy ageing model) of the default fleet recipe's [life], small
+    from prsm_health.actuator.design import preset
+    from prsm_health.physics.life import LifeSpec
+    from prsm_health.prognostics.ageing_model import rate_tables
+    from prsm_health.prognostics.ageing_rul import AgeingRUL
+
+    model.ageing_ = AgeingRUL(
+        rate_tables(preset("paper01"), LifeSpec()),
+        n_particles=80,
+        n_samples=20,
+        horizon=model.horizon_,
+    )
     return save_prognostics_model(tmp_path_factory.mktemp("prognostics") / "model.json", model)
 
 
@@ -256,6 +268,11 @@ def test_prognosis_of_30_stored_diagnoses_survives_a_restart(
         assert first["model"]["name"].startswith("degradation-")
         similarity = c.get("/v1/assets/press-30/prognosis", params={"method": "similarity"})
         assert similarity.status_code == 200 and similarity.json()["model"]["name"] == "similarity"
+        physics = c.get("/v1/assets/press-30/prognosis", params={"method": "physics"})
+        assert physics.status_code == 200, physics.text
+        physics_first = physics.json()
+        assert physics_first["model"]["name"] == "physics"
+        assert physics_first == json.loads(json.dumps(prognose(table, model, "physics").as_dict()))
 
         # real diagnoses, posted with operating hours as JSON and as binary bodies
         body = {
@@ -292,6 +309,9 @@ def test_prognosis_of_30_stored_diagnoses_survives_a_restart(
     # a new server on the same database file: the same answers
     with start() as live, live.client() as c:
         assert c.get("/v1/assets/press-30/prognosis").json() == first
+        # the physics prognosis too: the same particles from the same seed
+        again = c.get("/v1/assets/press-30/prognosis", params={"method": "physics"})
+        assert again.json() == physics_first
         assert c.get("/v1/assets/press-real/prognosis").json() == real_first
 
 

@@ -70,7 +70,8 @@ async def get_prognosis(
         Literal[METHODS] | None,  # type: ignore[valid-type]
         Query(
             description="degradation (default: the form chosen when the model was fitted), "
-            "similarity, or a forced degradation form"
+            "similarity, physics (the progpy ageing model, in models fitted on a fleet "
+            "dataset), or a forced degradation form"
         ),
     ] = None,
 ):
