@@ -622,11 +622,8 @@ class RULModel:
         rul_hours = {"estimate": float(mid), "lower": float(low), "upper": float(high)}
         return rul_hours, model, warnings
 
-    def _ageing_or_none(self):
-        return getattr(self, "ageing_", None)
-
     def _ageing(self):
-        ageing = self._ageing_or_none()
+        ageing = getattr(self, "ageing_", None)
         if ageing is None:
             raise PRSMHealthError(
                 "this prognostics model has no physics part: fit it with "
@@ -709,7 +706,9 @@ class RULModel:
                 "selection_rule": "lower leave-one-unit-out RMSE of RUL on the training fleet",
                 "loo_rmse": dict(self.loo_rmse_),
                 "forms": self.forms_,
-                "ageing": None if self._ageing_or_none() is None else self.ageing_.to_dict(),
+                "ageing": None
+                if getattr(self, "ageing_", None) is None
+                else self.ageing_.to_dict(),
             }
         return json_ready(out)
 

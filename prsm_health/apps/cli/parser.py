@@ -37,8 +37,7 @@ from .options import (
     step,
 )
 
-#: The methods ``prognose --method`` offers (prsm_health.prognostics.METHODS, which imports
-#: pandas and scipy).
+#: ``prognose --method``'s choices (prognostics.METHODS, which imports pandas and scipy).
 PROGNOSIS_METHODS = (
     "degradation",
     "similarity",
