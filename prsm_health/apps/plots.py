@@ -404,6 +404,17 @@ def plot_prognostics(histories, predictions, model, directory, *, alpha: float =
             lw=0.8,
             label="similarity",
         )
+        phys = mine[mine["method"] == "physics"]
+        if not phys.empty:  # models fitted on a fleet dataset
+            ax.plot(
+                phys["age_hours"],
+                phys["estimate"],
+                "^-.",
+                color="tab:green",
+                ms=2,
+                lw=0.8,
+                label="physics (progpy)",
+            )
         life = float(deg["age_hours"].max() + deg["true_rul"].min())
         ax.axvline(0.5 * life, color="0.5", ls=":", lw=0.8)
         ax.set_title(f"unit {unit} (life {life:.0f} h)", fontsize=9)
