@@ -208,17 +208,18 @@ class PRSMAgeing(PrognosticsModel):
         )
 
     def prediction_step(self, t, x) -> float:
-        """A time step [h] for progpy's simulations (``dt=model.prediction_step``): a fifth
+        """A time step [h] for progpy's simulations (``dt=model.prediction_step``): a third
         of the time the unit would take to wear out at its present rate, within 1–200 h —
         long strides while the clearance is far from the limit, short ones near it, where the
-        crossing is timed."""
+        crossing is timed (to the 1 h of the last step; ≈ 20 steps to a limit 2 000 h away:
+        progpy's Monte Carlo steps each sample in Python)."""
         p = self.parameters
         mean = 0.5 * (x["b_screw"] + x["b_nut"])
         screw, nut = self._rates(1.0, x["degradation"])
         rate = 0.5 * (screw + nut) * np.exp(x["log_wear"])
         with np.errstate(divide="ignore"):
             remaining = (p["failure_clearance"] - mean) / rate
-        return float(np.clip(np.min(0.2 * remaining), 1.0, 200.0))
+        return float(np.clip(np.min(remaining / 3.0), 1.0, 200.0))
 
     def output(self, x):
         p = self.parameters

@@ -56,7 +56,7 @@ def _run_to_failure(tables, load=1.0, load_after=None, change_age=math.inf):
 
 def test_failure_age_is_the_life_simulations(tables):
     # Same duty, no scatter: the progpy model's wear-out age equals the life simulation's. The
-    # life simulation integrates on a grid of 2 000 ages, the model in steps of ≤ 1/5 of the
+    # life simulation integrates on a grid of 2 000 ages, the model in steps of ≤ 1/3 of the
     # time left (its crossing is timed to the last, ≤ 1 h step): 1 % covers both.
     life = unit_life(DESIGN, EXACT, 0, 1)
     age, _ = _run_to_failure(tables)
