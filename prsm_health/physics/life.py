@@ -555,29 +555,22 @@ def unit_life(
     t_lube = lubricant_life_at(duty.lubricant_life * life_scale, temperature)
     temperature = min(max(temperature, 223.15), 473.15)
 
-    duty_rates = wear_rates(
-        design,
-        duty,
-        lubricant_name=spec.lubricant,
-        temperature=temperature,
-        wear=wear,
-        wear_scale=k_scale,
-        load_scale=load_scale,
-        geometry=geometry,
-    )
-    rates, damage = duty_rates.clearance, duty_rates.damage
-    after = None  # the rates from the duty's change on
-    if duty.change_age is not None:
-        after = wear_rates(
+    def unit_rates(loads: float) -> WearRates:  # this unit's, its duty's loads × loads
+        return wear_rates(
             design,
             duty,
             lubricant_name=spec.lubricant,
             temperature=temperature,
             wear=wear,
             wear_scale=k_scale,
-            load_scale=load_scale * duty.change_load,
+            load_scale=loads,
             geometry=geometry,
         )
+
+    duty_rates = unit_rates(load_scale)
+    rates, damage = duty_rates.clearance, duty_rates.damage
+    # the rates from the duty's change on
+    after = None if duty.change_age is None else unit_rates(load_scale * duty.change_load)
 
     # Deterministic wear first (exact on the degradation grid), to size the age grid; then the
     # unit's wandering usage intensity along it.
