@@ -33,7 +33,7 @@ import numpy as np
 
 from prsm_health.core.errors import require
 
-from .history import Z90, duty_arrays
+from .history import duty_arrays, history_arrays
 from .prognosis import QUANTILES
 
 #: Broad prior of (log_wear, log_lubricant_life) the training units are filtered from.
@@ -41,6 +41,9 @@ BROAD_PRIOR_SD = (1.0, 0.7)
 #: Random-walk rate of the parameter particles in the filter [1/√h] (they would otherwise
 #: collapse onto a few values after resampling; 0.005·√1000 h ≈ 0.16 in ln per 1000 h).
 PARAMETER_DRIFT = 0.005
+#: Longest step [h] the filter propagates its particles by between diagnoses (the lubricant's
+#: depletion, which sets the wear rate, changes by ≤ 50/T_lube ≈ 1 % per step).
+FILTER_STEP = 50.0
 
 
 def _systematic_resample(rng):
@@ -158,7 +161,7 @@ class AgeingRUL:
             filt.parameters["measurement_noise"] = {"clearance": noise}
             if age <= filt.t:  # a diagnosis at age 0, or two at one age: weight only
                 age = filt.t + 1e-6
-            step = min(50.0, age - filt.t)
+            step = min(FILTER_STEP, age - filt.t)
             u = {"load": float(loads[k]), "usage_rate": float(rates[k])}
             filt.estimate(float(age), u, {"clearance": float(z)}, dt=step)
             yield k, model, filt
@@ -267,11 +270,10 @@ class AgeingRUL:
         """
         lives = histories.groupby("unit_id")["failure_age_hours"].first()
         horizon = horizon or 3.0 * float(lives.max())
-        sd = (histories["clearance_upper"] - histories["clearance_lower"]).to_numpy() / (2 * Z90)
+        _, z, sd = history_arrays(histories)
         bias, gain, scale = 0.0, 1.0, 1.0
         if "clearance_mean_true" in histories.columns:
             true = histories["clearance_mean_true"].to_numpy(float)
-            z = histories["clearance"].to_numpy(float)
             gain, bias = np.polyfit(true, z, 1)
             residual = (z - (bias + gain * true)) / np.maximum(sd, 1e-9)
             scale = float(np.sqrt(np.mean(residual**2)))
@@ -288,10 +290,7 @@ class AgeingRUL:
         )
         means, covs = [], []
         for _, unit in histories.sort_values(["unit_id", "age_hours"]).groupby("unit_id"):
-            t = unit["age_hours"].to_numpy(float)
-            u_sd = (unit["clearance_upper"] - unit["clearance_lower"]).to_numpy() / (2 * Z90)
-            duty = duty_arrays(unit)
-            *_, (_, _, filt) = est.filtered(t, unit["clearance"].to_numpy(float), u_sd, **duty)
+            *_, (_, _, filt) = est.filtered(*history_arrays(unit), **duty_arrays(unit))
             params = np.column_stack(
                 [
                     np.asarray(filt.particles["log_wear"]),
