@@ -49,8 +49,11 @@ chromium:
 		echo "warning: $(CHROMIUM) is missing and only root can apt-get it: the browser test will fail (sudo apt-get install -y chromium, or PRSM_HEALTH_SKIP_BROWSER=1 to skip it)" >&2; \
 	fi
 
+# Two worker processes (pytest-xdist), each test file on one of them: module fixtures (a
+# trained model, a dataset) are built once, and a 2-core machine runs the suite in ≈ 5 min
+# instead of ≈ 9 (docs/performance.md).
 test: $(STAMP) chromium
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2 --dist loadfile
 
 # Re-vendor the dashboard's plotting library from the npm registry (needs npm; the files it
 # writes under prsm_health/apps/service/static/vendor/ are committed).
