@@ -23,9 +23,14 @@ from numba import njit
 from . import layout as L
 
 TWO_PI = 2.0 * math.pi
+#: LLVM's fast-math flags for every kernel: reciprocals for divisions, fused multiply-adds,
+#: reassociation, no signed zeros, approximate intrinsics — but not "nnan"/"ninf", so the
+#: step guard's isfinite checks still see a blow-up. Bits differ from IEEE order (say where:
+#: docs/performance.md); statistics do not.
+FAST = {"nsz", "arcp", "contract", "afn", "reassoc"}
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def screw_motion(t, motion):
     """Prescribed screw angle, speed and acceleration from piecewise-linear speed knots.
 
@@ -49,7 +54,7 @@ def screw_motion(t, motion):
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def axial_load(t, load_knots, amp, freq):
     """Resisting axial load [N] at time t: piecewise-linear knots plus a sinusoid."""
     n = load_knots.shape[1]
@@ -66,7 +71,20 @@ def axial_load(t, load_knots, amp, freq):
     return base + amp * math.sin(TWO_PI * freq * t)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
+def _tanh(x):
+    # tanh as a Padé [7/6] rational, ±1 beyond |x| = 4.97 where it reaches 1 (error ≤ 1e-4 there,
+    # ≤ 1e-6 below |x| = 3): a smoothed sign, where libm's tanh was 9 % of a right-hand side.
+    if x >= 4.97:
+        return 1.0
+    if x <= -4.97:
+        return -1.0
+    x2 = x * x
+    numerator = x * (135135.0 + x2 * (17325.0 + x2 * (378.0 + x2)))
+    return numerator / (135135.0 + x2 * (62370.0 + x2 * (3150.0 + 28.0 * x2)))
+
+
+@njit(cache=True, inline="always", fastmath=FAST)
 def _spring(closure, k, exponent):
     # Elastic part of a flank force: linear or Hertzian F = k·x^1.5.
     if closure <= 0.0:
@@ -76,7 +94,7 @@ def _spring(closure, k, exponent):
     return k * closure * math.sqrt(closure)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _flank(closure, rate, k, c, exponent):
     # Returns (contact force ≥ 0, dissipated power). A contact cannot pull: when the damper
     # would make the force negative it is clipped to 0, and the stored energy it releases
@@ -90,7 +108,7 @@ def _flank(closure, rate, k, c, exponent):
     return force, (force - spring) * rate
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _roller_frame(xr, yr, vxr, vyr, xb, yb, vxb, vyb, c, s, w_p):
     # Roller centre relative to a body centre in the pocket frame (e_r, e_t): radial and
     # tangential offsets and their rates (the frame turns with the carrier at w_p).
@@ -101,7 +119,7 @@ def _roller_frame(xr, yr, vxr, vyr, xb, yb, vxb, vyb, c, s, w_p):
     return rho, tau, dvx * c + dvy * s + tau * w_p, -dvx * s + dvy * c - rho * w_p
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _thread_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c, expo):
     # Both flanks of one thread engagement: closure ±δ_axial + cot β·approach beyond the
     # half-clearance. Returns (plus-flank force, minus-flank force, dissipated power).
@@ -114,7 +132,7 @@ def _thread_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c,
     return f_plus, f_minus, d1 + d2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _pitted_flank(closure, rate, depth, depth_rate, share, k, c, exponent):
     # One flank of an engagement whose thread turns are sound but one, which has a depression
     # `depth` at the contact: the share `share` of the turns closes `depth` less. Returns the
@@ -124,7 +142,7 @@ def _pitted_flank(closure, rate, depth, depth_rate, share, k, c, exponent):
     return (1.0 - share) * sound + share * pit, share * pit, (1.0 - share) * d1 + share * d2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _pitted_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c, expo, spall):
     # _thread_pair with a depression on one thread turn; spall = (share, depth and its rate on
     # the plus flank, on the minus flank). Returns forces, pitted-turn forces, dissipation.
@@ -152,7 +170,7 @@ def _pitted_pair(d_ax, d_ax_dot, approach, approach_dot, clearance, cot_b, k, c,
     return f_plus, f_minus, d1 + d2, pit_plus, pit_minus
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _gate(x, half, ramp):
     # 1 while |x| ≤ half − ramp/2, falling linearly to 0 at half + ramp/2: (value, slope).
     a = abs(x)
@@ -164,7 +182,7 @@ def _gate(x, half, ramp):
     return 1.0 - (a - half + 0.5 * ramp) / ramp, slope
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _mesh_stiffness(table, phase):
     n = table.shape[0]
     x = (phase - math.floor(phase)) * n
@@ -178,27 +196,27 @@ def _mesh_stiffness(table, phase):
     return table[i0] * (1.0 - w) + table[i1] * w
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _wave(errors, kind, u):
     # Error profile of one kind at contact coordinate u, linearly interpolated in its table:
     # (value [m], slope d/du [m/rad]).
     n = errors.shape[1] - 1
-    period = errors[kind, 0]
-    x = (u / period - math.floor(u / period)) * n
+    cycles = u * errors[kind, 0]  # column 0: 1/period
+    x = (cycles - math.floor(cycles)) * n
     i0 = int(x)
     if i0 >= n:
         i0 = n - 1
     i1 = i0 + 1 if i0 + 1 < n else 0
     a, b = errors[kind, 1 + i0], errors[kind, 1 + i1]
-    return a + (b - a) * (x - i0), (b - a) * n / period
+    return a + (b - a) * (x - i0), (b - a) * (n * errors[kind, 0])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _clamped(errors, kind, x):
     # A non-periodic table of x ≥ 0 from 0 to errors[kind, 0], linearly interpolated, its last
     # value beyond the end.
     n = errors.shape[1] - 2
-    pos = x / errors[kind, 0] * n
+    pos = x * errors[kind, 0] * n  # column 0: 1/range
     if pos >= n:
         return errors[kind, 1 + n]
     i0 = int(pos)
@@ -206,7 +224,7 @@ def _clamped(errors, kind, x):
     return a + (errors[kind, 2 + i0] - a) * (pos - i0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _traction(slip, v, cap, k, c, decay):
     # One rolling contact's tangential traction: the elastic displacement `slip` of a Mindlin
     # stiffness k sticks up to the Coulomb limit `cap` and slides beyond it (reset integrator,
@@ -226,7 +244,7 @@ def _traction(slip, v, cap, k, c, decay):
     return f_stick + c * v, v - decay * slip, c * v * v + f_stick * decay * slip
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     """dy/dt of the full state at time t; auxiliary outputs (torques, powers) into ``aux``.
 
@@ -407,10 +425,10 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # roller's revolution.
         normal = (f_plus + f_minus) / sin_b
         v_ax_slide = vz_c - vz_s
-        f_axial = -mu_c * normal * math.tanh(v_ax_slide / v_axial)
+        f_axial = -mu_c * normal * _tanh(v_ax_slide / v_axial)
         p_fric -= f_axial * v_ax_slide
         w_rel = w_s - w_rev
-        m_diff = mu_r * normal * math.tanh(w_rel / w_roll)
+        m_diff = mu_r * normal * _tanh(w_rel / w_roll)
         p_fric += m_diff * w_rel
         friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
         torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff - f_dh * dh
@@ -662,7 +680,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # sign switch at zero motor speed regularised.
         eta = p[L.P_GEAR_EFFICIENCY]
         share = 1.0 / eta - 1.0 if transmitted * w_m > 0.0 else 1.0 - eta
-        loss = abs(transmitted) * share * math.tanh(w_m / p[L.P_W_GEAR])
+        loss = abs(transmitted) * share * _tanh(w_m / p[L.P_W_GEAR])
         p_diss += loss * w_m
         load_torque = transmitted + loss
     elif coupled:
@@ -729,7 +747,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     aux[L.A_P_FRIC] = p_fric
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def _record(y, dy, aux, p, nq, out_row):
     v0 = nq
     out_row[L.C_MOTOR_ANGLE] = y[L.Q_THM]
@@ -750,7 +768,7 @@ def _record(y, dy, aux, p, nq, out_row):
     out_row[L.C_LOAD_FORCE] = aux[L.A_LOAD_FORCE]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _clamp_one(y, j, cap, k, e0):
     # A stuck contact cannot hold more than its Coulomb limit: when the normal load drops, the
     # elastic tangential displacement resets to the limit and its released energy is dissipated.
@@ -764,7 +782,7 @@ def _clamp_one(y, j, cap, k, e0):
         y[e0 + L.X_W_FRIC] += released
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def _clamp_traction(y, p, rollers, nq, aux):
     # Both traction states of every roller: screw side (stiffness P_K_TAN), nut side (R_K_TAN_N).
     n = rollers.shape[0]
@@ -777,7 +795,7 @@ def _clamp_traction(y, p, rollers, nq, aux):
         )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", fastmath=FAST)
 def _hold_prescribed(y, t, p, motion, nq):
     # The prescribed angle is not integrated: set it (and the rigidly coupled screw) exactly.
     # The knots are the screw's: through a reduction the motor turns N times as far.
@@ -793,7 +811,7 @@ def _hold_prescribed(y, t, p, motion, nq):
         y[nq + L.Q_THS] = w
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=FAST)
 def integrate(
     y,
     t0,

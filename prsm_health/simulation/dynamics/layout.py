@@ -100,7 +100,8 @@ N_PARAMS = 90
 DRIVE_PRESCRIBED, DRIVE_SPEED_LOOP, DRIVE_POSITION_LOOP = 0, 1, 2
 
 # ----------------------------------------------------------------- geometric error tables
-# One row per kind: column 0 the period P [rad] of the error profile, columns 1…N its values
+# One row per kind: column 0 the reciprocal 1/P of the error profile's period P [rad] (the
+# kernel multiplies: a division per lookup was a measurable share of a step), columns 1…N its values
 # [m] at u = P·k/N, interpolated linearly (the kernel's slope is that of the interpolant, so
 # forces and energy stay consistent). The contact coordinate u of each kind:
 #   screw axial / radial: u = θ_rev + ψ_i − θ_s (where roller i touches the screw surface),
@@ -119,7 +120,8 @@ ERR_SCREW_SPALL, ERR_NUT_SPALL, ERR_ROLLER_SPALL = 5, 6, 7
 # teeth), the latter only for the roller that carries the damage (R_TOOTH).
 ERR_RING_TOOTH, ERR_ROLLER_TOOTH = 8, 9
 # Coulomb coefficient of the screw–roller contacts vs entrainment speed [m/s], not periodic:
-# column 0 holds the highest tabulated speed, beyond which the last value holds.
+# column 0 holds the reciprocal of the highest tabulated speed, beyond which the last value
+# holds.
 ERR_COULOMB = 10
 N_ERROR_KINDS = 11
 N_ERROR_POINTS = 16384

@@ -60,6 +60,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -250,7 +251,7 @@ def _thread_laws(
     design: PRSMDesign, roller_load: float, law: str
 ) -> tuple[list[float], list[float]]:
     """Per roller side: the law coefficient for the kernel and the tangent stiffness [N/m]."""
-    from prsm_health.physics.stiffness.thread_load import roller_side_force, roller_side_stiffness
+    from prsm_health.physics.stiffness.thread_load import roller_side_stiffness
 
     coefficients, tangents = [], []
     for side in ("screw", "nut"):
@@ -261,17 +262,26 @@ def _thread_laws(
         else:
             # Least-squares c of F = c·δ^1.5 over 0.1…3 × the operating load (log-spaced).
             loads = np.geomspace(0.1, 3.0, 25) * roller_load
-            deflections = _deflection_at(design, side, loads, roller_side_force)
+            deflections = np.interp(loads, _force_curve(design, side), _DEFLECTION_GRID)
             basis = deflections**1.5
             coefficients.append(float(np.dot(basis, loads) / np.dot(basis, basis)))
     return coefficients, tangents
 
 
-def _deflection_at(design, side, loads, force_fn) -> np.ndarray:
-    # Invert the monotone force–deflection curve of one roller side by interpolation.
-    grid = np.geomspace(1e-10, 1e-3, 400)
-    forces = np.asarray(force_fn(design, grid, side), dtype=float)
-    return np.interp(loads, forces, grid)
+#: Deflections [m] at which a roller side's force–deflection curve is tabulated (inverted by
+#: interpolation: the curve is monotone).
+_DEFLECTION_GRID = np.geomspace(1e-10, 1e-3, 400)
+
+
+@lru_cache(maxsize=32)
+def _force_curve(design: PRSMDesign, side: str) -> np.ndarray:
+    """Force [N] of one roller side at :data:`_DEFLECTION_GRID`, per design (a frozen,
+    hashable dataclass): ≈ 45 ms of thread-load solves that every run of a dataset repeated."""
+    from prsm_health.physics.stiffness.thread_load import roller_side_force
+
+    forces = np.asarray(roller_side_force(design, _DEFLECTION_GRID, side), dtype=float)
+    forces.flags.writeable = False  # shared by every caller of the cache
+    return forces
 
 
 def _mesh_table(design: PRSMDesign, threaded_tooth: bool) -> np.ndarray:

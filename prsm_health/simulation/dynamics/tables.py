@@ -68,7 +68,7 @@ def error_terms(design, variation, rng, spalls=()) -> tuple[np.ndarray, float]:
     tables = np.zeros((L.N_ERROR_KINDS, L.N_ERROR_POINTS + 1))
     for kind, rows in terms.items():
         u = np.arange(L.N_ERROR_POINTS) * periods[kind] / L.N_ERROR_POINTS
-        tables[kind, 0] = periods[kind]
+        tables[kind, 0] = 1.0 / periods[kind]  # the kernel multiplies (layout: ERR_*)
         for wave, amplitude, phase in rows:
             tables[kind, 1:] += amplitude * np.sin(wave * u + phase)
     radius = {"screw": r_s, "nut": r_n, "roller": design.roller_diameter / 2}
@@ -101,7 +101,7 @@ def coulomb_table(errors, design, health, profile, options) -> float:
         degradation=health.lubricant_degradation,
         starvation=health.lubricant_starvation,
     )
-    errors[L.ERR_COULOMB, 0] = speeds[-1]
+    errors[L.ERR_COULOMB, 0] = 1.0 / speeds[-1]
     errors[L.ERR_COULOMB, 1:] = curve.coefficient
     return 1.0
 
@@ -182,7 +182,7 @@ def tooth_tables(errors, rollers, design, health, options) -> float:
         mesh = damaged_mesh(design, fault, fault.location, threaded_tooth=options.threaded_tooth)
         phase = (np.arange(L.N_ERROR_POINTS) * z / L.N_ERROR_POINTS - fault.tooth) % z
         grid = np.arange(mesh.ratio.size) / (mesh.ratio.size / mesh.cycles)
-        errors[row, 0] = z
+        errors[row, 0] = 1.0 / z
         errors[row, 1:] += np.interp(phase, grid, mesh.ratio - 1.0, right=0.0)
         if fault.location == "roller_gear":
             require(
