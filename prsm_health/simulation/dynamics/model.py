@@ -66,6 +66,7 @@ import numpy as np
 
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.drive_train import DriveTrain
+from prsm_health.actuator.faults import FATIGUE
 from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
 from prsm_health.core.errors import require, require_positive, require_range
 from prsm_health.physics.friction import FrictionParameters
@@ -407,6 +408,7 @@ def build_model(
     rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
     rollers = _roller_params(design, health, options.variation, orbit, rng)
     _rolling_params(rollers, design, options, rng, roller_load, tangents)
+    _place_fatigue_spall(rollers, health, p, operating, rng)
     errors, p[L.P_LEAD_SLOPE] = error_terms(design, options.variation, rng, health.spalls)
     p[L.P_HAS_SPALLS] = spall_params(p, design, health, profile, options)
     p[L.P_STRIBECK] = coulomb_table(errors, design, health, profile, options)
@@ -522,7 +524,7 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     r[:, L.R_RUNOUT] = variation.roller_runout * runout
     r[:, L.R_RUNOUT_PHASE] = runout_phase
     for spall in health.spalls:
-        if spall.location == "roller":
+        if spall.location == "roller" and spall.roller != FATIGUE:
             require(
                 spall.roller < n,
                 "faults.roller",
@@ -566,6 +568,37 @@ def _rolling_params(rollers, design, options, rng, roller_load, tangents) -> Non
     rollers[:, L.R_RELAX_S] = 1.0 / l_screw
     rollers[:, L.R_RELAX_N] = 1.0 / l_nut
     rollers[:, L.R_MISMATCH] = eps
+
+
+def static_roller_loads(rollers: np.ndarray, p: np.ndarray, load: float) -> np.ndarray:
+    """Each roller's axial load [N] when together they carry ``load`` [N] on the flanks a
+    positive load presses, statically: roller i's two thread contacts close in series once the
+    common axial approach u exceeds its gap b_s + b_n − (e_s + e_n) (its half-clearances less
+    its pitch errors, as the kernel's closures have them), each with the kernel's law
+    (P_K_THREAD_*, P_EXPONENT); u by bisection. On eight fresh units the shares agree with the
+    dynamic runs' mean contact loads within 0.03 (docs/faults.md, roller spalls)."""
+    gap = rollers[:, L.R_B_S] + rollers[:, L.R_B_N] - (rollers[:, L.R_E_S] + rollers[:, L.R_E_N])
+    exponent = p[L.P_EXPONENT]  # F = k·δ^e per contact: in series δ = Σ (F/k)^(1/e)
+    compliance = p[L.P_K_THREAD_S] ** (-1.0 / exponent) + p[L.P_K_THREAD_N] ** (-1.0 / exponent)
+    lo, hi = float(gap.min()), float(gap.max()) + 1e-3
+    for _ in range(100):  # to the float resolution of u
+        mid = 0.5 * (lo + hi)
+        total = np.sum((np.maximum(mid - gap, 0.0) / compliance) ** exponent)
+        lo, hi = (lo, mid) if total > load else (mid, hi)
+    return (np.maximum(0.5 * (lo + hi) - gap, 0.0) / compliance) ** exponent
+
+
+def _place_fatigue_spall(rollers, health, p, load: float, rng) -> None:
+    """Put a roller spall whose roller is ``"fatigue"`` on a roller drawn with probability ∝
+    its static load cubed (faults.Spall: fatigue life ∝ (C/P)³ for point contacts), from a
+    stream jumped off the variation stream (its other draws unchanged for a seed)."""
+    if not any(s.location == "roller" and s.roller == FATIGUE for s in health.spalls):
+        return
+    weight = static_roller_loads(rollers, p, load) ** 3
+    if not np.any(weight > 0.0):
+        weight = np.ones(len(rollers))
+    stream = np.random.Generator(rng.bit_generator.jumped(2))
+    rollers[stream.choice(len(rollers), p=weight / weight.sum()), L.R_SPALL] = 1.0
 
 
 def realised_clearances(model: Model) -> dict[str, float]:
