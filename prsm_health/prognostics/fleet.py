@@ -120,3 +120,49 @@ def _fingerprints(dataset, chosen: pd.DataFrame):
         return chosen["design_fingerprint"].to_numpy()
     design = dataset.design
     return None if design is None else design_fingerprint(design)
+
+
+#: z of a two-sided 90 % interval: a simulated diagnosis' interval half-width per σ.
+Z90 = 1.645
+
+
+def simulated_histories(
+    lives, snapshots: int, noise: float, rng, *, min_half_width: float = 0.0
+) -> pd.DataFrame:
+    """Histories of life-model units observed without the dynamics: each unit's true mean
+    clearance at ``snapshots`` ages (``UnitLife.snapshot_ages``) plus a Gaussian diagnosis
+    error of ``noise`` [m] drawn from ``rng`` unit after unit, its 90 % interval
+    ±max(1.645·noise, ``min_half_width``); with the truth and duty columns of the snapshots'
+    labels. What limits a RUL, seen apart from the diagnosis (sensitivity tables, studies).
+
+    Parameters
+    ----------
+    lives : sequence of :class:`~prsm_health.physics.life.UnitLife`
+    snapshots : int
+    noise : float [m]
+    rng : numpy.random.Generator
+    min_half_width : float [m]
+        Narrowest interval half-width (a noise-free history still gets an interval).
+    """
+    frames = []
+    half = max(Z90 * noise, min_half_width)
+    for unit in lives:
+        ages = unit.snapshot_ages(snapshots)
+        true = unit.clearance(ages)
+        value = true + rng.normal(0.0, noise, len(ages))
+        labels = [unit.labels(age) for age in ages]
+        frames.append(
+            pd.DataFrame(
+                {
+                    "unit_id": unit.unit_id,
+                    "age_hours": ages,
+                    "clearance": value,
+                    "clearance_lower": value - half,
+                    "clearance_upper": value + half,
+                    "clearance_mean_true": true,
+                    "failure_age_hours": unit.failure_age,
+                    **{c: [label[c] for label in labels] for c in DUTY_COLUMNS},
+                }
+            )
+        )
+    return pd.concat(frames, ignore_index=True)

@@ -17,6 +17,7 @@ pytest.importorskip("progpy")
 
 from prsm_health.prognostics.ageing_model import LOAD_FACTORS, PRSMAgeing, rate_tables  # noqa: E402
 from prsm_health.prognostics.ageing_rul import AgeingRUL  # noqa: E402
+from prsm_health.prognostics.fleet import simulated_histories  # noqa: E402
 
 DESIGN = preset("paper01")
 #: A fleet without unit-to-unit scatter or usage wandering: every unit is the duty's own.
@@ -117,26 +118,8 @@ def synthetic_fleet():
     clearance at 12 ages plus a Gaussian diagnosis error of 1 µm (interval ±1.645 µm)."""
     spec = replace(LifeSpec(), units=10)
     lives = fleet_lives(DESIGN, spec, 3)
-    rng = np.random.default_rng(4)
-    frames = []
-    for u in lives:
-        ages = u.snapshot_ages(12)
-        true = u.clearance(ages)
-        value = true + rng.normal(0.0, 1e-6, len(ages))
-        frames.append(
-            pd.DataFrame(
-                {
-                    "unit_id": u.unit_id,
-                    "age_hours": ages,
-                    "clearance": value,
-                    "clearance_lower": value - 1.645e-6,
-                    "clearance_upper": value + 1.645e-6,
-                    "clearance_mean_true": true,
-                    "failure_age_hours": u.failure_age,
-                }
-            )
-        )
-    return spec, lives, pd.concat(frames, ignore_index=True)
+    histories = simulated_histories(lives, 12, 1e-6, np.random.default_rng(4))
+    return spec, lives, histories
 
 
 def test_the_filter_learns_the_prior_and_predicts_held_out_units(synthetic_fleet):

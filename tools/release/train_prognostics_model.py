@@ -34,11 +34,13 @@ import pandas as pd
 from prsm_health.datasets import Dataset, generate, load_recipe
 from prsm_health.prognostics import (
     DEFAULT_PROGNOSTICS_MODEL,
+    HISTORY_COLUMNS,
     RULModel,
     fit_prognostics_model,
     fleet_histories,
     load_prognostics_model,
     save_prognostics_model,
+    simulated_histories,
 )
 from prsm_health.prognostics.metrics import evaluate_units
 
@@ -130,23 +132,8 @@ def sensitivity_table(recipe) -> list[str]:
         cells = []
         for noise in NOISE_LEVELS:
             rng = np.random.default_rng([recipe.seed, int(noise * 1e9)])
-            frames = []
-            for unit in lives:
-                ages = unit.snapshot_ages(spec.snapshots)
-                value = unit.clearance(ages) + rng.normal(0.0, noise, len(ages))
-                half = max(1.645 * noise, 0.2e-6)
-                frames.append(
-                    pd.DataFrame(
-                        {
-                            "unit_id": unit.unit_id,
-                            "age_hours": ages,
-                            "clearance": value,
-                            "clearance_lower": value - half,
-                            "clearance_upper": value + half,
-                        }
-                    )
-                )
-            table = pd.concat(frames, ignore_index=True)
+            table = simulated_histories(lives, spec.snapshots, noise, rng, min_half_width=0.2e-6)
+            table = table[["unit_id", *HISTORY_COLUMNS]]
             train, test = table[table["unit_id"] < 40], table[table["unit_id"] >= 40]
             model = RULModel(threshold=spec.failure_clearance, design=recipe.design)
             model.fit(train, {u: failure[u] for u in range(40)})

@@ -26,37 +26,12 @@ import pandas as pd
 from prsm_health.actuator.design import preset
 from prsm_health.datasets import load_recipe
 from prsm_health.physics.life import fleet_lives, unit_life
-from prsm_health.prognostics import HISTORY_COLUMNS, RULModel
+from prsm_health.prognostics import HISTORY_COLUMNS, RULModel, simulated_histories
 from prsm_health.prognostics.ageing_model import rate_tables
 from prsm_health.prognostics.ageing_rul import AgeingRUL
 
 ALPHA = 0.2
 SNAPSHOTS = 30
-
-
-def histories(lives, noise: float, rng) -> pd.DataFrame:
-    frames = []
-    for unit in lives:
-        ages = unit.snapshot_ages(SNAPSHOTS)
-        true = unit.clearance(ages)
-        value = true + rng.normal(0.0, noise, len(ages))
-        labels = [unit.labels(a) for a in ages]
-        frames.append(
-            pd.DataFrame(
-                {
-                    "unit_id": unit.unit_id,
-                    "age_hours": ages,
-                    "clearance": value,
-                    "clearance_lower": value - 1.645 * noise,
-                    "clearance_upper": value + 1.645 * noise,
-                    "clearance_mean_true": true,
-                    "failure_age_hours": unit.failure_age,
-                    "duty_hours": [x["duty_hours"] for x in labels],
-                    "duty_load": [x["duty_load"] for x in labels],
-                }
-            )
-        )
-    return pd.concat(frames, ignore_index=True)
 
 
 def main(argv=None) -> None:
@@ -68,7 +43,9 @@ def main(argv=None) -> None:
     recipe = load_recipe("datasets/fleet.toml")
     design = preset(recipe.design)
     spec = replace(recipe.life_spec, units=14)
-    train = histories(fleet_lives(design, spec, args.seed), args.noise, np.random.default_rng(1))
+    train = simulated_histories(
+        fleet_lives(design, spec, args.seed), SNAPSHOTS, args.noise, np.random.default_rng(1)
+    )
     failure = train.groupby("unit_id")["failure_age_hours"].first().to_dict()
     model = RULModel(threshold=spec.failure_clearance).fit(
         train[["unit_id", *HISTORY_COLUMNS]], failure
@@ -80,7 +57,7 @@ def main(argv=None) -> None:
     for unit in plain:
         duty = replace(spec.duty, change_age=0.4 * unit.failure_age, change_load=2.0)
         changed.append(unit_life(design, replace(spec, duty=duty), unit.unit_id, args.seed + 1))
-    test = histories(changed, args.noise, np.random.default_rng(2))
+    test = simulated_histories(changed, SNAPSHOTS, args.noise, np.random.default_rng(2))
     rows = []
     for unit in changed:
         h = test[test["unit_id"] == unit.unit_id].reset_index(drop=True)
