@@ -14,7 +14,8 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import pytest  # noqa: E402
 
-from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate
+from prsm_health import HealthState, OperatingProfile, SimulationOptions, simulate  # noqa: E402
+from prsm_health.actuator.health_check import CheckPhase, HealthCheck  # noqa: E402
 
 #: The regime in which the clearance is observable (docs/validation.md): a ±300 N load
 #: reversing at 10 Hz with 2 ms edges around a zero mean, Hertzian thread flanks.
@@ -47,5 +48,47 @@ def reversing_run():
         return _reversing_run(
             clearance, duration, seed, speed, sample_rate, tuple(sorted(profile.items()))
         )
+
+    return make
+
+
+# A short check with every role (1.0 s instead of the built-in 2.07 s, to keep the test cheap):
+# the built-in's conditions, shorter settled parts.
+SHORT_CHECK = HealthCheck(
+    "short-check",
+    (
+        CheckPhase("quiet", "constant", speed=50.0, load=0.0, duration=0.1, ramp_time=0.02),
+        CheckPhase("slow", "constant", speed=-10.0, load="10 % C_a", duration=0.1, ramp_time=0.02),
+        CheckPhase("fast", "constant", speed=100.0, load="10 % C_a", duration=0.06, ramp_time=0.02),
+        CheckPhase(
+            "swing",
+            "reversing",
+            speed=10.0,
+            load="25 % C_a",
+            duration=0.25,
+            ramp_time=0.02,
+            reversal_period=0.125,
+        ),
+        CheckPhase(
+            "heavy", "constant", speed=-100.0, load="-25 % C_a", duration=0.3, ramp_time=0.02
+        ),
+    ),
+)
+
+
+@functools.lru_cache(maxsize=8)
+def _short_check_run(clearance, seed):
+    health = None if clearance is None else HealthState.uniform(clearance)
+    return simulate("paper01", health, OperatingProfile(check=SHORT_CHECK), "flight-ema", seed)
+
+
+@pytest.fixture(scope="session")
+def short_check_run():
+    """Factory ``short_check_run(clearance=None, seed=4)`` → a recording of :data:`SHORT_CHECK`
+    (flight-ema sensors; None: the default health state). Cached for the session: do not
+    modify the runs."""
+
+    def make(clearance=None, seed=4):
+        return _short_check_run(clearance, seed)
 
     return make

@@ -7,37 +7,12 @@ training is measured by tools/release/train_check_model.py, not here)."""
 import numpy as np
 import pytest
 
-from prsm_health.actuator.health_check import CheckPhase, HealthCheck
-from prsm_health.actuator.states import OperatingProfile
 from prsm_health.core.run import Run
 from prsm_health.diagnostics.baseline import Baseline
 from prsm_health.diagnostics.contract import AMBIGUOUS, CANNOT_TELL, NOT_OBSERVABLE
 from prsm_health.diagnostics.diagnosis import ModelBundle, diagnose
 from prsm_health.signals.check_indicators import CHECK_INDICATORS
-from prsm_health.simulation.scenario import simulate
 
-# A short check with every role (1.0 s instead of the built-in 2.07 s, to keep the test cheap):
-# the built-in's conditions, shorter settled parts.
-SHORT = HealthCheck(
-    "short-check",
-    (
-        CheckPhase("quiet", "constant", speed=50.0, load=0.0, duration=0.1, ramp_time=0.02),
-        CheckPhase("slow", "constant", speed=-10.0, load="10 % C_a", duration=0.1, ramp_time=0.02),
-        CheckPhase("fast", "constant", speed=100.0, load="10 % C_a", duration=0.06, ramp_time=0.02),
-        CheckPhase(
-            "swing",
-            "reversing",
-            speed=10.0,
-            load="25 % C_a",
-            duration=0.25,
-            ramp_time=0.02,
-            reversal_period=0.125,
-        ),
-        CheckPhase(
-            "heavy", "constant", speed=-100.0, load="-25 % C_a", duration=0.3, ramp_time=0.02
-        ),
-    ),
-)
 NAMES = list(CHECK_INDICATORS)
 
 
@@ -77,8 +52,8 @@ def bundle(alone=(0.8, 0.1, 0.1), against=(0.05, 0.05, 0.9)):
 
 
 @pytest.fixture(scope="module")
-def check_run() -> Run:
-    return simulate("paper01", None, OperatingProfile(check=SHORT), "flight-ema", seed=4)
+def check_run(short_check_run) -> Run:
+    return short_check_run()
 
 
 def without_phase(run: Run, name: str) -> Run:

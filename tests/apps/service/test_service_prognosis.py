@@ -315,6 +315,54 @@ def test_prognosis_of_30_stored_diagnoses_survives_a_restart(
         assert c.get("/v1/assets/press-real/prognosis").json() == real_first
 
 
+@pytest.mark.slow  # three health-check recordings (≈ 3 s each) and two servers
+def test_an_asset_with_check_snapshots_gets_a_rul_that_survives_a_restart(
+    bundle, model_file, short_check_run, tmp_path
+):
+    # one unit's health checks as it wears, posted as Parquet with their operating hours: each
+    # is read as a check (its phases' roles), its clearance with the check model's interval
+    db = tmp_path / "history.sqlite"
+    checks = {400.0: 6e-6, 800.0: 12e-6, 1200.0: 18e-6}
+
+    def start():
+        return LiveServer(
+            create_app(None, db, bundle=bundle, warmup=False, prognostics_model_path=model_file)
+        )
+
+    with start() as live, live.client() as c:
+        for hours, clearance in checks.items():
+            body = write_run_parquet(
+                short_check_run(clearance, seed=21), tmp_path / "check.parquet"
+            )
+            r = c.post(
+                "/v1/diagnose",
+                content=body.read_bytes(),
+                headers={"content-type": "application/vnd.apache.parquet"},
+                params={"asset_id": "ema-check", "operating_hours": str(hours)},
+            )
+            assert r.status_code == 200, r.text
+            diagnosis = r.json()
+            assert diagnosis["check_phases"], diagnosis  # read as a health check
+            interval = diagnosis["clearance"]
+            assert interval["lower"] < interval["estimate"] < interval["upper"]
+        first = {}
+        for method in ("degradation", "similarity", "physics"):
+            r = c.get("/v1/assets/ema-check/prognosis", params={"method": method})
+            assert r.status_code == 200, r.text
+            answer = r.json()
+            assert answer["health_indicator"]["ages_hours"] == list(checks)
+            rul = answer["rul_hours"]
+            assert rul["lower"] <= rul["estimate"] <= rul["upper"], rul
+            assert answer["model"]["name"].startswith(method), answer["model"]
+            first[method] = answer
+
+    # a new server on the same database file: the same answers, every method
+    with start() as live, live.client() as c:
+        for method, answer in first.items():
+            again = c.get("/v1/assets/ema-check/prognosis", params={"method": method})
+            assert again.json() == answer
+
+
 # ----------------------------------------------------------------------------- errors
 def test_prognosis_errors(app, bundle):
     store = app.state.store
