@@ -355,6 +355,14 @@ def plot_fleet_lives(lives, path: str | Path, *, test_units=(), snapshots: int =
     return _save(fig, Path(path))
 
 
+#: How each RUL method's median is drawn: (marker/line, colour, marker size, line width, label).
+_RUL_STYLES = {
+    "degradation": ("o-", "tab:blue", 2.5, 1, "degradation (90 % interval)"),
+    "similarity": ("s--", "tab:orange", 2, 0.8, "similarity"),
+    "physics": ("^-.", "tab:green", 2, 0.8, "physics (progpy)"),
+}
+
+
 def plot_prognostics(histories, predictions, model, directory, *, alpha: float = 0.2) -> list[Path]:
     """Figures of a prognostics evaluation (tools/release/train_prognostics_model.py): each held-out
     unit's predicted RUL against its true RUL with the α cone, and its diagnosed health
@@ -374,7 +382,6 @@ def plot_prognostics(histories, predictions, model, directory, *, alpha: float =
     for ax, unit in zip(axes.flat, units):
         mine = predictions[predictions["unit_id"] == unit]
         deg = mine[mine["method"] == "degradation"]
-        sim = mine[mine["method"] == "similarity"]
         ax.plot(deg["age_hours"], deg["true_rul"], "k-", lw=1, label="true RUL")
         ax.fill_between(
             deg["age_hours"],
@@ -386,35 +393,13 @@ def plot_prognostics(histories, predictions, model, directory, *, alpha: float =
         ax.fill_between(
             deg["age_hours"], deg["lower"], deg["upper"], color="tab:blue", alpha=0.25, lw=0
         )
-        ax.plot(
-            deg["age_hours"],
-            deg["estimate"],
-            "o-",
-            color="tab:blue",
-            ms=2.5,
-            lw=1,
-            label="degradation (90 % interval)",
-        )
-        ax.plot(
-            sim["age_hours"],
-            sim["estimate"],
-            "s--",
-            color="tab:orange",
-            ms=2,
-            lw=0.8,
-            label="similarity",
-        )
-        phys = mine[mine["method"] == "physics"]
-        if not phys.empty:  # models fitted on a fleet dataset
-            ax.plot(
-                phys["age_hours"],
-                phys["estimate"],
-                "^-.",
-                color="tab:green",
-                ms=2,
-                lw=0.8,
-                label="physics (progpy)",
-            )
+        for method, (style, color, ms, lw, label) in _RUL_STYLES.items():
+            part = mine[mine["method"] == method]
+            if not part.empty:  # physics: models fitted on a fleet dataset only
+                ax.plot(
+                    part["age_hours"], part["estimate"], style, color=color, ms=ms, lw=lw,
+                    label=label,
+                )  # fmt: skip
         life = float(deg["age_hours"].max() + deg["true_rul"].min())
         ax.axvline(0.5 * life, color="0.5", ls=":", lw=0.8)
         ax.set_title(f"unit {unit} (life {life:.0f} h)", fontsize=9)

@@ -96,6 +96,11 @@ def rate_tables(design, spec: LifeSpec, ratings: dict | None = None) -> dict:
     }
 
 
+def _mean_clearance(x):
+    """The mean half-clearance (b_screw + b_nut)/2 [m]: what fails and what is measured."""
+    return 0.5 * (x["b_screw"] + x["b_nut"])
+
+
 def ageing_process_noise(model, x, dt=1.0):
     """The model's process noise (progpy's callable ``process_noise``): the usage's exact
     Ornstein–Uhlenbeck transition, and the parameters' random walk of ``parameter_drift``
@@ -214,7 +219,7 @@ class PRSMAgeing(PrognosticsModel):
         crossing is timed (to the 1 h of the last step; ≈ 20 steps to a limit 2 000 h away:
         progpy's Monte Carlo steps each sample in Python)."""
         p = self.parameters
-        mean = 0.5 * (x["b_screw"] + x["b_nut"])
+        mean = _mean_clearance(x)
         screw, nut = self._rates(1.0, x["degradation"])
         rate = 0.5 * (screw + nut) * np.exp(x["log_wear"])
         with np.errstate(divide="ignore"):
@@ -223,15 +228,15 @@ class PRSMAgeing(PrognosticsModel):
 
     def output(self, x):
         p = self.parameters
-        mean = 0.5 * (x["b_screw"] + x["b_nut"])
+        mean = _mean_clearance(x)
         return self.OutputContainer(np.atleast_2d(p["bias"] + p["gain"] * mean))
 
     def event_state(self, x):
         p = self.parameters
-        mean = 0.5 * (x["b_screw"] + x["b_nut"])
+        mean = _mean_clearance(x)
         span = p["failure_clearance"] - p["reference_clearance"]
         return {"wear": np.clip((p["failure_clearance"] - mean) / span, 0.0, 1.0)}
 
     def threshold_met(self, x):
-        mean = 0.5 * (x["b_screw"] + x["b_nut"])
+        mean = _mean_clearance(x)
         return {"wear": mean >= self.parameters["failure_clearance"]}

@@ -237,8 +237,10 @@ class AgeingRUL:
 
     @staticmethod
     def _posterior_summary(filt) -> dict:
+        from .ageing_model import _mean_clearance
+
         p = filt.particles
-        mean = 0.5 * (np.asarray(p["b_screw"]) + np.asarray(p["b_nut"]))
+        mean = _mean_clearance({k: np.asarray(p[k]) for k in ("b_screw", "b_nut")})
         return {
             "clearance_mean_m": float(np.mean(mean)),
             "log_wear": [float(np.mean(p["log_wear"])), float(np.std(p["log_wear"]))],

@@ -59,6 +59,8 @@ ENERGY_TOLERANCE = 0.01
 MODE_TOLERANCE = 0.005
 #: A third-octave band is judged when it holds at least this share of its channel's power.
 BAND_SHARE = 1e-4
+#: Third-octave centre frequencies [Hz], IEC 61260 base-10 (10^(n/10)): 25 Hz … 7.94 kHz.
+THIRD_OCTAVES = 10.0 ** (np.arange(14, 40) / 10.0)
 #: The truth signals whose band power is compared: the true values of the measured vibration
 #: and drive torque.
 BAND_CHANNELS = ("nut_axial_accel", "motor_torque")
@@ -90,17 +92,16 @@ def _scenario(case: Case, options: dict):
     )
 
 
-def _third_octaves(x: np.ndarray, sample_rate: float) -> tuple[np.ndarray, np.ndarray]:
-    """(centre frequencies [Hz], band powers) of third-octave bands from 25 Hz to 8 kHz (IEC
-    61260 base-10 centres 10^(n/10)), from a Welch PSD of the linearly detrended signal."""
+def _third_octaves(x: np.ndarray, sample_rate: float) -> np.ndarray:
+    """Band powers of the third-octave bands :data:`THIRD_OCTAVES`,
+    from a Welch PSD of the linearly detrended signal."""
     from scipy import signal
 
     f, psd = signal.welch(signal.detrend(x), sample_rate, nperseg=min(len(x), 4096))
     df = f[1] - f[0]
-    centres = 10.0 ** (np.arange(14, 40) / 10.0)  # 25 Hz … 7.94 kHz
-    lo, hi = centres * 10.0**-0.05, centres * 10.0**0.05
+    lo, hi = THIRD_OCTAVES * 10.0**-0.05, THIRD_OCTAVES * 10.0**0.05
     power = np.array([psd[(f >= a) & (f < b)].sum() * df for a, b in zip(lo, hi)])
-    return centres, power
+    return power
 
 
 def _line(x: np.ndarray, sample_rate: float, expected: float, envelope: bool) -> float:
@@ -125,7 +126,7 @@ def measure(case: Case, options: dict) -> dict:
     design, rate = scenario.design, run.sample_rate
     speed = float(scenario.profile.speed)
     accel = run.truth["nut_axial_accel"]
-    bands = {ch: _third_octaves(run.truth[ch], rate)[1] for ch in BAND_CHANNELS}
+    bands = {ch: _third_octaves(run.truth[ch], rate) for ch in BAND_CHANNELS}
     lines = {
         "gear mesh": _line(accel, rate, characteristic_frequencies(design, speed).gear_mesh, False),
         "nut spall (envelope)": _line(
@@ -201,13 +202,12 @@ def _row(criterion, deviations: dict, tolerance) -> dict:
 
 
 def _compare(candidate: list[dict], reference: list[dict]) -> list[dict]:
-    centres = 10.0 ** (np.arange(14, 40) / 10.0)
     band_dev = {}
     for ch in BAND_CHANNELS:
         cand = np.mean([r["bands"][ch] for r in candidate], axis=0)
         ref = np.mean([r["bands"][ch] for r in reference], axis=0)
         judged = ref >= BAND_SHARE * ref.sum()
-        for fc, c, r, use in zip(centres, cand, ref, judged):
+        for fc, c, r, use in zip(THIRD_OCTAVES, cand, ref, judged):
             if use and fc < 8000.0:
                 tol = BAND_TOLERANCE[0] if fc < 3000.0 else BAND_TOLERANCE[1]
                 band_dev[f"{ch} {fc:.0f} Hz"] = (abs(c - r) / r, tol)
