@@ -16,10 +16,10 @@ import pytest
 
 from prsm_health.actuator.design import preset
 from prsm_health.actuator.design_files import design_fingerprint, design_to_toml, same_design
-from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.errors import ParameterError, PRSMHealthError
 from prsm_health.core.run import Run
 from prsm_health.datasets import Dataset, generate, load_recipe
-from prsm_health.prognostics import fit_prognostics_model, prognose
+from prsm_health.prognostics import cross_validate_units, fit_prognostics_model, prognose
 from prsm_health.signals.features import dataset_features, extract_features
 
 BASE = preset("paper01")
@@ -177,3 +177,14 @@ def test_a_prognostics_model_for_a_fleet_of_ones_own_design(tmp_path):
     # a paper01 history is another design
     with pytest.raises(PRSMHealthError, match="another design"):
         prognose(unit.assign(design_fingerprint=design_fingerprint("paper01")), model)
+    # every unit scored by a model that never saw it: one unit per fold here (the physics
+    # method's predictions are the costly part: scored above)
+    predictions, summary = cross_validate_units(
+        fleet, histories, folds=4, methods=("degradation", "similarity"), n_samples=200
+    )
+    assert set(summary) == {"degradation", "similarity"}
+    assert predictions.groupby("unit_id")["fold"].nunique().eq(1).all()
+    assert sorted(predictions["unit_id"].unique()) == sorted(histories["unit_id"].unique())
+    assert all(s["n_units"] == 4 for s in summary.values())
+    with pytest.raises(ParameterError, match="folds"):
+        cross_validate_units(fleet, histories, folds=2)  # 2 training units a fold

@@ -350,7 +350,7 @@ class Recipe:
             "samples" not in self.sweep,
             "sweep.samples",
             self.sweep.get("samples"),
-            "a life recipe has units × snapshots runs; remove samples",
+            "a life recipe has units × snapshots × recordings runs; remove samples",
         )
 
     @cached_property
@@ -501,10 +501,11 @@ class Recipe:
         return specs
 
     def _life_runs(self) -> list[RunSpec]:
-        # Unit-major: unit u's snapshots are runs u·n … u·n + n − 1. The unit as built (its
-        # manufacturing variation and roller wear pattern) is its seed, the same in every
-        # snapshot; each snapshot's sensors draw their own noise (sensor_seed). The test split
-        # holds out whole units.
+        # Unit-major: unit u's recordings are runs u·n … u·n + n − 1 (n = snapshots ×
+        # recordings; the j-th recording at the k-th age is run u·n + k·recordings + j). The
+        # unit as built (its manufacturing variation and roller wear pattern) is its seed, the
+        # same in each of its runs; each run draws its own recording conditions and sensor
+        # noise (sensor_seed). The test split holds out whole units.
         spec = self.life_spec
         test_units = test_set(spec.units, self.test_fraction, self.seed)
         keys = swept_keys(self.sweep)
@@ -512,16 +513,17 @@ class Recipe:
         specs = []
         for unit in self.fleet():
             for k, age in enumerate(unit.snapshot_ages(spec.snapshots)):
-                run_id = unit.unit_id * spec.snapshots + k
-                unit_draw = np.random.default_rng([self.seed, run_id, 0x534E4150]).random(len(keys))
-                point = {
-                    key: float(sweep[key][0] + u * (sweep[key][1] - sweep[key][0]))
-                    for u, key in zip(unit_draw, keys)
-                }
-                point.update(unit_id=unit.unit_id, age_hours=float(age))
-                seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
-                split = "test" if unit.unit_id in test_units else "train"
-                specs.append(RunSpec(self, run_id, point, seed, split))
+                for j in range(spec.recordings):
+                    run_id = (unit.unit_id * spec.snapshots + k) * spec.recordings + j
+                    draw = np.random.default_rng([self.seed, run_id, 0x534E4150]).random(len(keys))
+                    point = {
+                        key: float(sweep[key][0] + u * (sweep[key][1] - sweep[key][0]))
+                        for u, key in zip(draw, keys)
+                    }
+                    point.update(unit_id=unit.unit_id, age_hours=float(age))
+                    seed = int(np.random.SeedSequence([self.seed, run_id]).generate_state(1)[0])
+                    split = "test" if unit.unit_id in test_units else "train"
+                    specs.append(RunSpec(self, run_id, point, seed, split))
         return specs
 
     def _points(self) -> list[dict]:

@@ -269,7 +269,11 @@ class LifeSpec:
     units : int
         Units in the fleet.
     snapshots : int
-        Dynamic recordings per unit, at ages k/snapshots of its life (k = 0 … snapshots − 1).
+        Ages per unit a recording is made at: k/snapshots of its life (k = 0 … snapshots − 1).
+    recordings : int
+        Recordings at each of those ages, each with its own recording conditions and sensor
+        noise (a monitor's several windows of one inspection); their diagnoses are combined
+        into one history row per age (:func:`prsm_health.prognostics.fleet_histories`).
     failure_clearance : float [m]
         The unit fails when its mean thread half-clearance reaches this.
     failure_spall_length : float [m]
@@ -284,6 +288,7 @@ class LifeSpec:
 
     units: int = 20
     snapshots: int = 30
+    recordings: int = 1
     failure_clearance: float = 30e-6
     failure_spall_length: float = 3e-3
     max_age: float = 2e5
@@ -293,13 +298,13 @@ class LifeSpec:
     wear: WearParameters = field(default_factory=WearParameters)
 
     def __post_init__(self):
-        for name in ("units", "snapshots"):
+        for name, most in (("units", 100_000), ("snapshots", 100_000), ("recordings", 100)):
             value = getattr(self, name)
             require(
-                isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= 100_000,
+                isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= most,
                 f"life.{name}",
                 value,
-                "must be an integer in [1, 100000]",
+                f"must be an integer in [1, {most}]",
             )
         require_range("life.failure_clearance", self.failure_clearance, 1e-6, 500e-6, unit="m")
         require_range("life.failure_spall_length", self.failure_spall_length, 1e-4, 10e-3, unit="m")

@@ -11,7 +11,7 @@
 Import from here, not from the modules: their split is this package's business.
 """
 
-from .fitting import FitReport, diagnosed_threshold, fit_prognostics_model
+from .fitting import FitReport, cross_validate_units, diagnosed_threshold, fit_prognostics_model
 from .fleet import fleet_histories, simulated_histories
 from .history import HISTORY_COLUMNS, HistoryError, read_history, validate_history
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
@@ -27,6 +27,7 @@ __all__ = [
     "HistoryError",
     "Prognosis",
     "RULModel",
+    "cross_validate_units",
     "diagnosed_threshold",
     "fit_prognostics_model",
     "fleet_histories",

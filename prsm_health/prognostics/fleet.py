@@ -1,8 +1,10 @@
 """Histories of a whole fleet: a life recipe's snapshots diagnosed in batches, one history row
-per snapshot, with the labels a prognosis is scored against."""
+per age (the diagnoses of its recordings combined), with the labels a prognosis is scored
+against."""
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from prsm_health.actuator.design_files import design_fingerprint
@@ -23,7 +25,8 @@ def fleet_histories(
     batch: int = 32,
 ) -> pd.DataFrame:
     """Diagnose the snapshots of a fleet dataset (a life recipe's) in batches: one history row
-    per snapshot.
+    per age — where the recipe makes several recordings at one age (``[life] recordings``),
+    their diagnoses combined (:func:`combine_recordings`).
 
     Parameters
     ----------
@@ -44,7 +47,8 @@ def fleet_histories(
         ``fault_class``, and the labels a
         prognosis is scored against: ``split``, ``rul_hours``, ``failure_age_hours``,
         ``failure_mode``, ``clearance_mean_true`` — and the duty log (``duty_hours``,
-        ``duty_load``) where the dataset records it; sorted by unit and age.
+        ``duty_load``) where the dataset records it, ``recordings`` (diagnoses combined into
+        the row); sorted by unit and age.
 
     Raises
     ------
@@ -110,7 +114,32 @@ def fleet_histories(
     for column in DUTY_COLUMNS:  # the duty log, in datasets that record it
         if column in chosen.columns:
             out[column] = chosen[column].to_numpy(float)
-    return out.reset_index(drop=True)
+    return combine_recordings(out)
+
+
+def combine_recordings(table: pd.DataFrame) -> pd.DataFrame:
+    """One row per (``unit_id``, ``age_hours``): the diagnoses of n recordings at one age
+    combined — the clearance their mean, each side of the 90 % interval the root mean square
+    of theirs divided by √n (the recordings' errors taken as independent: each has its own
+    recording conditions and sensor noise; the fleet's window errors at successive ages
+    correlate by 0.04, docs/prognostics.md), the fault class the most frequent one; every
+    other column the first row's (the same at one age). Adds ``recordings`` (n)."""
+    keys = ["unit_id", "age_hours"]
+    grouped = table.groupby(keys, sort=True)
+    out = grouped.first()
+    n = grouped.size()
+    value = grouped["clearance"].mean()
+    below = (table["clearance"] - table["clearance_lower"]) ** 2
+    above = (table["clearance_upper"] - table["clearance"]) ** 2
+    sides = pd.DataFrame({"below": below, "above": above, **{k: table[k] for k in keys}})
+    rms = np.sqrt(sides.groupby(keys, sort=True)[["below", "above"]].mean())
+    out["clearance"] = value
+    out["clearance_lower"] = value - rms["below"] / np.sqrt(n)
+    out["clearance_upper"] = value + rms["above"] / np.sqrt(n)
+    if "fault_class" in table.columns:
+        out["fault_class"] = grouped["fault_class"].agg(lambda c: c.value_counts().index[0])
+    out["recordings"] = n
+    return out.reset_index()[[*table.columns, "recordings"]]
 
 
 def _fingerprints(dataset, chosen: pd.DataFrame):

@@ -585,38 +585,43 @@ def evaluate_units(
         if part.empty:
             summary[method] = {"n_predictions": 0, "n_units": 0}
             continue
-        life = part["age_hours"] + part["true_rul"]
-        late = part[part["age_hours"] >= after_fraction * life]
-        entry = {
-            "rmse": rmse(part["true_rul"], part["estimate"]),
-            "coverage": interval_coverage(part["true_rul"], part["lower"], part["upper"]),
-            "n_predictions": len(part),
-            "n_units": int(part["unit_id"].nunique()),
+        summary[method] = {
+            **pooled_scores(part, after_fraction, alpha),
             "prognostic_horizon": float(np.mean(horizons[method])),
             "prognostic_horizon_first": float(np.mean(first_horizons[method])),
             "cra": _mean_finite(cras[method]),
             "monotonicity": _mean_finite(monotonic[method]),
         }
-        if late.empty:
-            entry.update(
-                {"rmse_after": math.nan, "alpha_lambda": math.nan, "coverage_after": math.nan}
-            )
-        else:
-            entry.update(
-                {
-                    "rmse_after": rmse(late["true_rul"], late["estimate"]),
-                    "alpha_lambda": alpha_lambda_accuracy(
-                        late["true_rul"], late["estimate"], alpha
-                    ),
-                    "coverage_after": interval_coverage(
-                        late["true_rul"], late["lower"], late["upper"]
-                    ),
-                }
-            )
-        summary[method] = entry
     if bar is not None:
         bar.close()
     return predictions, summary
+
+
+def pooled_scores(predictions: pd.DataFrame, after_fraction: float = 0.5, alpha: float = 0.2):
+    """The scores over a pool of predictions (one method's, :data:`PREDICTION_COLUMNS`):
+    ``rmse`` and ``coverage`` over all, ``rmse_after``, ``alpha_lambda`` and
+    ``coverage_after`` over those made at ages >= ``after_fraction`` × the unit's life (NaN
+    when there is none), ``n_predictions``, ``n_units``."""
+    life = predictions["age_hours"] + predictions["true_rul"]
+    late = predictions[predictions["age_hours"] >= after_fraction * life]
+    entry = {
+        "rmse": rmse(predictions["true_rul"], predictions["estimate"]),
+        "coverage": interval_coverage(
+            predictions["true_rul"], predictions["lower"], predictions["upper"]
+        ),
+        "n_predictions": len(predictions),
+        "n_units": int(predictions["unit_id"].nunique()),
+        "rmse_after": math.nan,
+        "alpha_lambda": math.nan,
+        "coverage_after": math.nan,
+    }
+    if not late.empty:
+        entry.update(
+            rmse_after=rmse(late["true_rul"], late["estimate"]),
+            alpha_lambda=alpha_lambda_accuracy(late["true_rul"], late["estimate"], alpha),
+            coverage_after=interval_coverage(late["true_rul"], late["lower"], late["upper"]),
+        )
+    return entry
 
 
 def _mean_finite(values) -> float:

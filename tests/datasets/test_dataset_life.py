@@ -51,6 +51,39 @@ def test_runs_are_units_times_snapshots_unit_major(recipe):
     assert recipe.runs() == Recipe.from_dict(copy.deepcopy(LIFE_RECIPE)).runs()  # deterministic
 
 
+def test_recordings_at_each_age_are_runs_of_their_own(recipe):
+    # [life] recordings = 2: each age recorded twice, each recording its own conditions and
+    # sensor noise; recordings = 1 keeps the run ids (and so the draws) of the plain recipe
+    twice = Recipe.from_dict(
+        recipe_with(life={"units": UNITS, "snapshots": SNAPSHOTS, "recordings": 2})
+    )
+    runs = twice.runs()
+    assert len(runs) == UNITS * SNAPSHOTS * 2
+    assert [r.run_id for r in runs] == list(range(UNITS * SNAPSHOTS * 2))
+    plain = recipe.runs()
+    for r in runs:
+        at = plain[r.run_id // 2]  # the plain recipe's run at the same unit and age
+        assert (r.point["unit_id"], r.point["age_hours"]) == (
+            at.point["unit_id"],
+            at.point["age_hours"],
+        )
+    pairs = [(runs[i], runs[i + 1]) for i in range(0, len(runs), 2)]
+    assert all(a.point["speed"] != b.point["speed"] for a, b in pairs)
+    assert all(a.scenario().sensors_seed != b.scenario().sensors_seed for a, b in pairs)
+    one = Recipe.from_dict(
+        recipe_with(life={"units": UNITS, "snapshots": SNAPSHOTS, "recordings": 1})
+    )
+
+    def draws(runs):
+        return [(r.run_id, r.point, r.seed, r.split) for r in runs]
+
+    assert draws(one.runs()) == draws(plain)
+    with pytest.raises(RecipeError, match=r"life\.recordings = 0"):
+        Recipe.from_dict(
+            recipe_with(life={"units": UNITS, "snapshots": SNAPSHOTS, "recordings": 0})
+        )
+
+
 def test_snapshots_of_a_unit_share_its_split_and_build(recipe):
     runs = recipe.runs()
     scenarios = [r.scenario() for r in runs]
