@@ -599,7 +599,7 @@ def evaluate_units(
 
 def pooled_scores(predictions: pd.DataFrame, after_fraction: float = 0.5, alpha: float = 0.2):
     """The scores over a pool of predictions (one method's, :data:`PREDICTION_COLUMNS`):
-    ``rmse`` and ``coverage`` over all, ``rmse_after``, ``alpha_lambda`` and
+    ``rmse``, ``coverage`` and ``alpha_lambda_all`` over all, ``rmse_after``, ``alpha_lambda`` and
     ``coverage_after`` over those made at ages >= ``after_fraction`` × the unit's life (NaN
     when there is none), ``n_predictions``, ``n_units``."""
     life = predictions["age_hours"] + predictions["true_rul"]
@@ -608,6 +608,9 @@ def pooled_scores(predictions: pd.DataFrame, after_fraction: float = 0.5, alpha:
         "rmse": rmse(predictions["true_rul"], predictions["estimate"]),
         "coverage": interval_coverage(
             predictions["true_rul"], predictions["lower"], predictions["upper"]
+        ),
+        "alpha_lambda_all": alpha_lambda_accuracy(
+            predictions["true_rul"], predictions["estimate"], alpha
         ),
         "n_predictions": len(predictions),
         "n_units": int(predictions["unit_id"].nunique()),

@@ -143,6 +143,8 @@ def test_evaluate_units_table_and_summary():
         assert s["rmse"] == pytest.approx(math.sqrt(np.mean(err**2)))
         inside = np.abs(late["estimate"] - late["true_rul"]) <= 0.2 * late["true_rul"]
         assert s["alpha_lambda"] == pytest.approx(inside.mean())
+        anywhere = np.abs(err) <= 0.2 * part["true_rul"]
+        assert s["alpha_lambda_all"] == pytest.approx(anywhere.mean())
         covered = (part["lower"] <= part["true_rul"]) & (part["true_rul"] <= part["upper"])
         assert s["coverage"] == pytest.approx(covered.mean())
         assert 0.0 <= s["prognostic_horizon"] <= max(lives.values())
