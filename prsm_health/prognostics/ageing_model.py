@@ -55,7 +55,14 @@ import math
 import numpy as np
 from progpy import PrognosticsModel
 
-from prsm_health.physics.life import DEGRADATION_GRID, LifeSpec, wear_rates
+from prsm_health.physics.life import (
+    DEGRADATION_GRID,
+    LifeSpec,
+    lubricant_life_at,
+    wear_rates,
+)
+from prsm_health.physics.load_rating import load_ratings
+from prsm_health.physics.wear import PartGeometry
 
 #: Load factors the rate tables are computed at (× the duty's loads).
 LOAD_FACTORS = np.geomspace(0.25, 4.0, 17)
@@ -65,10 +72,6 @@ def rate_tables(design, spec: LifeSpec, ratings: dict | None = None) -> dict:
     """The model's physics parameters for a fleet recipe's ``[life]``: half-clearance growth
     rates [m/h] of the screw and nut engagements at :data:`LOAD_FACTORS` × the duty's loads
     and at every lubricant degradation, the duty's lubricant life at its temperature [h]."""
-    from prsm_health.physics.life import lubricant_life_at
-    from prsm_health.physics.load_rating import load_ratings
-    from prsm_health.physics.wear import PartGeometry
-
     if ratings is None:
         r = load_ratings(design)
         ratings = {"C_a": float(r.dynamic), "C_0a": float(r.static)}
