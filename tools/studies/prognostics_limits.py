@@ -16,6 +16,13 @@ share of predictions after half of life within ±α of the true RUL:
     observed with a white Gaussian error of each ``--noise`` σ and the duty log known (14
     units fitted, 12 scored), and the degradation model beside it: what estimation from a
     noisy indicator costs.
+``ideal``
+    A near-ideal Bayesian estimator in the particle filter's place on the same noisy
+    trajectories: importance sampling over the unit's as-built clearance and its two factors
+    (``--draws`` prior draws, the filter's empirical-Bayes prior), each draw propagated without
+    noise under the logged usage and weighted by every diagnosis so far; 200 resampled draws
+    run to the limit under an unknown future usage (the OU process). What the data allow,
+    whatever the estimator.
 ``ukf DIAGNOSES``
     progpy's unscented Kalman filter in the particle filter's place (same model, calibration
     and prior, prediction by progpy's Monte Carlo from 100 draws of its Gaussian posterior) on
@@ -24,6 +31,7 @@ share of predictions after half of life within ±α of the true RUL:
 
     python tools/studies/prognostics_limits.py oracle [--units 12]          # ≈ 2 min
     python tools/studies/prognostics_limits.py noise [--noise 0.8e-6 1.6e-6]   # ≈ 4 min per σ
+    python tools/studies/prognostics_limits.py ideal [--noise 0.1e-6 … 2e-6]   # ≈ 1 min per σ
     python tools/studies/prognostics_limits.py ukf build/fleet-diagnoses.parquet   # ≈ 1 min
 """
 
@@ -58,6 +66,9 @@ def main(argv=None) -> None:
     oracle.add_argument("--units", type=int, default=12)
     noise = sub.add_parser("noise")
     noise.add_argument("--noise", type=float, nargs="+", default=[0.8e-6, 1.6e-6])
+    ideal = sub.add_parser("ideal")
+    ideal.add_argument("--noise", type=float, nargs="+", default=[0.1e-6, 0.3e-6, 0.8e-6, 2e-6])
+    ideal.add_argument("--draws", type=int, default=20000)
     ukf = sub.add_parser("ukf")
     ukf.add_argument("diagnoses")
     args = parser.parse_args(argv)
@@ -69,6 +80,8 @@ def main(argv=None) -> None:
         run_oracle(design, spec, tables, args.units)
     elif args.study == "noise":
         run_noise(design, spec, tables, args.noise)
+    elif args.study == "ideal":
+        run_ideal(design, spec, tables, args.noise, args.draws)
     else:
         run_ukf(spec, tables, pd.read_parquet(args.diagnoses))
 
@@ -175,6 +188,85 @@ def run_noise(design, spec, tables, levels) -> None:
                 f"{m} α–λ {s['alpha_lambda']:.3f} (coverage {s['coverage_after']:.2f})"
                 for m, s in summary.items()
             )
+        )
+
+
+# ------------------------------------------------------------------------------------- ideal
+def _advance(model, x, dt, load, usage_rate):
+    nxt = model.next_state(
+        model.StateContainer(x), model.InputContainer({"load": load, "usage_rate": usage_rate}), dt
+    )
+    return {k: np.ravel(nxt[k]).copy() for k in x}
+
+
+def _ideal_unit(model, unit, history, prior, spec, draws, noise, rng) -> list[bool]:
+    """Within ±α of the true RUL, each prediction after half of the unit's life."""
+    t = history["age_hours"].to_numpy()
+    z = history["clearance"].to_numpy()
+    duty = duty_arrays(history)
+    rates = np.where(np.isfinite(duty["usage_rate"]), duty["usage_rate"], 1.0)
+    loads = duty["load"]
+    sigma, memory = model.parameters["usage_sigma"], model.parameters["usage_time"]
+    b0 = rng.uniform(*spec.scatter.initial_clearance, draws)
+    factors = rng.multivariate_normal(*prior, draws)
+    x = {
+        "b_screw": b0,
+        "b_nut": b0.copy(),
+        "degradation": np.zeros(draws),
+        "usage": np.zeros(draws),
+        "log_wear": factors[:, 0],
+        "log_lubricant_life": factors[:, 1],
+    }
+    log_lik, now, hits = np.zeros(draws), 0.0, []
+    for k in range(len(t)):
+        while now < t[k] - 1e-9:  # the logged usage over the interval before diagnosis k
+            step = min(FILTER_STEP, t[k] - now)
+            x = _advance(model, x, step, float(loads[k]), float(rates[k]))
+            now += step
+        log_lik -= 0.5 * ((z[k] - 0.5 * (x["b_screw"] + x["b_nut"])) / noise) ** 2
+        if not 0.5 * unit.failure_age <= t[k] < unit.failure_age:
+            continue
+        weight = np.exp(log_lik - log_lik.max())
+        pick = rng.choice(draws, 200, p=weight / weight.sum())
+        y = {key: value[pick] for key, value in x.items()}
+        y["usage"] = np.full(200, (math.log(max(rates[k], 1e-9)) + 0.5 * sigma**2) / sigma)
+        age, reached = t[k], np.full(200, math.inf)
+        spread = math.sqrt(1.0 - math.exp(-2.0 * STEP / memory))
+        while np.isinf(reached).any() and age < t[k] + 5 * unit.failure_age:
+            y = _advance(model, y, STEP, float(loads[k]), math.nan)
+            y["usage"] = y["usage"] + spread * rng.standard_normal(200)  # OU: next_state decays it
+            age += STEP
+            hit = (0.5 * (y["b_screw"] + y["b_nut"]) >= spec.failure_clearance) & np.isinf(reached)
+            reached[hit] = age
+        rul = unit.failure_age - t[k]
+        hits.append(abs(np.median(reached) - t[k] - rul) <= ALPHA * rul)
+    return hits
+
+
+def run_ideal(design, spec, tables, levels, draws: int) -> None:
+    model = PRSMAgeing(**tables)
+    test_lives = fleet_lives(design, replace(spec, units=12), 12)
+    for noise in levels:
+        train = simulated_histories(
+            fleet_lives(design, replace(spec, units=14), 11),
+            SNAPSHOTS,
+            noise,
+            np.random.default_rng(1),
+            min_half_width=0.2e-6,
+        )
+        fitted = AgeingRUL.fit(tables, spec, train)
+        test = simulated_histories(
+            test_lives, SNAPSHOTS, noise, np.random.default_rng(2), min_half_width=0.2e-6
+        )
+        rng = np.random.default_rng(0)
+        hits = []
+        for unit in test_lives:
+            history = test[test["unit_id"] == unit.unit_id].sort_values("age_hours")
+            prior = (fitted.prior_mean, fitted.prior_cov)
+            hits += _ideal_unit(model, unit, history, prior, spec, draws, noise, rng)
+        print(
+            f"σ = {noise * 1e6:.2g} µm, near-ideal estimator: α–λ after half of life "
+            f"{np.mean(hits):.3f} ({len(hits)} predictions)"
         )
 
 
