@@ -118,8 +118,9 @@ class AgeingRUL:
             seed=seed,
         )
 
-    def _prior_particles(self, rng, mean, cov) -> dict:
-        n = self.n_particles
+    def _prior_particles(self, rng, mean, cov, n: int | None = None) -> dict:
+        """``n`` (default ``n_particles``) draws of the state from the prior."""
+        n = self.n_particles if n is None else int(n)
         b0 = rng.uniform(*self.initial_clearance, n)
         params = rng.multivariate_normal(mean, cov, n)
         return {

@@ -12,7 +12,7 @@ from prsm_health.core.errors import (
     PRSMHealthError,
 )
 
-from .history import DUTY_COLUMNS
+from .history import DUTY_COLUMNS, Z90
 
 
 def fleet_histories(
@@ -151,17 +151,13 @@ def _fingerprints(dataset, chosen: pd.DataFrame):
     return None if design is None else design_fingerprint(design)
 
 
-#: z of a two-sided 90 % interval: a simulated diagnosis' interval half-width per σ.
-Z90 = 1.645
-
-
 def simulated_histories(
     lives, snapshots: int, noise: float, rng, *, min_half_width: float = 0.0
 ) -> pd.DataFrame:
     """Histories of life-model units observed without the dynamics: each unit's true mean
     clearance at ``snapshots`` ages (``UnitLife.snapshot_ages``) plus a Gaussian diagnosis
     error of ``noise`` [m] drawn from ``rng`` unit after unit, its 90 % interval
-    ±max(1.645·noise, ``min_half_width``); with the truth and duty columns of the snapshots'
+    ±max(Z90·noise, ``min_half_width``) (Z90 = 1.6449, the history's own); with the truth and duty columns of the snapshots'
     labels. What limits a RUL, seen apart from the diagnosis (sensitivity tables, studies).
 
     Parameters

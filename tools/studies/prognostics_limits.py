@@ -87,23 +87,29 @@ def main(argv=None) -> None:
 
 
 # ------------------------------------------------------------------------------------ oracle
-def _time_to_limit(model, unit, state, age, until, known_usage, n=1, seed=0):
-    """Ages [h] at which n copies of ``state`` reach the limit, stepping the model from
-    ``age``; the usage from the unit's duty log (``known_usage``) or the model's OU process."""
-    rng = np.random.default_rng(seed)
-    x = {k: np.full(n, float(v)) for k, v in state.items()}
+def _advance(model, x, dt, load, usage_rate):
+    nxt = model.next_state(
+        model.StateContainer(x), model.InputContainer({"load": load, "usage_rate": usage_rate}), dt
+    )
+    return {k: np.ravel(nxt[k]).copy() for k in x}
+
+
+def _time_to_limit(model, state, age, until, load, rng, n=1, logged=None):
+    """Ages [h] at which n copies of ``state`` (scalars or arrays of n) reach the limit,
+    stepping the model from ``age``; the usage from a unit's duty log (``logged``, a
+    :class:`~prsm_health.physics.life.UnitLife`) or else the model's OU process, its noise
+    drawn from ``rng``."""
+    x = {k: np.broadcast_to(np.asarray(v, dtype=float), n).copy() for k, v in state.items()}
     spread = math.sqrt(1.0 - math.exp(-2.0 * STEP / model.parameters["usage_time"]))
     t, reached = age, np.full(n, math.inf)
     while t < until and np.isinf(reached).any():
-        if known_usage:
-            logged = np.interp([t, t + STEP], unit.ages, unit.duty_hours)
-            rate = float(np.diff(logged)[0]) / STEP
-        else:
-            rate = math.nan
-        u = model.InputContainer({"load": unit.load_scale, "usage_rate": rate})
-        nxt = model.next_state(model.StateContainer(x), u, STEP)
-        x = {k: np.ravel(nxt[k]).copy() for k in x}
-        if not known_usage:
+        rate = math.nan
+        if logged is not None:
+            rate = (
+                float(np.diff(np.interp([t, t + STEP], logged.ages, logged.duty_hours))[0]) / STEP
+            )
+        x = _advance(model, x, STEP, load, rate)
+        if logged is None:
             x["usage"] = x["usage"] + spread * rng.standard_normal(n)  # OU: next_state decays it
         t += STEP
         hit = (
@@ -121,6 +127,7 @@ def run_oracle(design, spec, tables, n_units: int) -> None:
         if unit.failure_mode != "wear":
             continue
         life = math.log(unit.lubricant_life / tables["lubricant_life"])
+        load = unit.load_scale
         start = {
             "b_screw": unit.initial_clearance,
             "b_nut": unit.initial_clearance,
@@ -132,9 +139,8 @@ def run_oracle(design, spec, tables, n_units: int) -> None:
         low, high = math.log(unit.wear_scale) - 0.5, math.log(unit.wear_scale) + 0.5
         for _ in range(25):  # the wear factor whose logged usage fails the unit at its age
             mid = 0.5 * (low + high)
-            end = _time_to_limit(
-                model, unit, {**start, "log_wear": mid}, 0.0, 4 * unit.failure_age, True
-            )
+            state = {**start, "log_wear": mid}
+            end = _time_to_limit(model, state, 0.0, 4 * unit.failure_age, load, None, logged=unit)
             low, high = (mid, high) if end[0] > unit.failure_age else (low, mid)
         wear = 0.5 * (low + high)
         for age in unit.snapshot_ages(SNAPSHOTS):
@@ -152,8 +158,9 @@ def run_oracle(design, spec, tables, n_units: int) -> None:
                 "log_wear": wear,
             }
             until = age + 4 * rul + 500.0
-            known = _time_to_limit(model, unit, state, age, until, True)[0] - age
-            drawn = np.median(_time_to_limit(model, unit, state, age, until, False, 200)) - age
+            known = _time_to_limit(model, state, age, until, load, None, logged=unit)[0] - age
+            rng = np.random.default_rng(0)  # each prediction its own 200 usage futures
+            drawn = np.median(_time_to_limit(model, state, age, until, load, rng, 200)) - age
             within["true future usage"].append(abs(known - rul) <= ALPHA * rul)
             within["future usage unknown"].append(abs(drawn - rul) <= ALPHA * rul)
     for label, hits in within.items():
@@ -192,31 +199,16 @@ def run_noise(design, spec, tables, levels) -> None:
 
 
 # ------------------------------------------------------------------------------------- ideal
-def _advance(model, x, dt, load, usage_rate):
-    nxt = model.next_state(
-        model.StateContainer(x), model.InputContainer({"load": load, "usage_rate": usage_rate}), dt
-    )
-    return {k: np.ravel(nxt[k]).copy() for k in x}
-
-
-def _ideal_unit(model, unit, history, prior, spec, draws, noise, rng) -> list[bool]:
-    """Within ±α of the true RUL, each prediction after half of the unit's life."""
+def _ideal_unit(model, unit, history, fitted, draws, noise, rng) -> list[bool]:
+    """Within ±α of the true RUL, each prediction after half of the unit's life (``fitted``:
+    the particle filter's :class:`AgeingRUL`, whose prior the draws come from)."""
     t = history["age_hours"].to_numpy()
     z = history["clearance"].to_numpy()
     duty = duty_arrays(history)
     rates = np.where(np.isfinite(duty["usage_rate"]), duty["usage_rate"], 1.0)
     loads = duty["load"]
-    sigma, memory = model.parameters["usage_sigma"], model.parameters["usage_time"]
-    b0 = rng.uniform(*spec.scatter.initial_clearance, draws)
-    factors = rng.multivariate_normal(*prior, draws)
-    x = {
-        "b_screw": b0,
-        "b_nut": b0.copy(),
-        "degradation": np.zeros(draws),
-        "usage": np.zeros(draws),
-        "log_wear": factors[:, 0],
-        "log_lubricant_life": factors[:, 1],
-    }
+    sigma = model.parameters["usage_sigma"]
+    x = fitted._prior_particles(rng, fitted.prior_mean, fitted.prior_cov, draws)
     log_lik, now, hits = np.zeros(draws), 0.0, []
     for k in range(len(t)):
         while now < t[k] - 1e-9:  # the logged usage over the interval before diagnosis k
@@ -228,16 +220,10 @@ def _ideal_unit(model, unit, history, prior, spec, draws, noise, rng) -> list[bo
             continue
         weight = np.exp(log_lik - log_lik.max())
         pick = rng.choice(draws, 200, p=weight / weight.sum())
-        y = {key: value[pick] for key, value in x.items()}
-        y["usage"] = np.full(200, (math.log(max(rates[k], 1e-9)) + 0.5 * sigma**2) / sigma)
-        age, reached = t[k], np.full(200, math.inf)
-        spread = math.sqrt(1.0 - math.exp(-2.0 * STEP / memory))
-        while np.isinf(reached).any() and age < t[k] + 5 * unit.failure_age:
-            y = _advance(model, y, STEP, float(loads[k]), math.nan)
-            y["usage"] = y["usage"] + spread * rng.standard_normal(200)  # OU: next_state decays it
-            age += STEP
-            hit = (0.5 * (y["b_screw"] + y["b_nut"]) >= spec.failure_clearance) & np.isinf(reached)
-            reached[hit] = age
+        picked = {key: value[pick] for key, value in x.items()}
+        picked["usage"] = (math.log(max(rates[k], 1e-9)) + 0.5 * sigma**2) / sigma
+        until = t[k] + 5 * unit.failure_age
+        reached = _time_to_limit(model, picked, t[k], until, float(loads[k]), rng, 200)
         rul = unit.failure_age - t[k]
         hits.append(abs(np.median(reached) - t[k] - rul) <= ALPHA * rul)
     return hits
@@ -262,8 +248,7 @@ def run_ideal(design, spec, tables, levels, draws: int) -> None:
         hits = []
         for unit in test_lives:
             history = test[test["unit_id"] == unit.unit_id].sort_values("age_hours")
-            prior = (fitted.prior_mean, fitted.prior_cov)
-            hits += _ideal_unit(model, unit, history, prior, spec, draws, noise, rng)
+            hits += _ideal_unit(model, unit, history, fitted, draws, noise, rng)
         print(
             f"σ = {noise * 1e6:.2g} µm, near-ideal estimator: α–λ after half of life "
             f"{np.mean(hits):.3f} ({len(hits)} predictions)"
