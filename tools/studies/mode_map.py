@@ -1,0 +1,136 @@
+"""Which bodies own which modes of the full model, and what a condensed fidelity must keep (issue
+[5/5] item 2, its groundwork).
+
+    python tools/studies/mode_map.py [--runs 4] [--dampings 0.03 0.1 0.2]
+
+For the first ``--runs`` runs of ``datasets/flight-ema-reference.toml`` (the realistic duty:
+loads of 2–40 % C_a, the drive train) at each contact damping ratio, the model is linearised on
+its loaded flanks (``simulate.linearised_modes``, the eigenvalues that set the RK4 step) and each
+mode is given to the body family that holds most of its kinetic energy (½·m·v² of each
+coordinate's velocity in the eigenvector; a mode with no velocity part is a first-order
+traction relaxation). Prints, per damping, one Markdown row per family: its modes' frequency
+range, how many lie in the measured band (below 10 kHz, the 20 kHz output's Nyquist), and the
+RK4 step the fastest of them allows; then the step the model would allow with the rollers and
+the carrier condensed out (their modes gone, every other mode kept).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections import defaultdict
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from prsm_health.datasets import Recipe, load_recipe
+from prsm_health.simulation.dynamics import layout as L
+from prsm_health.simulation.dynamics.model import build_model
+from prsm_health.simulation.dynamics.simulate import STABILITY_MARGIN, linearised_modes
+
+ROOT = Path(__file__).resolve().parents[2]
+BAND = 10_000.0  # [Hz] the measured band: the 20 kHz output's Nyquist
+RK4_LIMIT = 2.785  # |λ|·h on RK4's stability boundary (negative real axis; 2.83 imaginary)
+CONDENSED = ("roller", "carrier")  # the families a condensed fidelity solves quasi-statically
+
+
+def coordinate_families(model) -> tuple[list[str], np.ndarray]:
+    """The body family and the mass or inertia [kg, kg·m²] of each generalised coordinate."""
+    p, nq = model.params, model.n_coordinates
+    family, mass = [""] * nq, np.zeros(nq)
+    for q, name, m in (
+        (L.Q_XS, "screw lateral", L.P_M_S),
+        (L.Q_YS, "screw lateral", L.P_M_S),
+        (L.Q_THS, "screw torsion", L.P_J_S),
+        (L.Q_ZS, "screw axial", L.P_M_S),
+        (L.Q_XN, "nut lateral", L.P_M_N),
+        (L.Q_YN, "nut lateral", L.P_M_N),
+        (L.Q_THN, "nut rotation", L.P_J_N),
+        (L.Q_ZN, "nut axial", L.P_M_N),
+        (L.Q_XP, "carrier", L.P_M_P),
+        (L.Q_YP, "carrier", L.P_M_P),
+        (L.Q_THP, "carrier", L.P_J_P),
+        (L.Q_THM, "motor", L.P_J_M),
+        (L.Q_ZL, "payload", L.P_M_L),
+    ):
+        family[q], mass[q] = name, p[m]
+    for i in range(model.n_rollers):
+        b = L.Q_ROLLER0 + L.ROLLER_DOF * i
+        for j, (name, m) in enumerate(
+            (("lateral", L.P_M_C), ("lateral", L.P_M_C), ("spin", L.P_J_C), ("axial", L.P_M_C))
+        ):
+            family[b + j], mass[b + j] = f"roller {name}", p[m]
+    return family, mass
+
+
+def mode_table(model) -> list[tuple[float, float, str]]:
+    """(frequency |λ|/2π [Hz], damping ratio, owning family) of each mode, fastest first."""
+    values, vectors, free = linearised_modes(model)
+    family, mass = coordinate_families(model)
+    nq = model.n_coordinates
+    modes = []
+    for k in np.argsort(-np.abs(values)):
+        lam = values[k]
+        if lam.imag < 0.0 or abs(lam) < 1.0:  # one of each conjugate pair; rigid-body motion
+            continue
+        energy = defaultdict(float)
+        for col, j in enumerate(free):
+            if nq <= j < 2 * nq:
+                energy[family[j - nq]] += mass[j - nq] * abs(vectors[col, k]) ** 2
+        owner = max(energy, key=energy.get) if energy else "traction relaxation"
+        modes.append((abs(lam) / (2 * math.pi), -lam.real / abs(lam), owner))
+    return modes
+
+
+def rk4_step(frequency: float) -> float:
+    """The RK4 step [µs] a mode of this |λ|/2π allows, with the kernel's stability margin."""
+    return 1e6 * STABILITY_MARGIN * RK4_LIMIT / (2 * math.pi * frequency)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--runs", type=int, default=4)
+    parser.add_argument("--dampings", type=float, nargs="+", default=[0.03, 0.1, 0.2])
+    args = parser.parse_args()
+    source = load_recipe(ROOT / "datasets" / "flight-ema-reference.toml").source
+    recipe = Recipe.from_dict(dict(source, name="modes", test_fraction=0.0))
+    for damping in args.dampings:
+        by_family, kept = defaultdict(list), []
+        for spec in recipe.runs()[: args.runs]:
+            sc = spec.scenario()  # the recipe draws a damping per run: this study sets it
+            options = replace(sc.options, contact_damping_ratio=damping)
+            model = build_model(sc.design, sc.health, sc.profile, options, sc.seed, sc.drive_train)
+            modes = mode_table(model)
+            for frequency, zeta, owner in modes:
+                by_family[owner].append((frequency, zeta))
+            rest = [f for f, _, owner in modes if not owner.startswith(CONDENSED)]
+            kept.append(max(rest))
+        print(f"\n### contact damping ratio {damping:g} ({args.runs} runs)\n")
+        print(
+            "| family | modes per run | frequency range | in band (< 10 kHz) per run | "
+            "of them oscillatory (ζ < 0.5) | RK4 step of its fastest |"
+        )
+        print("|---|---|---|---|---|---|")
+        for owner, modes in sorted(by_family.items(), key=lambda kv: -max(f for f, _ in kv[1])):
+            freqs, zetas = np.array(modes).T
+            in_band = freqs[freqs < BAND]
+            ringing = freqs[(freqs < BAND) & (zetas < 0.5)]
+            print(
+                f"| {owner} | {len(freqs) / args.runs:.1f} | {freqs.min():.0f}–{freqs.max():.0f} Hz | "
+                f"{len(in_band) / args.runs:.1f}"
+                + (f" ({in_band.min():.0f}–{in_band.max():.0f} Hz)" if len(in_band) else "")
+                + f" | {len(ringing) / args.runs:.1f}"
+                + (f" ({ringing.min():.0f}–{ringing.max():.0f} Hz)" if len(ringing) else "")
+                + f" | {rk4_step(freqs.max()):.2f} µs |"
+            )
+        fastest = max(kept)
+        print(
+            f"\nRollers and carrier condensed out: fastest remaining mode {fastest:.0f} Hz "
+            f"(over the runs), RK4 step ≤ {rk4_step(fastest):.1f} µs."
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
