@@ -318,6 +318,10 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
 
     cos_p = math.cos(th_p)
     sin_p = math.sin(th_p)
+    # Reciprocals once per call: IEEE arithmetic forbids the compiler to turn the loop's
+    # 18 divisions per roller into products (a division costs ≈ 8 products).
+    inv_orbit, inv_sin_b = 1.0 / orbit, 1.0 / sin_b
+    inv_v_axial, inv_w_roll = 1.0 / v_axial, 1.0 / w_roll
 
     torque_screw = 0.0  # contact torque acting on the screw [N·m]
     force_screw_axial = 0.0  # contact force on the screw along z [N]
@@ -346,8 +350,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         rho, tau, rho_dot, tau_dot = _roller_frame(
             xr, yr, vxr, vyr, x_s, y_s, vx_s, vy_s, c, s, w_p
         )
-        th_rev = th_p + tau / orbit
-        w_rev = w_p + tau_dot / orbit
+        th_rev = th_p + tau * inv_orbit
+        w_rev = w_p + tau_dot * inv_orbit
         u = th_rev + psi - th_s
         e_ax, de_ax = _wave(errors, L.ERR_SCREW_AXIAL, u)
         e_rad, de_rad = _wave(errors, L.ERR_SCREW_RADIAL, u)
@@ -404,7 +408,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # along e_t of the roller, from θ_rev (helix, radial error slope, runout, spall slopes)
         g_tan = (
             f_ax * (lead_local - lead_r) - f_rad * de_rad + f_rad * ro_s + f_dh * dh - f_dhr * dh_r
-        ) / orbit
+        ) * inv_orbit
         # Screw–roller traction (_traction: Mindlin stick up to μN, rolling relaxation), plus
         # viscous drag. v_slide = 0 is rolling at the screw's pitch circle and the roller's
         # effective rolling radius r_rs on the screw.
@@ -414,7 +418,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         if stribeck:  # the lubrication regime at this contact's entrainment speed
             u_e = 0.5 * abs(r_s * (w_s - w_rev) - v_roll)
             mu_c = _clamped(errors, L.ERR_COULOMB, u_e) * fscale
-        cap = mu_c * (f_plus + f_minus) / sin_b
+        cap = mu_c * (f_plus + f_minus) * inv_sin_b
         aux[a0 + i] = cap
         f_fric, dy[s0 + i], pf = _traction(
             y[s0 + i], v_slide, cap, k_tan, c_tan, abs(v_roll) * rollers[i, L.R_RELAX_S]
@@ -426,12 +430,12 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # Paper 02's steady losses: Coulomb friction μ2·N against the roller's axial sliding on
         # the screw and the differential-sliding torque μ3·N on the screw, reacted by the
         # roller's revolution.
-        normal = (f_plus + f_minus) / sin_b
+        normal = (f_plus + f_minus) * inv_sin_b
         v_ax_slide = vz_c - vz_s
-        f_axial = -mu_c * normal * _tanh(v_ax_slide / v_axial)
+        f_axial = -mu_c * normal * _tanh(v_ax_slide * inv_v_axial)
         p_fric -= f_axial * v_ax_slide
         w_rel = w_s - w_rev
-        m_diff = mu_r * normal * _tanh(w_rel / w_roll)
+        m_diff = mu_r * normal * _tanh(w_rel * inv_w_roll)
         p_fric += m_diff * w_rel
         friction_torque += r_s * f_fric - f_axial * lead_eff + m_diff
         torque_screw += -f_ax * lead_local + f_rad * de_rad - r_s * f_fric - m_diff - f_dh * dh
@@ -439,7 +443,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         # on the roller: radial push f_rad·e_r, helix reaction, traction (through θ_rev, whose
         # coefficient in v_slide is −(r_s + r_rs)) and the reaction of the differential-sliding
         # torque along e_t
-        tangential = g_tan + f_fric * (r_s + r_rs) / orbit + m_diff / orbit
+        tangential = g_tan + (f_fric * (r_s + r_rs) + m_diff) * inv_orbit
         fx_r = f_rad * c - tangential * s
         fy_r = f_rad * s + tangential * c
         dy[v0 + L.Q_XS] -= fx_r
@@ -453,8 +457,8 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         rho, tau, rho_dot, tau_dot = _roller_frame(
             xr, yr, vxr, vyr, x_n, y_n, vx_n, vy_n, c, s, w_p
         )
-        th_rev = th_p + tau / orbit
-        w_rev = w_p + tau_dot / orbit
+        th_rev = th_p + tau * inv_orbit
+        w_rev = w_p + tau_dot * inv_orbit
         e_ax, de_ax = _wave(errors, L.ERR_NUT_AXIAL, th_rev + psi - th_n)
         lead_local = lead_n + de_ax
         d_ax = (
@@ -502,7 +506,9 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
             engaged += 1.0
         f_ax = f_plus - f_minus  # axial force of the roller on the nut (+z)
         f_rad = (f_plus + f_minus) * cot_b  # pushes roller inward, nut outward
-        g_tan = (-f_ax * (lead_local - lead_r) - f_rad * ro_s + f_dh * dh - f_dhr * dh_r) / orbit
+        g_tan = (
+            -f_ax * (lead_local - lead_r) - f_rad * ro_s + f_dh * dh - f_dhr * dh_r
+        ) * inv_orbit
         # Roller–nut traction, the same law as the screw side's with the nut side's stiffness
         # and normal load: the roller also rolls on the nut, so with its gear in mesh it is
         # over-constrained, and a mismatch ε between the gear ratio and the threads' rolling
@@ -511,7 +517,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         r_rn = rollers[i, L.R_ROLL_N]
         v_roll = r_rn * (w_c - w_rev)
         v_nut = r_n * (w_n - w_rev) - v_roll
-        cap = mu_c * (f_plus + f_minus) / sin_b
+        cap = mu_c * (f_plus + f_minus) * inv_sin_b
         aux[a0 + L.AR_CAP_N * n_rollers + i] = cap
         f_tn, dy[s0 + n_rollers + i], pf = _traction(
             y[s0 + n_rollers + i],
@@ -525,7 +531,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         aux[a0 + L.AR_TRACTION_N * n_rollers + i] = f_tn
         # −∂v_nut/∂q̇ times f_tn: e_t of the roller through θ_rev (coefficient r_rn − r_n),
         # its spin r_rn, the nut's rotation −r_n
-        g_tan += f_tn * (r_n - r_rn) / orbit
+        g_tan += f_tn * (r_n - r_rn) * inv_orbit
         fx_r = -f_rad * c + g_tan * (-s)
         fy_r = -f_rad * s + g_tan * c
         dy[v0 + L.Q_XN] -= fx_r
@@ -727,12 +733,13 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
     dy[v0 + L.Q_THP] /= p[L.P_J_P]
     if not on_payload:  # the payload coordinate follows the nut
         dy[v0 + L.Q_ZL] = dy[v0 + L.Q_ZN]
+    inv_m_c, inv_j_c = 1.0 / m_c, 1.0 / p[L.P_J_C]
     for i in range(n_rollers):
         b = v0 + L.Q_ROLLER0 + L.ROLLER_DOF * i
-        dy[b] /= m_c
-        dy[b + 1] /= m_c
-        dy[b + 2] /= p[L.P_J_C]
-        dy[b + 3] /= m_c
+        dy[b] *= inv_m_c
+        dy[b + 1] *= inv_m_c
+        dy[b + 2] *= inv_j_c
+        dy[b + 3] *= inv_m_c
 
     e0 = 2 * nq
     p_drive = drive * w_m
