@@ -31,7 +31,15 @@ def _run(cache, check=True) -> str:
     return out.stdout.strip().splitlines()[-1]
 
 
+def _runs_haswell_code() -> bool:
+    from llvmlite import binding
+
+    features = binding.get_host_cpu_features()
+    return all(features.get(f, False) for f in ("avx2", "fma", "bmi2", "f16c", "movbe", "lzcnt"))
+
+
 @pytest.mark.slow
+@pytest.mark.skipif(not _runs_haswell_code(), reason="this CPU cannot run Haswell code (x86 AVX2)")
 def test_cached_integrate_with_a_fresh_rhs_runs_the_same_bits(tmp_path):
     cache = tmp_path / "numba"
     compiled_all = _run(cache)  # compiles every kernel and fills the cache
