@@ -188,6 +188,23 @@ def acceptance(
     return rows
 
 
+def markdown_table(rows: list[dict]) -> str:
+    """:func:`acceptance`'s rows as one Markdown table, a row per duty, damping and criterion."""
+    lines = [
+        "| duty | contact damping | criterion | worst deviation | tolerance | where | passed |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        tol = r["tolerance"]
+        tol = tol if isinstance(tol, tuple) else (tol,)
+        lines.append(
+            f"| {r['duty']} | {r['damping']:g} | {r['criterion']} | {100 * r['worst']:.2f} % | "
+            + " / ".join(f"{100 * t:g} %" for t in tol)
+            + f" | {r['detail']} | {'yes' if r['passed'] else '**no**'} |"
+        )
+    return "\n".join(lines)
+
+
 def _row(criterion, deviations: dict, tolerance) -> dict:
     """Row of one criterion: ``deviations`` maps where → (deviation, its tolerance)."""
     if not deviations:

@@ -3,7 +3,7 @@ step passes against the 0.5 µs reference, and a candidate with other physics fa
 
 import pytest
 
-from prsm_health.validation.fidelity import acceptance
+from prsm_health.validation.fidelity import acceptance, markdown_table
 
 pytestmark = pytest.mark.slow  # ≈ 10 s: runs at a 0.5 µs step
 
@@ -33,3 +33,16 @@ def test_a_candidate_with_other_contact_physics_fails():
     rows = _by_criterion(acceptance({"max_step": "auto", "contact_law": "linear"}, **STEADY))
     assert not rows["eigenfrequencies below 5 kHz"]["passed"]
     assert not rows["third-octave band power"]["passed"]
+
+
+def test_markdown_table_has_a_line_per_row_and_marks_failures():
+    rows = [
+        dict(duty="steady", damping=0.03, criterion="lines", worst=0.0012, tolerance=0.001,
+             detail="gear mesh", passed=False),
+        dict(duty="steady", damping=0.1, criterion="bands", worst=0.05, tolerance=(0.1, 0.2),
+             detail="", passed=True),
+    ]  # fmt: skip
+    lines = markdown_table(rows).splitlines()
+    assert len(lines) == 2 + len(rows) and lines[0].startswith("| duty |")
+    assert lines[2] == "| steady | 0.03 | lines | 0.12 % | 0.1 % | gear mesh | **no** |"
+    assert lines[3] == "| steady | 0.1 | bands | 5.00 % | 10 % / 20 % |  | yes |"

@@ -16,7 +16,7 @@ import argparse
 import sys
 import time
 
-from prsm_health.validation.fidelity import DAMPINGS, DUTIES, acceptance
+from prsm_health.validation.fidelity import DAMPINGS, DUTIES, acceptance, markdown_table
 
 
 def _value(text: str):
@@ -51,19 +51,7 @@ def main() -> int:
         f"{args.duration:g} s per case; {time.perf_counter() - t0:.0f} s on {args.workers} "
         "workers\n"
     )
-    print("| duty | contact damping | criterion | worst deviation | tolerance | where | passed |")
-    print("|---|---|---|---|---|---|---|")
-    for r in rows:
-        tol = r["tolerance"]
-        tol = (
-            " / ".join(f"{100 * t:g} %" for t in tol)
-            if isinstance(tol, tuple)
-            else f"{100 * tol:g} %"
-        )
-        print(
-            f"| {r['duty']} | {r['damping']:g} | {r['criterion']} | {100 * r['worst']:.2f} % | "
-            f"{tol} | {r['detail']} | {'yes' if r['passed'] else '**no**'} |"
-        )
+    print(markdown_table(rows))
     return 0 if all(r["passed"] for r in rows) else 1
 
 

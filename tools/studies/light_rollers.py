@@ -68,13 +68,7 @@ def main() -> int:
         f"rollers' mass and inertia × {args.scale:g} against the full model at 0.5 µs; "
         f"{args.seeds} seeds × {args.duration:g} s; {time.perf_counter() - t0:.0f} s\n"
     )
-    print("| duty | criterion | worst deviation | tolerance | where | passed |")
-    print("|---|---|---|---|---|---|")
-    for r in rows:
-        print(
-            f"| {r['duty']} | {r['criterion']} | {100 * r['worst']:.2f} % | "
-            f"{100 * r['tolerance']:.3g} % | {r['detail']} | {'yes' if r['passed'] else '**no**'} |"
-        )
+    print(fidelity.markdown_table(rows))
     return 0 if all(r["passed"] for r in rows) else 1
 
 
