@@ -35,32 +35,38 @@ RK4_LIMIT = 2.785  # |λ|·h on RK4's stability boundary (negative real axis; 2.
 CONDENSED = ("roller", "carrier")  # the families a condensed fidelity solves quasi-statically
 
 
+#: Each body family's coordinates and the parameter holding their mass or inertia (the carrier
+#: twice: its lateral mass, its rotary inertia).
+FAMILIES = (
+    ("screw lateral", (L.Q_XS, L.Q_YS), L.P_M_S),
+    ("screw torsion", (L.Q_THS,), L.P_J_S),
+    ("screw axial", (L.Q_ZS,), L.P_M_S),
+    ("nut lateral", (L.Q_XN, L.Q_YN), L.P_M_N),
+    ("nut rotation", (L.Q_THN,), L.P_J_N),
+    ("nut axial", (L.Q_ZN,), L.P_M_N),
+    ("carrier", (L.Q_XP, L.Q_YP), L.P_M_P),
+    ("carrier", (L.Q_THP,), L.P_J_P),
+    ("motor", (L.Q_THM,), L.P_J_M),
+    ("payload", (L.Q_ZL,), L.P_M_L),
+)
+#: A roller's coordinates (offsets from its first) by family, with their mass or inertia.
+ROLLER_FAMILIES = (
+    ("roller lateral", (0, 1), L.P_M_C),
+    ("roller spin", (2,), L.P_J_C),
+    ("roller axial", (3,), L.P_M_C),
+)
+
+
 def coordinate_families(model) -> tuple[list[str], np.ndarray]:
     """The body family and the mass or inertia [kg, kg·m²] of each generalised coordinate."""
     p, nq = model.params, model.n_coordinates
     family, mass = [""] * nq, np.zeros(nq)
-    for q, name, m in (
-        (L.Q_XS, "screw lateral", L.P_M_S),
-        (L.Q_YS, "screw lateral", L.P_M_S),
-        (L.Q_THS, "screw torsion", L.P_J_S),
-        (L.Q_ZS, "screw axial", L.P_M_S),
-        (L.Q_XN, "nut lateral", L.P_M_N),
-        (L.Q_YN, "nut lateral", L.P_M_N),
-        (L.Q_THN, "nut rotation", L.P_J_N),
-        (L.Q_ZN, "nut axial", L.P_M_N),
-        (L.Q_XP, "carrier", L.P_M_P),
-        (L.Q_YP, "carrier", L.P_M_P),
-        (L.Q_THP, "carrier", L.P_J_P),
-        (L.Q_THM, "motor", L.P_J_M),
-        (L.Q_ZL, "payload", L.P_M_L),
-    ):
-        family[q], mass[q] = name, p[m]
-    for i in range(model.n_rollers):
-        b = L.Q_ROLLER0 + L.ROLLER_DOF * i
-        for j, (name, m) in enumerate(
-            (("lateral", L.P_M_C), ("lateral", L.P_M_C), ("spin", L.P_J_C), ("axial", L.P_M_C))
-        ):
-            family[b + j], mass[b + j] = f"roller {name}", p[m]
+    starts = [L.Q_ROLLER0 + L.ROLLER_DOF * i for i in range(model.n_rollers)]
+    placed = [(FAMILIES, [0])] + [(ROLLER_FAMILIES, starts)]
+    for table, offsets in placed:
+        for name, coordinates, m in table:
+            for q in (o + c for o in offsets for c in coordinates):
+                family[q], mass[q] = name, p[m]
     return family, mass
 
 
