@@ -62,8 +62,7 @@ def coordinate_families(model) -> tuple[list[str], np.ndarray]:
     p, nq = model.params, model.n_coordinates
     family, mass = [""] * nq, np.zeros(nq)
     starts = [L.Q_ROLLER0 + L.ROLLER_DOF * i for i in range(model.n_rollers)]
-    placed = [(FAMILIES, [0])] + [(ROLLER_FAMILIES, starts)]
-    for table, offsets in placed:
+    for table, offsets in ((FAMILIES, [0]), (ROLLER_FAMILIES, starts)):
         for name, coordinates, m in table:
             for q in (o + c for o in offsets for c in coordinates):
                 family[q], mass[q] = name, p[m]
