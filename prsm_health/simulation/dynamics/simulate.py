@@ -45,12 +45,20 @@ def linearised_eigenvalues(model: Model) -> np.ndarray:
 
 def linearised_modes(model: Model) -> tuple[np.ndarray, np.ndarray, list[int]]:
     """Eigenvalues [1/s], eigenvectors (columns) and the state indices they span, of the model
-    linearised on the loaded flanks at the operating load.
+    linearised on the loaded flanks at the operating load (:func:`linearised_jacobian`)."""
+    jac, free = linearised_jacobian(model)
+    values, vectors = np.linalg.eig(jac)
+    return values, vectors, free
+
+
+def linearised_jacobian(model: Model) -> tuple[np.ndarray, list[int]]:
+    """Jacobian ∂(dy/dt)/∂y [1/s] of the model linearised on the loaded flanks at the operating
+    load, over the state indices it spans (returned with it).
 
     Clearances are closed and every roller carries the operating load on one flank of each
     thread and on the gear, so all contact stiffnesses act (at their tangent values for the
-    Hertzian law): the stiffest state a run normally meets. The Jacobian is taken by central
-    differences of the kernel's right-hand side; the prescribed screw angle is not a state.
+    Hertzian law): the stiffest state a run normally meets. Taken by central differences of the
+    kernel's right-hand side; the prescribed screw angle is not a state.
     """
     nq = model.n_coordinates
     rollers = model.rollers.copy()
@@ -95,8 +103,7 @@ def linearised_modes(model: Model) -> tuple[np.ndarray, np.ndarray, list[int]]:
         y[j] -= 2 * scale[j]
         _kernels.rhs(0.0, y, *args, f_minus, aux)
         jac[:, col] = (f_plus[free] - f_minus[free]) / (2 * scale[j])
-    values, vectors = np.linalg.eig(jac)
-    return values, vectors, free
+    return jac, free
 
 
 def max_stable_step(model: Model) -> tuple[float, float]:
