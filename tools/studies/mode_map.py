@@ -11,7 +11,8 @@ coordinate's velocity in the eigenvector; a mode with no velocity part is a firs
 traction relaxation). Prints, per damping, one Markdown row per family: its modes' frequency
 range, how many lie in the measured band (below 10 kHz, the 20 kHz output's Nyquist), and the
 RK4 step the fastest of them allows; then the step the model would allow with the rollers and
-the carrier condensed out (their modes gone, every other mode kept).
+the carrier condensed out (their modes gone, every other mode kept), and run 0's undamped modes
+below 5 kHz, full and statically condensed (with and without the rollers' inertia carried).
 """
 
 from __future__ import annotations
