@@ -76,7 +76,7 @@ class Case:
     duration: float
 
 
-def _scenario(case: Case, options: dict):
+def _scenario(case: Case, options: dict, design="paper01"):
     from prsm_health.actuator.faults import Spall
     from prsm_health.actuator.states import HealthState, OperatingProfile
     from prsm_health.simulation.dynamics.model import SimulationOptions
@@ -84,7 +84,7 @@ def _scenario(case: Case, options: dict):
 
     merged = {"contact_law": "hertz", "contact_damping_ratio": case.damping, **options}
     return Scenario(
-        design="paper01",
+        design=design,
         health=HealthState.uniform(10e-6, faults=(Spall(location="nut"),)),
         profile=OperatingProfile(duration=case.duration, **DUTIES[case.duty]),
         options=SimulationOptions(**merged),
@@ -114,14 +114,15 @@ def _line(x: np.ndarray, sample_rate: float, expected: float, envelope: bool) ->
     return float(f[band][np.argmax(a[band])]) if band.any() else math.nan
 
 
-def measure(case: Case, options: dict) -> dict:
-    """Everything the check compares, for one case simulated with ``options``."""
+def measure(case: Case, options: dict, design="paper01") -> dict:
+    """Everything the check compares, for one case simulated with ``options`` (and ``design``,
+    a name or a PRSMDesign)."""
     from prsm_health.physics.kinematics import characteristic_frequencies, defect_frequencies
     from prsm_health.signals.features import extract_features
     from prsm_health.simulation.dynamics.model import build_model
     from prsm_health.simulation.dynamics.simulate import linearised_eigenvalues
 
-    scenario = _scenario(case, options)
+    scenario = _scenario(case, options, design)
     run = scenario.simulate()
     design, rate = scenario.design, run.sample_rate
     speed = float(scenario.profile.speed)
@@ -151,8 +152,8 @@ def measure(case: Case, options: dict) -> dict:
 
 
 def _measure_both(args) -> tuple[dict, dict]:
-    case, candidate = args
-    return measure(case, candidate), measure(case, {"max_step": REFERENCE_STEP})
+    case, candidate, design = args
+    return measure(case, candidate, design), measure(case, {"max_step": REFERENCE_STEP})
 
 
 def acceptance(
@@ -163,14 +164,16 @@ def acceptance(
     dampings: tuple = DAMPINGS,
     duties: tuple = tuple(DUTIES),
     workers: int = 1,
+    candidate_design="paper01",
 ) -> list[dict]:
     """The acceptance check of ``candidate`` (SimulationOptions fields, e.g.
-    ``{"max_step": "auto"}``) against the reference, one row per (duty, damping, criterion):
+    ``{"max_step": "auto"}``; simulated with ``candidate_design``, a name or a PRSMDesign)
+    against the reference (paper01), one row per (duty, damping, criterion):
     ``duty``, ``damping``, ``criterion``, ``worst`` (the largest deviation, relative),
     ``tolerance``, ``passed``, ``detail`` (where the worst one is)."""
     groups = [(d, c) for d in duties for c in dampings]
     cases = [Case(d, c, s, duration) for d, c in groups for s in range(seeds)]
-    jobs = [(case, candidate) for case in cases]
+    jobs = [(case, candidate, candidate_design) for case in cases]
     if workers > 1:
         with ProcessPoolExecutor(workers) as pool:
             results = list(pool.map(_measure_both, jobs))

@@ -20,31 +20,19 @@ import sys
 import time
 from dataclasses import replace
 
+from prsm_health.actuator.design_files import load_design
 from prsm_health.validation import fidelity
 
 
-def _light_scenario(scale: float):
-    """fidelity._scenario with the rollers' mass and inertia scaled when asked by the option."""
-    plain = fidelity._scenario
-
-    def scenario(case, options):
-        options = dict(options)
-        factor = options.pop("roller_mass_scale", None)
-        sc = plain(case, options)
-        if factor is None:
-            return sc
-        masses = sc.design.masses
-        light = replace(
-            sc.design,
-            masses=replace(
-                masses,
-                roller_mass=masses.roller_mass * factor,
-                roller_inertia=masses.roller_inertia * factor,
-            ),
-        )
-        return replace(sc, design=light)
-
-    return scenario
+def light_design(scale: float):
+    """paper01 with its rollers' mass and inertia scaled by ``scale``."""
+    design = load_design("paper01")
+    masses = replace(
+        design.masses,
+        roller_mass=design.masses.roller_mass * scale,
+        roller_inertia=design.masses.roller_inertia * scale,
+    )
+    return replace(design, masses=masses)
 
 
 def main() -> int:
@@ -54,15 +42,14 @@ def main() -> int:
     parser.add_argument("--duration", type=float, default=0.5)
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
-    # set before the worker processes fork, so they measure the light candidate too
-    fidelity._scenario = _light_scenario(args.scale)
     t0 = time.perf_counter()
     rows = fidelity.acceptance(
-        {"max_step": "auto", "roller_mass_scale": args.scale},
+        {"max_step": "auto"},
         seeds=args.seeds,
         duration=args.duration,
         dampings=(0.03,),
         workers=args.workers,
+        candidate_design=light_design(args.scale),
     )
     print(
         f"rollers' mass and inertia × {args.scale:g} against the full model at 0.5 µs; "
