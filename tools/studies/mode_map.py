@@ -5,8 +5,8 @@
 
 For the first ``--runs`` runs of ``datasets/flight-ema-reference.toml`` (the realistic duty:
 loads of 2–40 % C_a, the drive train) at each contact damping ratio, the model is linearised on
-its loaded flanks (``simulate.linearised_modes``, the eigenvalues that set the RK4 step) and each
-mode is given to the body family that holds most of its kinetic energy (½·m·v² of each
+its loaded flanks once per run (``simulate.linearised_jacobian``, whose eigenvalues set the RK4
+step) and each mode is given to the body family that holds most of its kinetic energy (½·m·v² of each
 coordinate's velocity in the eigenvector; a mode with no velocity part is a first-order
 traction relaxation). Prints, per damping, one Markdown row per family: its modes' frequency
 range, how many lie in the measured band (below 10 kHz, the 20 kHz output's Nyquist), and the
@@ -33,7 +33,6 @@ from prsm_health.simulation.dynamics.model import build_model
 from prsm_health.simulation.dynamics.simulate import (
     STABILITY_MARGIN,
     linearised_jacobian,
-    linearised_modes,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -77,9 +76,10 @@ def coordinate_families(model) -> tuple[list[str], np.ndarray]:
     return family, mass
 
 
-def mode_table(model) -> list[tuple[float, float, str]]:
-    """(frequency |λ|/2π [Hz], damping ratio, owning family) of each mode, fastest first."""
-    values, vectors, free = linearised_modes(model)
+def mode_table(model, jac, free) -> list[tuple[float, float, str]]:
+    """(frequency |λ|/2π [Hz], damping ratio, owning family) of each mode of the linearised
+    model (``jac`` over the states ``free``, :func:`linearised_jacobian`), fastest first."""
+    values, vectors = np.linalg.eig(jac)
     family, mass = coordinate_families(model)
     nq = model.n_coordinates
     modes = []
@@ -96,7 +96,7 @@ def mode_table(model) -> list[tuple[float, float, str]]:
     return modes
 
 
-def condensed_frequencies(model) -> dict[str, np.ndarray]:
+def condensed_frequencies(model, jac, free) -> dict[str, np.ndarray]:
     """Undamped natural frequencies [Hz] below 5 kHz: of the full model, and with the rollers
     and the carrier statically condensed (Guyan 1965) — their mass carried into the other
     bodies through the static modes (M_red = TᵀMT, T = [I; −K_cc⁻¹K_ck]) or dropped (M_kk).
@@ -104,7 +104,6 @@ def condensed_frequencies(model) -> dict[str, np.ndarray]:
     K = −M·∂v̇/∂q from the linearised Jacobian (friction's traction states and all damping
     left out): a check of the mass and stiffness a condensation keeps, not of the dynamics.
     """
-    jac, free = linearised_jacobian(model)
     family, mass = coordinate_families(model)
     nq, index = model.n_coordinates, {j: i for i, j in enumerate(free)}
     q = [j for j in free if j < nq and nq + j in index]
@@ -153,17 +152,17 @@ def main() -> int:
     recipe = Recipe.from_dict(dict(source, name="modes", test_fraction=0.0))
     for damping in args.dampings:
         by_family, kept, first = defaultdict(list), [], None
-        label = f"contact damping {damping:g}"
         for spec in recipe.runs()[: args.runs]:
             sc = spec.scenario()  # the recipe draws a damping per run: this study sets it
             options = replace(sc.options, contact_damping_ratio=damping)
             model = build_model(sc.design, sc.health, sc.profile, options, sc.seed, sc.drive_train)
-            modes = mode_table(model)
+            linearised = model, *linearised_jacobian(model)
+            first = first or linearised  # run 0's, for the condensation below
+            modes = mode_table(*linearised)
             for frequency, zeta, owner in modes:
                 by_family[owner].append((frequency, zeta))
             rest = [f for f, _, owner in modes if not owner.startswith(CONDENSED)]
             kept.append(max(rest))
-            first = first if kept[1:] else model
         print(f"\n### contact damping ratio {damping:g} ({args.runs} runs)\n")
         print(
             "| family | modes per run | frequency range | in band (< 10 kHz) per run | "
@@ -187,9 +186,9 @@ def main() -> int:
             f"\nRollers and carrier condensed out: fastest remaining mode {fastest:.0f} Hz "
             f"(over the runs), RK4 step ≤ {rk4_step(fastest):.1f} µs."
         )
-        print(f"\nUndamped modes below 5 kHz of run 0, full and condensed ({label}):\n")
+        print(f"\nUndamped modes below 5 kHz of run 0, full and condensed (damping {damping:g}):\n")
         try:
-            condensed = condensed_frequencies(first)
+            condensed = condensed_frequencies(*first)
         except np.linalg.LinAlgError:  # a condensed coordinate with no stiffness at this point
             condensed = {"condensation": "undefined (K_cc singular in this linearisation)"}
         for name, freqs in condensed.items():
