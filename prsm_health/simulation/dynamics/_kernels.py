@@ -26,8 +26,8 @@ TWO_PI = 2.0 * math.pi
 #: LLVM fast-math flags of every kernel: none (IEEE arithmetic). With them (reciprocals, fused
 #: multiply-adds, reassociation) the kernel was ≈ 10 % faster, but a process that loaded
 #: `integrate` from numba's cache and compiled `rhs` itself (the linearisation calls it) ran
-#: other bits than one that compiled or loaded both (seen on Haswell code, 1 fresh-clone test run
-#: in 3): runs of one recipe differed between processes, and these runs amplify a last-bit
+#: other bits than one that compiled or loaded both (seen on Haswell code, 3 fresh-cache test runs
+#: in 9): runs of one recipe differed between processes, and these runs amplify a last-bit
 #: difference to percent. IEEE arithmetic is the same whatever the compiler inlines or fuses.
 #: tests/simulation/dynamics/test_kernel_cache_mix.py holds it.
 FAST = False
