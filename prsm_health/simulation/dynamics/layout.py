@@ -124,7 +124,10 @@ ERR_RING_TOOTH, ERR_ROLLER_TOOTH = 8, 9
 # holds.
 ERR_COULOMB = 10
 N_ERROR_KINDS = 11
+#: Points per table: a power of two (the kernel wraps indices by a bit mask).
 N_ERROR_POINTS = 16384
+#: Points of the healthy mesh-stiffness table over one mesh cycle: a power of two, as above.
+MESH_POINTS = 512
 
 # ----------------------------------------------------------------- per-roller parameters
 R_COS_PSI, R_SIN_PSI = 0, 1  # angular position of the pocket on the carrier

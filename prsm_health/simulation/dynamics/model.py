@@ -293,7 +293,10 @@ def _mesh_table(design: PRSMDesign, threaded_tooth: bool) -> np.ndarray:
     from prsm_health.physics.stiffness.gear_mesh import design_mesh_stiffness
 
     table = np.array(
-        design_mesh_stiffness(design, threaded_tooth=threaded_tooth).stiffness, dtype=float
+        design_mesh_stiffness(
+            design, threaded_tooth=threaded_tooth, n_points=L.MESH_POINTS
+        ).stiffness,
+        dtype=float,
     )
     table.flags.writeable = False
     return table

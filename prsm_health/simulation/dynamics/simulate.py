@@ -209,7 +209,9 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         1.0 / h,
         np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
     )
-    truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
+    # all truth signals as the rows of one array: one filter pass (a quarter cheaper, same bits)
+    decimated = decimate(np.stack(list(truth_raw.values())), factor, axis=-1)
+    truth = dict(zip(truth_raw, decimated))
     n_out = len(next(iter(truth.values())))
     time = np.arange(n_out) / instrumentation.sample_rate
     nq = model.n_coordinates

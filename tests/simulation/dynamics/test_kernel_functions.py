@@ -32,3 +32,22 @@ def test_table_lookup_reads_the_reciprocal_period():
         assert abs(value - math.cos(phase)) <= (2.0 * math.pi / n) ** 2
         scale = 2.0 * math.pi / period
         assert abs(slope + scale * math.sin(phase)) <= 2.0 * math.pi / n * scale
+
+
+def test_mesh_lookup_interpolates_periodically_at_any_phase():
+    # The kernel wraps the index by a bit mask: right only for a table of a power of two
+    # points (layout.MESH_POINTS), at negative and many-cycle phases alike.
+    n = L.MESH_POINTS
+    table = 1e9 + 1e8 * np.sin(2.0 * math.pi * np.arange(n) / n) ** 3
+    grid = np.arange(n + 1) / n
+    for phase in (-7.3, -0.001, 0.0, 0.25, 0.9999, 41.5, 12345.678):
+        expected = np.interp(phase % 1.0, grid, np.append(table, table[0]))
+        assert abs(_kernels._mesh_stiffness(table, phase) - expected) <= 1e-6 * 1e9
+
+
+def test_knot_segment_is_the_last_knot_not_after_t():
+    # Bisection gives the scan's segment, duplicate knot times included.
+    times = np.array([0.0, 0.1, 0.1, 0.25, 0.4, 0.4, 0.4, 0.9, 1.0])
+    knots = np.vstack([times, np.arange(times.size)])
+    for t in np.linspace(0.0, 0.999, 200):
+        assert _kernels._segment(knots, t) == np.searchsorted(times, t, side="right") - 1
