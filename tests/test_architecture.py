@@ -25,7 +25,6 @@ ONE_JOB = {
     "physics/stiffness/gear_mesh.py": "potential-energy mesh stiffness of one gear pair (its "
     "checked parameters, contact path and mesh cycle; the tooth is in gear_tooth.py)",
     "physics/stiffness/cylinder.py": "paper 05's electric-cylinder deformation model",
-    "simulation/instrumentation.py": "the sensor models of an instrumentation profile",
     "actuator/design.py": "the PRSM design dataclasses, their validation and the presets",
     "diagnostics/estimators.py": "the scikit-learn estimators of a diagnosis model",
     "simulation/dynamics/_kernels.py": "the numba right-hand side and RK4 of the PRSM model",

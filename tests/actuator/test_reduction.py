@@ -18,13 +18,11 @@ from prsm_health.simulation.dynamics import layout as L
 from prsm_health.simulation.dynamics.model import build_model, initial_state
 from prsm_health.simulation.dynamics.simulate import integrate, integration_step, max_stable_step
 from prsm_health.simulation.instrumentation import (
-    AngleSensor,
     Instrumentation,
-    SpeedEstimate,
-    TorqueEstimate,
     bind_drive_train,
     load_instrumentation,
 )
+from prsm_health.simulation.sensors import AngleSensor, SpeedEstimate, TorqueEstimate
 
 RATE = 20_000.0
 

@@ -13,15 +13,17 @@ from prsm_health.core.channels import MEASURED_NAMES
 from prsm_health.core.errors import ParameterError
 from prsm_health.simulation.decimation import decimate
 from prsm_health.simulation.instrumentation import (
+    Instrumentation,
+    list_profiles,
+    load_instrumentation,
+)
+from prsm_health.simulation.sensors import (
     ARCMIN,
     SENSOR_CLASSES,
     STANDARD_GRAVITY,
     Accelerometer,
-    Instrumentation,
     LoadCell,
     TorqueEstimate,
-    list_profiles,
-    load_instrumentation,
 )
 
 RATE_IN, FACTOR = 200_000.0, 10

@@ -13,11 +13,10 @@ import pytest
 from prsm_health.core.errors import ParameterError
 from prsm_health.simulation.decimation import decimate
 from prsm_health.simulation.instrumentation import (
-    SENSOR_CLASSES,
     Instrumentation,
-    TemperatureSensor,
     load_instrumentation,
 )
+from prsm_health.simulation.sensors import SENSOR_CLASSES, TemperatureSensor
 from prsm_health.simulation.thermal import (
     CONTACT_TO_HOUSING_RESISTANCE,
     housing_temperature,
