@@ -23,6 +23,7 @@ from numba import njit
 from . import layout as L
 
 TWO_PI = 2.0 * math.pi
+INV_TWO_PI = 1.0 / TWO_PI  # the roller loop multiplies (IEEE: a division stays one)
 #: LLVM fast-math flags of every kernel: none (IEEE arithmetic). With them (reciprocals, fused
 #: multiply-adds, reassociation) the kernel was ≈ 10 % faster, but a process that loaded
 #: `integrate` from numba's cache and compiled `rhs` itself (the linearisation calls it) ran
@@ -82,6 +83,8 @@ def axial_load(t, load_knots, amp, freq):
         k = _segment(load_knots, t)
         w = (t - load_knots[0, k]) / (load_knots[0, k + 1] - load_knots[0, k])
         base = load_knots[1, k] + w * (load_knots[1, k + 1] - load_knots[1, k])
+    if amp == 0.0:  # most profiles: no libm call per right-hand side (same bits)
+        return base
     return base + amp * math.sin(TWO_PI * freq * t)
 
 
@@ -561,7 +564,7 @@ def rhs(t, y, p, rollers, mesh_table, motion, load_knots, errors, dy, aux):
         dy[v0 + L.Q_THN] += f_ax * lead_local - f_dh * dh - r_n * f_tn
 
         # ---------------- roller gear – ring gear mesh (line of action n = cos α0 e_t − sin α0 e_r)
-        phase = z_ring * (phi - th_n) / TWO_PI + rollers[i, L.R_MESH_PHASE]
+        phase = z_ring * (phi - th_n) * INV_TWO_PI + rollers[i, L.R_MESH_PHASE]
         k_mesh = _mesh_stiffness(mesh_table, phase) * rollers[i, L.R_MESH_SCALE]
         if toothed:  # a damaged ring tooth meets every roller, a roller's own tooth its ring
             ring, _ = _wave(errors, L.ERR_RING_TOOTH, phase)
