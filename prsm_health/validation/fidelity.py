@@ -76,7 +76,9 @@ class Case:
     duration: float
 
 
-def _scenario(case: Case, options: dict, design="paper01"):
+def case_scenario(case: Case, options: dict, design="paper01"):
+    """The Scenario of one case simulated with ``options`` (SimulationOptions fields) and
+    ``design``: a 0.5 mm nut spall, 10 µm clearance, Hertzian flanks, the case's damping."""
     from prsm_health.actuator.faults import Spall
     from prsm_health.actuator.states import HealthState, OperatingProfile
     from prsm_health.simulation.dynamics.model import SimulationOptions
@@ -122,7 +124,7 @@ def measure(case: Case, options: dict, design="paper01") -> dict:
     from prsm_health.simulation.dynamics.model import build_model
     from prsm_health.simulation.dynamics.simulate import linearised_eigenvalues
 
-    scenario = _scenario(case, options, design)
+    scenario = case_scenario(case, options, design)
     run = scenario.simulate()
     design, rate = scenario.design, run.sample_rate
     speed = float(scenario.profile.speed)
