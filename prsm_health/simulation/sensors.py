@@ -105,12 +105,6 @@ def _truth(truth: dict, name: str, channel: str) -> np.ndarray:
         ) from None
 
 
-def _no_bound_keys(cls, table: dict, where: str) -> None:
-    """Refuse a key that is bound from the drive train (one declaration), naming the allowed."""
-    if "gear_ratio" in table:
-        raise UnknownKeyError(where, "gear_ratio", table["gear_ratio"], cls.allowed_keys())
-
-
 # ----------------------------------------------------------------------------- sensors
 @dataclass(frozen=True)
 class Sensor:
@@ -230,7 +224,27 @@ class Sensor:
 
 
 @dataclass(frozen=True)
-class AngleSensor(Sensor):
+class _ReportsOutput(Sensor):
+    """A drive sensor that reports the reduction's output: its ``gear_ratio`` field is the drive
+    train's (one declaration, bound by ``bind_drive_train``), neither a profile key nor written
+    back."""
+
+    @classmethod
+    def allowed_keys(cls) -> list[str]:
+        return [k for k in super().allowed_keys() if k != "gear_ratio"]
+
+    @classmethod
+    def from_table(cls, table: dict, where: str, start=None):
+        if "gear_ratio" in table:
+            raise UnknownKeyError(where, "gear_ratio", table["gear_ratio"], cls.allowed_keys())
+        return super().from_table(table, where, start)
+
+    def to_dict(self) -> dict:
+        return {k: v for k, v in super().to_dict().items() if k != "gear_ratio"}
+
+
+@dataclass(frozen=True)
+class AngleSensor(_ReportsOutput):
     """Motor encoder or resolver with its converter → ``screw_angle`` (from ``motor_angle``).
 
     measured = [θ + Σ_k e_k·sin(k·p·θ + φ_k) + n, quantised to 2π/counts_per_rev] / N, read at
@@ -285,19 +299,6 @@ class AngleSensor(Sensor):
         self._range("noise", 0.0, 0.1)
         self._range("gear_ratio", 1.0, 1000.0)
 
-    # The ratio is the drive train's (one declaration): not a profile key, not written back.
-    @classmethod
-    def allowed_keys(cls) -> list[str]:
-        return [k for k in super().allowed_keys() if k != "gear_ratio"]
-
-    @classmethod
-    def from_table(cls, table: dict, where: str, start=None):
-        _no_bound_keys(cls, table, where)
-        return super().from_table(table, where, start)
-
-    def to_dict(self) -> dict:
-        return {k: v for k, v in super().to_dict().items() if k != "gear_ratio"}
-
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         theta = decimate(_truth(truth, self.SOURCE, channel), factor)
         phases = rng.uniform(0.0, 2 * np.pi, len(self.harmonic_orders))
@@ -312,7 +313,7 @@ class AngleSensor(Sensor):
 
 
 @dataclass(frozen=True)
-class SpeedEstimate(Sensor):
+class SpeedEstimate(_ReportsOutput):
     """The drive's speed estimate → ``screw_speed``, from the *measured* ``screw_angle``.
 
     As a servo drive computes it: backward difference of the sampled angle (ω[n] = (θ[n] −
@@ -344,18 +345,6 @@ class SpeedEstimate(Sensor):
         self._range("bandwidth", 0.0, 1e6)
         require(isinstance(self.exact, bool), "exact", self.exact, "must be true or false")
         self._range("gear_ratio", 1.0, 1000.0)
-
-    @classmethod
-    def allowed_keys(cls) -> list[str]:
-        return [k for k in super().allowed_keys() if k != "gear_ratio"]
-
-    @classmethod
-    def from_table(cls, table: dict, where: str, start=None):
-        _no_bound_keys(cls, table, where)
-        return super().from_table(table, where, start)
-
-    def to_dict(self) -> dict:
-        return {k: v for k, v in super().to_dict().items() if k != "gear_ratio"}
 
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         if self.exact:
