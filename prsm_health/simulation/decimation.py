@@ -13,15 +13,13 @@ import numpy as np
 from scipy import signal
 
 
-def decimate(values: np.ndarray, factor: int, axis: int = 0) -> np.ndarray:
-    """Anti-aliased decimation by an integer factor along ``axis`` (polyphase FIR).
+def decimate(values: np.ndarray, factor: int) -> np.ndarray:
+    """Anti-aliased decimation by an integer factor along axis 0 (polyphase FIR).
 
     Parameters
     ----------
-    values : ndarray, shape (n, …) (n along ``axis``)
+    values : ndarray, shape (n, …)
     factor : int
-    axis : int
-        Many signals at once are cheapest as the rows of a C-ordered array, ``axis=-1``.
 
     Returns
     -------
@@ -29,6 +27,4 @@ def decimate(values: np.ndarray, factor: int, axis: int = 0) -> np.ndarray:
     """
     if factor == 1:
         return np.array(values, dtype=float)
-    return signal.resample_poly(
-        values, 1, factor, axis=axis, window=("kaiser", 5.0), padtype="line"
-    )
+    return signal.resample_poly(values, 1, factor, axis=0, window=("kaiser", 5.0), padtype="line")

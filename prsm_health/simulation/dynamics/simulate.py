@@ -209,9 +209,9 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         1.0 / h,
         np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
     )
-    # all truth signals as the rows of one array: one filter pass (a quarter cheaper, same bits)
-    decimated = decimate(np.stack(list(truth_raw.values())), factor, axis=-1)
-    truth = dict(zip(truth_raw, decimated))
+    # one signal at a time: stacking them first was no faster (one filter pass or 17, the same
+    # MACs) and held a second copy of the record, gigabytes for a run of minutes
+    truth = {name: decimate(values, factor) for name, values in truth_raw.items()}
     n_out = len(next(iter(truth.values())))
     time = np.arange(n_out) / instrumentation.sample_rate
     nq = model.n_coordinates
