@@ -166,7 +166,6 @@ def fit_prognostics_model(
 
     dataset = fleet if isinstance(fleet, Dataset) else Dataset(fleet)
     design = dataset.design
-    fingerprint = None if design is None else design_fingerprint(design)
     name = design.name if design is not None else str(dataset.runs["design"].iloc[0])
     if histories is None:
         if bundle is None:
@@ -216,7 +215,7 @@ def fit_prognostics_model(
         )
     report = FitReport(
         design=name,
-        design_fingerprint=fingerprint,
+        design_fingerprint=model.design_fingerprint,  # computed once, by _fitted_model
         threshold=float(model.threshold),
         threshold_learnt=learnt,
         true_failure_clearance=None if spec is None else spec.failure_clearance,
