@@ -32,10 +32,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from prsm_health.simulation.dynamics import _kernels
-from prsm_health.simulation.dynamics import layout as L
 from prsm_health.simulation.dynamics.model import build_model, initial_state
-from prsm_health.simulation.dynamics.simulate import integration_step, max_stable_step
+from prsm_health.simulation.dynamics.simulate import (
+    integrate,
+    integration_step,
+    max_stable_step,
+)
 from prsm_health.validation.fidelity import DAMPINGS, Case, case_scenario
 
 SAMPLE_RATE = 20_000.0  # [Hz] the default instrumentation's output
@@ -52,20 +54,12 @@ def _model(damping: float):
 def _step_cost(model, span: float, repeats: int) -> float:
     """Wall seconds per RK4 step of the kernel on ``model`` (best of ``repeats``)."""
     n_steps = int(round(span / TIMING_STEP))
-    work = [np.empty(model.n_state) for _ in range(5)]
-    aux = np.zeros(L.n_aux(model.n_rollers))
-    out = np.empty((1, L.N_CHANNELS))
     best = math.inf
     for _ in range(repeats):
         y = initial_state(model)
         t0 = time.perf_counter()
-        status, _ = _kernels.integrate(
-            y, 0.0, TIMING_STEP, n_steps, n_steps + 1, model.params, model.rollers,
-            model.mesh_table, model.motion, model.load_knots, model.errors, out, *work, aux,
-        )  # fmt: skip
+        integrate(model, y, TIMING_STEP, n_steps, record=False)
         best = min(best, time.perf_counter() - t0)
-        if status != 0:
-            raise RuntimeError("the timing run became non-finite: lower TIMING_STEP")
     return best / n_steps
 
 

@@ -26,12 +26,12 @@ import numpy as np
 
 from prsm_health.simulation.dynamics import _kernels
 from prsm_health.simulation.dynamics import layout as L
-from prsm_health.simulation.dynamics.model import build_model, initial_state
+from prsm_health.simulation.dynamics.model import build_model
 from prsm_health.simulation.dynamics.simulate import (
     integrate,
     integration_step,
     max_stable_step,
-    settling_model,
+    settled_state,
 )
 from prsm_health.validation.fidelity import DUTIES, Case, case_scenario
 
@@ -58,24 +58,17 @@ def trace(duty: str, damping: float, duration: float):
     model = build_model(s.design, s.health, s.profile, s.options, s.seed, s.drive_train)
     h_stable, f_max = max_stable_step(model)
     h, _ = integration_step("auto", h_stable, f_max, SAMPLE_RATE)
-    n_settle = int(round(s.options.settle_time / h))
-    y = initial_state(model, -n_settle * h)
-    integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
+    y = settled_state(model, h, s.options.settle_time)
     n_steps = int(round(duration / h))
     aux = np.zeros(L.n_aux(model.n_rollers))
     dy = np.empty(model.n_state)
-    work = [np.empty(model.n_state) for _ in range(5)]
-    row = np.empty((1, L.N_CHANNELS))
     states = np.empty((n_steps, model.n_rollers), dtype=np.int8)
     accel = np.empty(n_steps)
-    args = (model.params, model.rollers, model.mesh_table, model.motion, model.load_knots)
     for k in range(n_steps):
         t = k * h
         states[k] = contact_states(model, y, t, aux, dy)
         accel[k] = dy[model.n_coordinates + L.Q_ZN]
-        status, _ = _kernels.integrate(y, t, h, 1, 1, *args, model.errors, row, *work, aux)
-        if status != 0:
-            raise RuntimeError(f"{duty}, damping {damping}: non-finite at t = {t:.6f} s")
+        integrate(model, y, h, 1, t0=t, record=False)  # raises on a non-finite state
     return np.arange(n_steps) * h, states, accel, h
 
 

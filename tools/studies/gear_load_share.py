@@ -37,12 +37,11 @@ from prsm_health.physics.load_rating import load_ratings
 from prsm_health.signals.gear_indicators import time_synchronous_average
 from prsm_health.simulation.dynamics import _kernels
 from prsm_health.simulation.dynamics import layout as L
-from prsm_health.simulation.dynamics.model import SimulationOptions, build_model, initial_state
+from prsm_health.simulation.dynamics.model import SimulationOptions, build_model
 from prsm_health.simulation.dynamics.simulate import (
-    integrate,
     integration_step,
     max_stable_step,
-    settling_model,
+    settled_state,
 )
 from prsm_health.simulation.scenario import simulate
 
@@ -68,9 +67,7 @@ def roller_forces(model, duration: float, mismatch: float | None = None) -> dict
         model = replace(model, rollers=rollers)
     h_stable, f_max = max_stable_step(model)
     h, factor = integration_step("auto", h_stable, f_max, RATE)
-    n_settle = int(round(model.options.settle_time / h))
-    y = initial_state(model, -n_settle * h)
-    integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
+    y = settled_state(model, h, model.options.settle_time)
     n = model.n_rollers
     n_out = int(round(duration * RATE))
     work = [np.empty(model.n_state) for _ in range(5)]

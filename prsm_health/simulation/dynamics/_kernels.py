@@ -200,28 +200,32 @@ def _gate(x, half, ramp):
 
 
 @njit(cache=True, inline="always", fastmath=FAST)
-def _mesh_stiffness(table, phase):
-    # Linear interpolation over one mesh cycle of len(table) points, a power of two
-    # (layout.MESH_POINTS): the index wraps by a bit mask.
-    n = table.shape[0]
-    x = phase * n
+def _periodic(x, n):
+    # Linear interpolation at x table intervals into a periodic table of n points, n a power of
+    # two (layout.N_ERROR_POINTS, MESH_POINTS): (index, next index, weight of the next). The index
+    # wraps by a bit mask: a wrap by the floor of the period and bounds tests cost the kernel 9 %.
     floor = math.floor(x)
     i0 = int(floor) & (n - 1)
+    return i0, (i0 + 1) & (n - 1), x - floor
+
+
+@njit(cache=True, inline="always", fastmath=FAST)
+def _mesh_stiffness(table, phase):
+    # The mesh stiffness at ``phase`` [cycles], the table spanning one mesh cycle.
+    n = table.shape[0]
+    i0, i1, w = _periodic(phase * n, n)
     a = table[i0]
-    return a + (table[(i0 + 1) & (n - 1)] - a) * (x - floor)
+    return a + (table[i1] - a) * w
 
 
 @njit(cache=True, inline="always", fastmath=FAST)
 def _wave(errors, kind, u):
     # Error profile of one kind at contact coordinate u, linearly interpolated in its table:
-    # (value [m], slope d/du [m/rad]). N_ERROR_POINTS is a power of two, so the index wraps by a
-    # bit mask: the wrap by floor of the period and a bounds test cost the kernel ≈ 9 %.
+    # (value [m], slope d/du [m/rad]).
     n = errors.shape[1] - 1
-    x = u * errors[kind, 0] * n  # column 0: 1/period
-    floor = math.floor(x)
-    i0 = int(floor) & (n - 1)
-    a, b = errors[kind, 1 + i0], errors[kind, 1 + ((i0 + 1) & (n - 1))]
-    return a + (b - a) * (x - floor), (b - a) * (n * errors[kind, 0])
+    i0, i1, w = _periodic(u * errors[kind, 0] * n, n)  # column 0: 1/period
+    a, b = errors[kind, 1 + i0], errors[kind, 1 + i1]
+    return a + (b - a) * w, (b - a) * (n * errors[kind, 0])
 
 
 @njit(cache=True, inline="always", fastmath=FAST)

@@ -152,6 +152,18 @@ def settling_model(model: Model) -> Model:
     return replace(model, params=params)
 
 
+def settled_state(model: Model, h: float, settle_time: float) -> np.ndarray:
+    """The state at t = 0 after ``settle_time`` [s] of :func:`settling_model` at the step ``h``
+    [s] from the initial state: the run's own start, its extra states (the energy book and the
+    speed loop's integrator) zeroed at t = 0."""
+    n_settle = int(round(settle_time / h))
+    y = initial_state(model, -n_settle * h)
+    if n_settle:
+        integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
+        y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = 0.0
+    return y
+
+
 def choose_step(max_step: float, sample_rate: float) -> tuple[float, int]:
     """Integration step h = 1/(m·f_s) ≤ max_step with the smallest integer m."""
     m = max(1, math.ceil(1.0 / (max_step * sample_rate) - 1e-9))
@@ -194,13 +206,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     h_stable, f_max = max_stable_step(model)
     h, factor = integration_step(options.max_step, h_stable, f_max, instrumentation.sample_rate)
     n_steps = int(round(profile.duration / h))
-    n_settle = int(round(options.settle_time / h))
-    y = initial_state(model, -n_settle * h)
-    if n_settle:
-        integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
-        y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = (
-            0.0  # energy book starts at t = 0
-        )
+    y = settled_state(model, h, options.settle_time)
     truth_raw = _truth_from_record(integrate(model, y, h, n_steps, progress=progress))
     # derived after the kernel's signals: the housing at the temperature probe
     truth_raw["housing_temperature"] = housing_temperature_signal(profile.temperature, truth_raw)

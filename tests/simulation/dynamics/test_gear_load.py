@@ -20,12 +20,11 @@ from prsm_health import (
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.simulation.dynamics import _kernels
 from prsm_health.simulation.dynamics import layout as L
-from prsm_health.simulation.dynamics.model import build_model, initial_state
+from prsm_health.simulation.dynamics.model import build_model
 from prsm_health.simulation.dynamics.simulate import (
-    integrate,
     integration_step,
     max_stable_step,
-    settling_model,
+    settled_state,
 )
 
 DESIGN = preset("paper01")
@@ -46,9 +45,7 @@ def _forces(mismatch: float, duration: float = 0.05) -> dict[str, np.ndarray]:
     model = replace(model, rollers=rollers)
     h_stable, f_max = max_stable_step(model)
     h, factor = integration_step("auto", h_stable, f_max, 20_000.0)
-    n_settle = int(round(OPTIONS.settle_time / h))
-    y = initial_state(model, -n_settle * h)
-    integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
+    y = settled_state(model, h, OPTIONS.settle_time)
     n = model.n_rollers
     work = [np.empty(model.n_state) for _ in range(5)]
     aux = np.zeros(L.n_aux(n))
