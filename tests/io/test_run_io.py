@@ -84,8 +84,11 @@ def test_simulated_truth_is_the_physics_without_sensor_errors(run):
     # the resolver is on the motor: the drive reports the screw angle as its reading / N
     ratio = run.scenario["drive_train"]["gear_ratio"]
     assert np.allclose(run.truth["motor_angle"] / ratio, run.channels["screw_angle"], rtol=1e-12)
-    assert np.array_equal(run.truth["motor_torque"], run.channels["drive_torque"])
-    assert np.array_equal(run.truth["axial_load"], run.channels["axial_load"])
+    # equal to round-off: the truth record is decimated all columns at once, a reading alone
+    # (the same filter, its sum in another order)
+    for truth, channel in (("motor_torque", "drive_torque"), ("axial_load", "axial_load")):
+        scale = np.max(np.abs(run.truth[truth]))
+        assert np.max(np.abs(run.truth[truth] - run.channels[channel])) < 1e-12 * scale
     assert not np.array_equal(run.truth["motor_angle"], run.truth["screw_angle"])  # coupling
     assert np.all(run.truth["screw_axial_position"] < 0)
     assert all(len(v) == len(run) for v in run.truth.values())

@@ -33,3 +33,26 @@ def test_ramps_have_no_edge_transient():
     ramp = np.linspace(0.0, 10.0, 40_000)
     y = decimate(ramp, FACTOR)
     assert np.max(np.abs(y - ramp[::FACTOR])) < 1e-9 * 10.0
+
+
+@pytest.mark.parametrize("n", [2, 7, 300, 5_003])
+def test_columns_together_equal_scipy_one_at_a_time(n):
+    # The numba kernel (all columns of a record at once) is resample_poly's filter and edges:
+    # equal to round-off (1e-12 of the signal: a 201-tap sum in another order), also for
+    # records shorter than the filter, where both ends use the line through the end samples.
+    from scipy import signal
+
+    from prsm_health.simulation import _kernels
+    from prsm_health.simulation.decimation import _taps
+
+    rng = np.random.default_rng(n)
+    x = np.cumsum(rng.standard_normal((n, 5)), axis=0) + np.linspace(0.0, 50.0, n)[:, None]
+    expected = signal.resample_poly(x, 1, FACTOR, axis=0, window=("kaiser", 5.0), padtype="line")
+    scale = np.max(np.abs(expected))
+    assert np.max(np.abs(decimate(x, FACTOR) - expected)) < 1e-12 * scale
+    # the kernel's Python source (NUMBA_DISABLE_JIT's path), on the short ones
+    if n <= 300:
+        out = np.empty_like(expected)
+        kernel = _kernels.fir_decimate_columns
+        getattr(kernel, "py_func", kernel)(x, _taps(FACTOR), FACTOR, out)
+        assert np.max(np.abs(out - expected)) < 1e-12 * scale
