@@ -28,6 +28,8 @@ def n_coordinates(n_rollers: int) -> int:
 # roller–nut contacts (n…2n−1).
 X_W_DRIVE, X_W_LOAD, X_W_DISS, X_W_FRIC, X_SPEED_INT = 0, 1, 2, 3, 4
 N_EXTRA = 5
+#: The extra states that are the energy book (a run starts its own at 0).
+ENERGY_STATES = (X_W_DRIVE, X_W_LOAD, X_W_DISS, X_W_FRIC)
 #: Traction states per roller: screw side, nut side.
 N_TRACTION = 2
 

@@ -154,13 +154,15 @@ def settling_model(model: Model) -> Model:
 
 def settled_state(model: Model, h: float, settle_time: float) -> np.ndarray:
     """The state at t = 0 after ``settle_time`` [s] of :func:`settling_model` at the step ``h``
-    [s] from the initial state: the run's own start, its extra states (the energy book and the
-    speed loop's integrator) zeroed at t = 0."""
+    [s] from the initial state: the run's own start, its energy book zeroed at t = 0. The speed
+    loop's integrator keeps what it settled to (the torque the load needs): zeroed, it would
+    drop that torque at t = 0 and start the run with the transient settling removed."""
     n_settle = int(round(settle_time / h))
     y = initial_state(model, -n_settle * h)
     if n_settle:
         integrate(settling_model(model), y, h, n_settle, t0=-n_settle * h, record=False)
-        y[2 * model.n_coordinates : 2 * model.n_coordinates + L.N_EXTRA] = 0.0
+        energies = 2 * model.n_coordinates + np.array(L.ENERGY_STATES)
+        y[energies] = 0.0
     return y
 
 
