@@ -30,6 +30,9 @@ from .workers import WorkerPool
 
 log = logging.getLogger("prsm_health.apps.service")
 
+#: How long a stop waits for a warm-up still running [s] (it takes seconds; a cold numba cache
+#: tens of them).
+WARMUP_JOIN_TIMEOUT = 120.0
 TITLE = "prsm-health diagnostics service"
 DESCRIPTION = (
     "Health diagnosis of planetary roller screw mechanisms: clearance estimate with "
@@ -164,11 +167,17 @@ def _open_store(db_path) -> HistoryStore:
 
 @contextlib.asynccontextmanager
 async def _lifespan(app: FastAPI, *, warmup: bool):
+    warming = threading.Thread(target=_warm, args=(app,), name="prsm-health-warmup", daemon=True)
     if warmup:
-        threading.Thread(target=_warm, args=(app,), name="prsm-health-warmup", daemon=True).start()
+        warming.start()
     try:
         yield
     finally:
+        # A stop during the warm-up waits for it: it may still be starting the diagnosis
+        # processes that close() stops, and a daemon thread inside numba's compiler or holding
+        # stderr at interpreter exit aborts the process (a -6 exit seen under load).
+        if warming.is_alive():
+            warming.join(timeout=WARMUP_JOIN_TIMEOUT)
         app.state.workers.close()
         app.state.store.close()
 

@@ -573,7 +573,7 @@ def test_command_line_service_prognosis_survives_a_restart(model_file, tmp_path)
             continue  # another process took the free port between probe and bind: retry
         assert r is not None, stderr.decode(errors="replace")
         assert r.status_code == 200, r.text
-        assert proc.returncode == 0
+        assert proc.returncode == 0, stderr.decode(errors="replace")
         assert b"Traceback" not in stderr
         answers.append(r.json())
     assert answers[0] == answers[1]
