@@ -46,7 +46,8 @@ SPEED_UPS = (4.0, 10.0)  # the issue's targets: at the default damping, at 0.1
 BAND_EDGES = (3000.0, 5000.0, 8000.0)  # [Hz]
 
 
-def _model(damping: float):
+def steady_model(damping: float):
+    """The acceptance check's steady case (seed 0) at ``damping``, as the kernel's Model."""
     s = case_scenario(Case("steady 20 % C_a", damping, 0, 0.1), {})
     return build_model(s.design, s.health, s.profile, s.options, s.seed, s.drive_train)
 
@@ -93,7 +94,7 @@ def main() -> int:
     print("|---|---|---|")
     steps = {}
     for damping in DAMPINGS:
-        model = _model(damping)
+        model = steady_model(damping)
         h_stable, f_max = max_stable_step(model)
         h_full, _ = integration_step("auto", h_stable, f_max, SAMPLE_RATE)
         steps[damping] = h_full
