@@ -115,7 +115,9 @@ class SimulationOptions:
         (module docstring): 0.3–0.9.
     settle_time : float [s]
         Simulated before t = 0 at the initial speed and load and discarded, so the start-up
-        transient of the as-built rollers finding their load share is not in the run.
+        transient of the as-built rollers finding their load share is not in the run. The motor
+        follows the prescribed motion meanwhile; a speed or position loop takes over at t = 0
+        holding the settling's mean drive torque.
     support_damping_ratio : float [-]
         Damping ratio of bearings, guides and pockets.
     lubrication : {"regime", "constant"}

@@ -32,8 +32,8 @@ from .model import (
 #: RK4's stability limit on the imaginary axis is 2√2; keep a margin for the nonlinearity.
 STABILITY_MARGIN = 0.9
 #: A speed or position loop starts holding the drive torque averaged over this last part of the
-#: settling [s]: several periods of the slowest roller-load ripple (the carrier's revolution at
-#: 100 rad/s is 0.17 s; the mesh and roller passes are ≥ 100 Hz), and the loop's own time.
+#: settling [s]: many periods of the mesh and thread ripples that make the torque fluctuate
+#: (kHz); a slower ripple (the carrier's revolution) is left to the loop to follow.
 HANDOVER_TIME = 0.005
 
 
@@ -165,7 +165,8 @@ def settled_state(model: Model, h: float, settle_time: float) -> np.ndarray:
     A speed or position loop takes over from the prescribed motion holding the mean drive
     torque of the settling's last :data:`HANDOVER_TIME` (its integrator set to it): the loop's
     own wind-up against the settling's nut damper, which carries load while the speed lags,
-    took ≈ 0.3 s (a run under 300 N started 5 % slow after 30 ms of settling)."""
+    took ≈ 0.3 s (with paper 01's drive train a run started 5 % slow under 300 N after 30 ms of
+    settling, at 18 instead of 50 rad/s under 3000 N)."""
     n_settle = int(round(settle_time / h))
     y = initial_state(model, -n_settle * h)
     if n_settle:
