@@ -510,6 +510,19 @@ class _LinearTransducer(Sensor):
         return _quantise(y, self.resolution)
 
 
+def _linear_units(unit: str) -> dict[str, str]:
+    """A linear transducer's parameter units when it measures in ``unit``."""
+    return {
+        "full_scale": unit,
+        "nonlinearity": "-",
+        "gain_sigma": "-",
+        "drift_sigma": f"{unit}/s",
+        "bandwidth": "Hz",
+        "noise": unit,
+        "resolution": unit,
+    }
+
+
 _LINEAR_ALIASES = {
     "nonlinearity_percent": ("nonlinearity", 0.01, "% of full_scale"),
     "gain_sigma_percent": ("gain_sigma", 0.01, "%"),
@@ -535,15 +548,7 @@ class PositionSensor(_LinearTransducer):
     """
 
     KIND: ClassVar[str] = "position sensor"
-    UNITS: ClassVar[dict[str, str]] = {
-        "full_scale": "m",
-        "nonlinearity": "-",
-        "gain_sigma": "-",
-        "drift_sigma": "m/s",
-        "bandwidth": "Hz",
-        "noise": "m",
-        "resolution": "m",
-    }
+    UNITS: ClassVar[dict[str, str]] = _linear_units("m")
     ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = _LINEAR_ALIASES
     SOURCE: ClassVar[str] = "nut_position"
 
@@ -563,15 +568,7 @@ class LoadCell(_LinearTransducer):
     """
 
     KIND: ClassVar[str] = "load cell"
-    UNITS: ClassVar[dict[str, str]] = {
-        "full_scale": "N",
-        "nonlinearity": "-",
-        "gain_sigma": "-",
-        "drift_sigma": "N/s",
-        "bandwidth": "Hz",
-        "noise": "N",
-        "resolution": "N",
-    }
+    UNITS: ClassVar[dict[str, str]] = _linear_units("N")
     ALIASES: ClassVar[dict[str, tuple[str, float, str]]] = _LINEAR_ALIASES
     SOURCE: ClassVar[str] = "axial_load"
 

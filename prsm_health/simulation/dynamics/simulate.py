@@ -173,8 +173,7 @@ def settled_state(model: Model, h: float, settle_time: float) -> np.ndarray:
         settling = settling_model(model)
         looped = model.params[L.P_DRIVE_MODE] != L.DRIVE_PRESCRIBED
         n_mean = min(n_settle, max(1, int(round(HANDOVER_TIME / h)))) if looped else 0
-        t0 = -n_settle * h
-        integrate(settling, y, h, n_settle - n_mean, t0=t0, record=False)
+        integrate(settling, y, h, n_settle - n_mean, t0=-n_settle * h, record=False)
         nq = model.n_coordinates
         if n_mean:
             record = integrate(settling, y, h, n_mean, t0=-n_mean * h)
