@@ -35,7 +35,10 @@ LAYERS = (
     "io",
     "datasets",
     "diagnostics",
+    "monitoring",
+    "training",
     "prognostics",
+    "release",
     "validation",
     "apps",
 )

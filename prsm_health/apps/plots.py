@@ -216,7 +216,7 @@ def plot_diagnosis(result, path: str | Path) -> Path:
 
 
 def plot_evaluation(report: dict, records, directory: str | Path) -> list[Path]:
-    """Figures of :func:`prsm_health.diagnostics.evaluation.evaluate_model` as PNGs in ``directory``:
+    """Figures of :func:`prsm_health.training.evaluation.evaluate_model` as PNGs in ``directory``:
 
     - ``clearance.png``: predicted vs true clearance with the 90 % intervals (grey where the
       diagnosis called the clearance not observable);

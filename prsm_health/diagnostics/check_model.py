@@ -5,7 +5,7 @@ A check recording (``run.check_phase``; :mod:`prsm_health.actuator.health_check`
 into windows: :func:`prsm_health.signals.check_indicators.check_indicators` finds its phases by
 their commanded condition (no-load stroke, torque at two speeds under one load, slow reversal
 under load, the highest-load stroke) and reads each for its signature; the model bundle's
-``check`` part (:class:`CheckModel`, trained by :mod:`prsm_health.diagnostics.check_training`)
+``check`` part (:class:`CheckModel`, trained by :mod:`prsm_health.training.check_training`)
 turns them into a clearance with its interval and class probabilities:
 
 * **alone** — one recording, absolute indicators (``fault``);

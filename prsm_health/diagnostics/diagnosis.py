@@ -1,6 +1,6 @@
 """Diagnosis: recording → windows → indicators → estimators → :class:`Diagnosis`.
 
-A **model bundle** (saved by :func:`prsm_health.diagnostics.training.train`) holds the clearance estimator,
+A **model bundle** (saved by :func:`prsm_health.training.train.train`) holds the clearance estimator,
 the fault classifier, the indicator names they were trained on, the window length of the
 training runs, the design and the measured channels of the training runs. :func:`diagnose`
 cuts a recording into windows of that length, computes the indicators

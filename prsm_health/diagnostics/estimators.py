@@ -13,7 +13,7 @@ reversal), because gradient-boosted histogram trees route NaN to a learned side 
   conformal class set (every class the evidence cannot rule out at a set coverage).
 
 Evaluation (permutation importance, cross-validated metrics) lives in
-:mod:`prsm_health.diagnostics.evaluation`; saving and loading in :mod:`prsm_health.diagnostics.model_files`.
+:mod:`prsm_health.training.evaluation`; saving and loading in :mod:`prsm_health.diagnostics.model_files`.
 
 References
 ----------

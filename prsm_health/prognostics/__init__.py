@@ -13,7 +13,13 @@ Import from here, not from the modules: their split is this package's business.
 
 from .fitting import FitReport, cross_validate_units, diagnosed_threshold, fit_prognostics_model
 from .fleet import fleet_histories, simulated_histories
-from .history import HISTORY_COLUMNS, HistoryError, read_history, validate_history
+from .history import (
+    HISTORY_COLUMNS,
+    HistoryError,
+    history_of_readings,
+    read_history,
+    validate_history,
+)
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
 from .prognosis import Prognosis
 from .rul import HORIZON_FACTOR, METHODS, RULModel, prognose
@@ -34,6 +40,7 @@ __all__ = [
     "simulated_histories",
     "load_prognostics_model",
     "prognose",
+    "history_of_readings",
     "read_history",
     "save_prognostics_model",
     "validate_history",

@@ -309,3 +309,49 @@ def history_arrays(history: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.nd
         - history["clearance_lower"].to_numpy(dtype=np.float64)
     )
     return t, value, half_width / Z90
+
+
+def history_of_readings(rows):
+    """The history table a prognosis is made from (:func:`prsm_health.prognostics.prognose`),
+    from an asset's stored readings — rows with ``operating_hours``, ``clearance_estimate``,
+    ``clearance_lower``, ``clearance_upper``, ``fault_class`` and ``design`` attributes (the
+    service's :meth:`prsm_health.monitoring.sqlite_store.HistoryStore.operating_history`) —
+    and notes on the rows left out.
+
+    ``age_hours`` is the stored operating hours; ``clearance``, ``clearance_lower``,
+    ``clearance_upper`` [m] the stored estimate and 90 % interval; ``design`` the diagnosing
+    model's; ``fault_class``. Of several diagnoses at the same operating hours only the latest
+    received is kept (a repeated reading replaces the earlier one); diagnoses without a
+    clearance estimate or interval (a model without a clearance estimator) carry nothing to
+    predict from and are left out, with a note.
+
+    Returns
+    -------
+    (pandas.DataFrame, list of str)
+        The table, oldest first (operating hours strictly increasing), and the notes.
+    """
+    import pandas as pd
+
+    usable = [
+        r for r in rows if None not in (r.clearance_estimate, r.clearance_lower, r.clearance_upper)
+    ]
+    notes = []
+    if len(usable) < len(rows):
+        notes.append(
+            f"{len(rows) - len(usable)} stored diagnosis(es) with operating hours but without a "
+            "clearance estimate and interval were left out"
+        )
+    stored = {  # the history's column → the stored row's field
+        "age_hours": "operating_hours",
+        "clearance": "clearance_estimate",
+        "clearance_lower": "clearance_lower",
+        "clearance_upper": "clearance_upper",
+        "fault_class": "fault_class",
+        "design": "design",
+    }
+    table = pd.DataFrame(
+        {column: [getattr(r, name) for r in usable] for column, name in stored.items()},
+        columns=[*HISTORY_COLUMNS, "fault_class", "design"],
+    )
+    table = table.drop_duplicates("age_hours", keep="last").reset_index(drop=True)
+    return table, notes

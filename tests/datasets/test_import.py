@@ -206,8 +206,8 @@ def test_import_train_evaluate_round_trip_beats_statistics(tmp_path):
     from sklearn.metrics import f1_score
 
     from prsm_health.diagnostics.diagnosis import load_bundle
-    from prsm_health.diagnostics.evaluation import evaluate_model
-    from prsm_health.diagnostics.training import train
+    from prsm_health.training.evaluation import evaluate_model
+    from prsm_health.training.train import train
 
     rng = np.random.default_rng(7)
     files, rows = [], []

@@ -1,5 +1,5 @@
 """Tests of prsm_health.diagnostics.estimators (sklearn contract, interval coverage, calibration),
-prsm_health.diagnostics.evaluation (group importance, cross-validated metrics) and
+prsm_health.training.evaluation (group importance, cross-validated metrics) and
 prsm_health.diagnostics.model_files (safe save/load)."""
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from prsm_health.diagnostics.estimators import (
     DistributionGuard,
     FaultClassifier,
 )
-from prsm_health.diagnostics.evaluation import cross_validated_metrics, permutation_importance_table
+from prsm_health.training.evaluation import cross_validated_metrics, permutation_importance_table
 from prsm_health.diagnostics.model_files import _bundle_bytes, load_model, save_model
 
 # ------------------------------------------------------------------------------------------

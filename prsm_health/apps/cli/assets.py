@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from prsm_health.core.errors import PRSMHealthError
-from prsm_health.diagnostics.asset_history import AssetStore, bundle_priors
+from prsm_health.monitoring import FileAssetStore, bundle_priors
 
 from .output import print_columns, print_json, print_table
 
@@ -22,8 +22,8 @@ COLUMNS = (
 
 
 def show(args) -> int:
-    store = AssetStore(args.store)
-    if args.asset not in store.assets():
+    store = FileAssetStore(args.store)
+    if args.asset not in store.asset_ids():
         raise PRSMHealthError(
             f"no asset {args.asset!r} in {store.directory} (prsm-health asset list --store "
             f"{store.directory})"
@@ -34,7 +34,7 @@ def show(args) -> int:
         from prsm_health.diagnostics.diagnosis import load_bundle
 
         prior_scale, _, names = bundle_priors(load_bundle(args.model))
-    report = store.load(args.asset).report(prior_scale, names)
+    report = store.load(args.asset).history.report(prior_scale, names)
     if args.json:
         print_json(report)
         return 0
@@ -79,7 +79,7 @@ def recording_rows(report: dict) -> list[tuple]:
     """One row per recording of ``asset show``, oldest first."""
     return [
         (
-            r["source"] or r["recording_id"],
+            r["filename"] or r["source"] or r["recording_id"],
             r["time"] or None,
             r["operating_hours"],
             "yes" if r["baseline"] else "no",
@@ -94,7 +94,7 @@ def recording_rows(report: dict) -> list[tuple]:
 
 
 def list_assets(args) -> int:
-    assets = AssetStore(args.store).assets()
+    assets = FileAssetStore(args.store).asset_ids()
     if args.json:
         print_json(assets)
         return 0

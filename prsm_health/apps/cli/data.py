@@ -8,7 +8,7 @@ import sys
 from prsm_health.datasets import Dataset, dataset_throughput, load_recipe
 from prsm_health.datasets import generate as generate_dataset
 from prsm_health.datasets.importer import import_recordings as import_dataset
-from prsm_health.diagnostics.training import training_problems
+from prsm_health.training.train import training_problems
 
 from .output import print_json, print_table
 

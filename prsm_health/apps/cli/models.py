@@ -7,14 +7,15 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.identifiers import content_id
 from prsm_health.datasets import Dataset
-from prsm_health.diagnostics.asset_history import AssetStore, diagnose_asset, file_recording_id
 from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
 from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
-from prsm_health.diagnostics.evaluation import evaluate_model
-from prsm_health.diagnostics.training import train as train_model
+from prsm_health.training.evaluation import evaluate_model
+from prsm_health.training.train import train as train_model
 from prsm_health.io import read_recording
+from prsm_health.monitoring import FileAssetStore, diagnose_asset
 
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
@@ -22,7 +23,7 @@ from .output import print_json, print_table, scaled, share, um
 from .parser import DEFAULT_CV
 from .prognose import check_train_options, train_prognostics
 
-# What each fault macro-F1 counts (prsm_health.diagnostics.evaluation.fault_report and
+# What each fault macro-F1 counts (prsm_health.training.evaluation.fault_report and
 # training._class_metrics), so that the tables of train and evaluate cannot be misread.
 F1_CANNOT_TELL_MISS = "fault macro-F1 (cannot_tell counted as a miss)"
 F1_NAMED = "fault macro-F1 (on the runs given a class)"
@@ -119,14 +120,15 @@ def diagnose(args) -> int:
         result = diagnose_asset(
             run,
             bundle,
-            AssetStore(args.store),
+            FileAssetStore(args.store),
             args.asset,
-            file_recording_id(args.file, args.map),
+            content_id(args.file, args.map),
             healthy=True if args.healthy else (False if args.unhealthy else None),
             operating_hours=args.operating_hours,
             time=args.time if args.time is not None else _modified(args.file),
             window=args.window,
-            source=Path(args.file).name,
+            source="file",
+            filename=Path(args.file).name,
         )
     if args.plot:
         plot_diagnosis(result, args.plot)

@@ -51,7 +51,7 @@ DEFAULT_PROFILE = "flight-ema"
 #: ``--live`` defaults and message budget (prsm_health.apps.live, which imports foxglove).
 LIVE_HOST, LIVE_PORT, LIVE_MESSAGE_BUDGET = "127.0.0.1", 8765, 20_000
 
-#: ``train --target``: the diagnosis models' targets (prsm_health.diagnostics.training), and
+#: ``train --target``: the diagnosis models' targets (prsm_health.training.train), and
 #: ``rul``, a prognostics model of a fleet dataset.
 TRAIN_TARGETS = ("clearance", "fault", "both", "rul")
 #: ``train --cv`` when not given.

@@ -36,8 +36,15 @@ threads), :mod:`.routes` (endpoints), :mod:`.handlers` (error answers), :mod:`.a
 (create_app), :mod:`.server` (serve).
 """
 
+from prsm_health.monitoring.sqlite_store import (
+    DB_ENV,
+    HistoryStore,
+    default_db_path,
+    parse_time,
+    utc_now,
+)
+
 from .app import create_app
-from .history import DB_ENV, HistoryStore, default_db_path, parse_time, utc_now
 from .limits import MAX_ABS_VALUE, ServiceLimits
 from .schemas import ASSET_ID_PATTERN
 from .server import TOKEN_ENV, bind_socket, check_bind, is_loopback, serve

@@ -17,10 +17,10 @@ from fastapi.openapi.utils import get_openapi
 from prsm_health import __version__
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import load_bundle
+from prsm_health.monitoring.sqlite_store import HistoryStore, default_db_path
 
 from .diagnosing import warm_up
 from .handlers import install_error_handlers
-from .history import HistoryStore, default_db_path
 from .limits import ServiceLimits
 from .model_info import model_info
 from .routes import ROUTERS

@@ -1,42 +1,43 @@
 """The work done in worker threads or diagnosis processes: a request body (JSON, or a binary
 recording decoded by :mod:`prsm_health.io`) or an upload (with its column map) → a
-:class:`~prsm_health.core.run.Run` → the library's diagnosis → the encoded answer and its
-history rows (:class:`Answer`). The service's calls into :mod:`prsm_health.diagnostics.diagnosis`
-and :mod:`prsm_health.io` are here; recordings are read by the library's one reader
-(:func:`prsm_health.io.read_with_warnings`: the reader ``diagnose`` and ``import`` use), recording
-checks are :meth:`Run.validate <prsm_health.core.run.Run.validate>`'s, and each request cuts
-its recording into windows once (:func:`~prsm_health.diagnostics.diagnosis.split_windows`).
+:class:`~prsm_health.core.run.Run` → the library's diagnosis (:class:`Answer`). Recordings are
+read by the library's one reader (:func:`prsm_health.io.read_with_warnings`: the reader
+``diagnose`` and ``import`` use), recording checks are :meth:`Run.validate
+<prsm_health.core.run.Run.validate>`'s, and each request cuts its recording into windows once
+(:func:`~prsm_health.diagnostics.diagnosis.split_windows`).
 
-Everything that crosses to and from a diagnosis process is plain data: the request body as
-bytes (decoded in the process: cheaper to send than decoded arrays) with the asset's baseline
-as JSON (:class:`~.evidence.BaselineFor`), and back the answer's JSON bytes and the history
-rows (built there too, so the server process encodes no windows). A request naming an asset
-sends back instead the recording's diagnosis (the contract value, its windows left out)
-and the answer's other parts already encoded (:class:`~.evidence.AssetPart`): the server
-records it in the asset's history and encodes that one diagnosis with its ``asset`` part.
+A request without an asset comes back as its encoded answer. A request naming an asset comes
+back as the recording's diagnosis and what the asset's history needs (:class:`AssetRequest`);
+the server records it with :func:`prsm_health.monitoring.record_diagnosis` — the step ``prsm-health
+diagnose --asset`` takes too — and encodes the answer once (:func:`record_and_encode`).
+Everything that crosses to and from a diagnosis process is plain data (bytes, frozen values).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import logging
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from prsm_health.core.channels import CHANNEL_NAMES
 from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.identifiers import content_id, run_content_id
 from prsm_health.core.jsonable import json_ready
 from prsm_health.core.run import MIN_SAMPLES, Run
+from prsm_health.diagnostics.baseline import Baseline
 from prsm_health.diagnostics.check_model import is_check
+from prsm_health.diagnostics.contract import Diagnosis
 from prsm_health.diagnostics.diagnosis import diagnose, split_windows
 from prsm_health.io import read_with_warnings
 from prsm_health.io.column_map import column_map_from_text
 from prsm_health.io.derived import derive_channels
+from prsm_health.monitoring.sqlite_store import HistoryStore, history_rows, spectra_row
+from prsm_health.monitoring.steps import record_diagnosis
 from prsm_health.signals.envelope_analysis import window_spectra
 
-from .evidence import AssetPart, BaselineFor, content_id, run_id
-from .history import history_rows, spectra_row, utc_now
 from .limits import MAX_ABS_VALUE, MAX_TIME, ServiceLimits
 from .responses import HTTPError, encode
 from .schemas import DiagnoseRequest, parse_diagnose_request
@@ -49,12 +50,6 @@ def diagnosis_json(run: Run, bundle, windows: tuple | None = None) -> dict:
     """The library's diagnosis of ``run`` as a JSON-ready dict (with ``windows``);
     ``windows``: ``run`` already cut by :func:`split_windows` with the model's window."""
     return json_ready(diagnose(run, bundle, windows=windows).to_json())
-
-
-def _row_fields(result: dict) -> dict:
-    """What a history row takes from a diagnosis besides its JSON (replaced with the
-    recorded diagnosis': :meth:`AssetPart.answer <.evidence.AssetPart.answer>`)."""
-    return {k: result.get(k) for k in ("clearance", "fault_class", "class_probabilities", "model")}
 
 
 def check_run(run: Run, limits: ServiceLimits, *, max_samples: int, what: str = "") -> None:
@@ -92,28 +87,96 @@ SPECTRA_CHANNEL = "nut_axial_accel"
 
 
 @dataclass(frozen=True)
-class Answer:
-    """What a diagnose request gives back to the route: the encoded JSON answer and, when the
-    request named an asset, its history rows (:func:`~.history.history_rows`), the spectra
-    row of the recording's last window (:func:`~.history.spectra_row`; None when the recording
-    has no nut axial acceleration) and what the asset's history needs (:class:`AssetPart`:
-    the answer is then made in the server, ``encoded`` is empty)."""
+class AssetRequest:
+    """What a diagnose request says about its recording's asset: the asset, the recording's
+    id (given, else from its content: :func:`~prsm_health.core.identifiers.content_id`), how it
+    came (``source``: the body format or ``file``), its file name, the label ``healthy``, the
+    asset's operating hours [h] and the nominal speed [rad/s] and load [N] given with it."""
 
-    encoded: bytes
-    history: list | None = None
+    asset_id: str
+    recording_id: str
+    source: str
+    filename: str | None = None
+    healthy: bool | None = None
+    operating_hours: float | None = None
+    speed: float | None = None
+    load: float | None = None
+
+
+@dataclass(frozen=True)
+class Answer:
+    """What a diagnose request gives back to the route: without an asset, the encoded JSON
+    answer (``encoded``); with one, the recording's ``diagnosis`` (its windows kept), the
+    ``asset`` request, the spectra row of its last window (None without a nut axial
+    acceleration) and, for an upload, the answer's other parts (``upload``: ``recording`` and
+    ``warnings``), made into the answer once the diagnosis is recorded
+    (:func:`record_and_encode`)."""
+
+    encoded: bytes = b""
+    diagnosis: Diagnosis | None = None
+    asset: AssetRequest | None = None
     spectra: tuple | None = None
-    asset: AssetPart | None = None
+    upload: dict | None = None
+
+
+def record_and_encode(store: HistoryStore, bundle, answer: Answer, received_at: str) -> bytes:
+    """Record an asset's recording in its history (:func:`prsm_health.monitoring.record_diagnosis`)
+    with the request's diagnosis rows and spectra in the same transaction, and encode the
+    answer — the diagnosis with the asset's state — once. A JSON or binary body is stored as
+    one row; an upload as one row per window, or one for the whole recording when it was read
+    whole (a health check read phase by phase)."""
+    a = answer.asset
+    windows = answer.diagnosis.windows
+    made = {}
+
+    def rows(_history, recorded: Diagnosis):
+        result = json_ready(dataclasses.replace(recorded, windows=windows).to_json())
+        if answer.upload is None:
+            if len(result.get("windows", [])) <= 1:
+                result.pop("windows", None)
+            made["answer"] = result
+            stored = [result]
+        else:
+            per_window = result.pop("windows", [])
+            made["answer"] = {"diagnosis": result, "windows": per_window, **answer.upload}
+            stored = per_window or [result]
+        history = history_rows(
+            a.asset_id,
+            stored,
+            received_at=received_at,
+            source=a.source,
+            filename=a.filename,
+            speed=a.speed,
+            load=a.load,
+            operating_hours=a.operating_hours,
+        )
+        return history, answer.spectra
+
+    record_diagnosis(
+        store,
+        bundle,
+        a.asset_id,
+        a.recording_id,
+        dataclasses.replace(answer.diagnosis, windows=[]),
+        healthy=a.healthy,
+        operating_hours=a.operating_hours,
+        time=received_at,
+        source=a.source,
+        filename=a.filename,
+        extra=rows,
+    )
+    return encode(made["answer"])
 
 
 def last_window_spectra(
-    last: Run, bundle, asset_id: str, windows: list[dict], **row
+    last: Run, bundle, asset_id: str, window: dict | None, **row
 ) -> tuple | None:
     """The spectra row of the recording's last window ``last`` (the one the diagnosis was
     given: :func:`split_windows` with the model's window):
     :func:`prsm_health.signals.envelope_analysis.window_spectra` of its nut axial acceleration
     at its mean screw speed, with the model's design. None when the recording has no nut axial
-    acceleration. ``windows``: the diagnosis' window entries (the last one's index and span
-    are stored); ``row``: :func:`spectra_row`'s keywords."""
+    acceleration. ``window``: the last window's index and span in the recording (stored; None
+    for a recording read whole); ``row``: :func:`spectra_row`'s keywords."""
     if SPECTRA_CHANNEL not in last.channels:
         return None
     speed = last.channels.get("screw_speed")
@@ -127,7 +190,6 @@ def last_window_spectra(
     except PRSMHealthError:  # the diagnosis stands; the asset keeps its previous spectra
         log.warning("no spectra for asset %r", asset_id, exc_info=True)
         return None
-    window = windows[-1].get("window") if windows else None
     return spectra_row(asset_id, spectra, window=window, channel=SPECTRA_CHANNEL, **row)
 
 
@@ -265,9 +327,9 @@ def diagnose_body(
 ) -> Answer:
     """``POST /v1/diagnose``: a JSON body (``fmt`` ``"json"``, fields in the body) or a binary
     recording (``params`` from the query) → the Diagnosis contract (``windows`` only when the
-    recording spans more than one model window) and, with an ``asset_id``, its history row
-    and the recording's diagnosis for the asset's history, made with the asset's
-    ``baseline`` (loaded for the asset the request names)."""
+    recording spans more than one model window); with an ``asset_id``, the diagnosis made
+    with the asset's ``baseline`` (loaded for the asset the request names) for the server to
+    record."""
     notes: list[str] = []
     if fmt == "json":
         req = parse_diagnose_request(body, limits)
@@ -298,41 +360,40 @@ def diagnose_body(
     diagnosis = diagnose(run, bundle, windows=_windows(run, cut), baseline=base)
     if notes:
         diagnosis.warnings[:0] = notes
-    result = json_ready(diagnosis.to_json())
-    windows = result.get("windows", [])
-    if len(windows) <= 1:
-        result.pop("windows", None)
     if params.asset_id is None:
+        result = json_ready(diagnosis.to_json())
+        if len(result.get("windows", [])) <= 1:
+            result.pop("windows", None)
         return Answer(encode(result))
-    history = history_rows(
+    asset = AssetRequest(
         params.asset_id,
-        [_row_fields(result)],
-        received_at=received_at,
-        source=fmt,
-        speed=params.speed,
-        load=params.load,
-        operating_hours=params.operating_hours,
-    )
-    spectra = last_window_spectra(
-        cut[0][-1],
-        bundle,
-        params.asset_id,
-        windows,
-        received_at=received_at,
-        source=fmt,
-        operating_hours=params.operating_hours,
-    )
-    part = AssetPart(
-        params.asset_id,
-        params.recording_id or (content_id(body) if fmt != "json" else run_id(run)),
-        dataclasses.replace(diagnosis, windows=[]),
+        params.recording_id or (content_id(body) if fmt != "json" else run_content_id(run)),
         source=fmt,
         healthy=params.healthy,
         operating_hours=params.operating_hours,
-        inner=b',"windows":' + encode(windows) if "windows" in result else b"",
-        row=0,
+        speed=params.speed,
+        load=params.load,
     )
-    return Answer(b"", history, spectra, part)
+    return Answer(
+        diagnosis=diagnosis,
+        asset=asset,
+        spectra=_spectra(cut, bundle, diagnosis, asset, received_at),
+    )
+
+
+def _spectra(cut, bundle, diagnosis: Diagnosis, asset: AssetRequest, received_at: str):
+    """The spectra row of the recording's last window (:func:`last_window_spectra`)."""
+    window = diagnosis.windows[-1].to_json().get("window") if diagnosis.windows else None
+    return last_window_spectra(
+        cut[0][-1],
+        bundle,
+        asset.asset_id,
+        window,
+        received_at=received_at,
+        source=asset.source,
+        filename=asset.filename,
+        operating_hours=asset.operating_hours,
+    )
 
 
 def _what(fmt: str) -> str:
@@ -372,15 +433,13 @@ def diagnose_upload(
     recording_id: str | None = None,
 ) -> Answer:
     """``POST /v1/diagnose/file``: the whole-recording diagnosis, the per-window ones, what
-    was read and the reader's notes; with an ``asset_id``, the windows' history rows and the
-    recording's diagnosis for the asset's history, made with the asset's ``baseline``."""
+    was read and the reader's notes; with an ``asset_id``, the diagnosis made with the asset's
+    ``baseline`` for the server to record."""
     run, notes = read_upload(upload, limits)
     check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
     cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
     base = None if baseline is None else baseline.get(asset_id)
     diagnosis = diagnose(run, bundle, windows=_windows(run, cut), baseline=base)
-    result = json_ready(diagnosis.to_json())
-    per_window = result.pop("windows", [])
     recording = {
         "filename": upload.filename,
         "samples": len(run),
@@ -388,37 +447,45 @@ def diagnose_upload(
         "duration": float(len(run) / run.sample_rate),
         "channels": [c for c in CHANNEL_NAMES if c in run.channels],
     }
-    rest = {"windows": per_window, "recording": recording, "warnings": notes}
+    rest = {"recording": recording, "warnings": notes}
     if asset_id is None:
-        return Answer(encode({"diagnosis": result, **rest}))
-    received_at = received_at or utc_now()
-    history = history_rows(
-        asset_id,
-        per_window,
-        received_at=received_at,
-        source="file",
-        filename=upload.filename,
-    )
-    spectra = last_window_spectra(
-        cut[0][-1],
-        bundle,
-        asset_id,
-        per_window,
-        received_at=received_at,
-        source="file",
-        filename=upload.filename,
-    )
+        result = json_ready(diagnosis.to_json())
+        per_window = result.pop("windows", [])
+        return Answer(encode({"diagnosis": result, "windows": per_window, **rest}))
     if recording_id is None:  # the file's content, with its column map's
-        maps = () if upload.column_map is None else (upload.column_map,)
-        recording_id = content_id(upload.path, *maps)
-    part = AssetPart(
-        asset_id,
-        recording_id,
-        dataclasses.replace(diagnosis, windows=[]),
-        source="file",
-        filename=upload.filename,
-        healthy=healthy,
-        head=b'{"diagnosis":',
-        tail=b"," + encode(rest)[1:],
+        recording_id = content_id(upload.path, upload.column_map)
+    asset = AssetRequest(
+        asset_id, recording_id, source="file", filename=upload.filename, healthy=healthy
     )
-    return Answer(b"", history, spectra, part)
+    spectra = _spectra(cut, bundle, diagnosis, asset, received_at)
+    return Answer(diagnosis=diagnosis, asset=asset, spectra=spectra, upload=rest)
+
+
+@dataclass(frozen=True)
+class BaselineFor:
+    """The baseline of the asset a request names, as it crosses to the diagnosis worker
+    (:func:`prsm_health.monitoring.asset_baseline`, loaded in the server; None while the
+    asset's baseline is incomplete)."""
+
+    asset_id: str
+    baseline: Baseline | None = None
+
+    def get(self, asset_id: str | None) -> Baseline | None:
+        """The baseline, when the request's asset is the one it was loaded for (a JSON
+        body's asset id is found before the body is parsed: :func:`peek_asset_id`)."""
+        return self.baseline if asset_id == self.asset_id else None
+
+
+_ASSET_KEY = re.compile(rb'"asset_id"\s*:\s*"([A-Za-z0-9][A-Za-z0-9._:-]{0,127})"')
+
+
+def peek_asset_id(body: bytes) -> str | None:
+    """The asset id of a JSON body, found without parsing it (megabytes of samples): the last
+    ``"asset_id": "…"`` key and plain value. Only a hint for loading the baseline before the
+    diagnosis — the worker uses the baseline only for the asset id it parses
+    (:meth:`BaselineFor.get`)."""
+    at = body.rfind(b'"asset_id"')
+    if at < 0:
+        return None
+    found = _ASSET_KEY.match(body, at)
+    return None if found is None else found.group(1).decode()

@@ -30,7 +30,7 @@ def model_info(bundle, model_file: Path | None) -> dict:
 
 def metrics_summary(model_path: Path | None, metadata: dict) -> dict | None:
     """Training metrics: from the bundle metadata, else the ``<stem>.metrics.json`` that
-    :func:`prsm_health.diagnostics.training.train` writes beside the model."""
+    :func:`prsm_health.training.train.train` writes beside the model."""
     metrics = metadata.get("metrics")
     if metrics is None and model_path is not None:
         side = model_path.with_name(model_path.stem + ".metrics.json")

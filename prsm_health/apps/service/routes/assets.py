@@ -10,7 +10,8 @@ import anyio
 from fastapi import APIRouter, Query, Request
 from fastapi import Path as PathParam
 
-from ..history import HistoryStore
+from prsm_health.monitoring.sqlite_store import HistoryStore
+
 from ..responses import HTTPError, encode, json_response
 from ..schemas import (
     ASSET_ID_PATTERN,

@@ -5,9 +5,9 @@ from typing import Annotated
 from fastapi import Depends, Request
 
 from prsm_health.diagnostics.diagnosis import ModelBundle
+from prsm_health.monitoring.sqlite_store import HistoryStore
 from prsm_health.prognostics import RULModel as _PrognosticsModel
 
-from ..history import HistoryStore
 from ..limits import ServiceLimits
 from ..workers import WorkerPool
 

@@ -6,10 +6,18 @@ import anyio
 from fastapi import APIRouter, Request
 
 from prsm_health.actuator.design import PRESETS
+from prsm_health.monitoring import asset_baseline
+from prsm_health.monitoring.sqlite_store import utc_now
 
-from ..diagnosing import BodyParams, check_asset_fields, diagnose_body, diagnose_upload
-from ..evidence import load_baseline, peek_asset_id, record
-from ..history import utc_now
+from ..diagnosing import (
+    BaselineFor,
+    BodyParams,
+    check_asset_fields,
+    diagnose_body,
+    diagnose_upload,
+    peek_asset_id,
+    record_and_encode,
+)
 from ..limits import MAX_OPERATING_HOURS
 from ..responses import HTTPError, json_response
 from ..schemas import (
@@ -217,9 +225,7 @@ async def post_diagnose(
     with workers.admitted():
         body = await request.body()
         asset_id = params.asset_id if params is not None else peek_asset_id(body)
-        baseline = None
-        if asset_id is not None:
-            baseline = await anyio.to_thread.run_sync(load_baseline, store, bundle, asset_id)
+        baseline = await load_baseline(store, bundle, asset_id)
         answer = await workers.diagnose(
             diagnose_body, body, fmt, params, limits, received_at, baseline
         )
@@ -227,16 +233,20 @@ async def post_diagnose(
     return json_response(await store_answer(store, bundle, answer, received_at))
 
 
+async def load_baseline(store, bundle, asset_id: str | None) -> BaselineFor | None:
+    """The baseline of the asset a request names (None without one), for the worker."""
+    if asset_id is None:
+        return None
+    baseline = await anyio.to_thread.run_sync(asset_baseline, store, bundle, asset_id)
+    return BaselineFor(asset_id, baseline)
+
+
 async def store_answer(store, bundle, answer, received_at: str) -> bytes:
-    """Store what a diagnosis gave for an asset — recorded in the asset's history with the
-    request's rows (:func:`~..evidence.record`), or the rows alone — and the answer."""
-    if answer.asset is not None:
-        return await anyio.to_thread.run_sync(
-            record, store, bundle, answer.asset, answer.history, answer.spectra, received_at
-        )
-    if answer.history:
-        await anyio.to_thread.run_sync(store.add_rows, answer.history, answer.spectra)
-    return answer.encoded
+    """The answer; with an asset, once recorded in its history with the request's rows
+    (:func:`~..diagnosing.record_and_encode`)."""
+    if answer.asset is None:
+        return answer.encoded
+    return await anyio.to_thread.run_sync(record_and_encode, store, bundle, answer, received_at)
 
 
 @router.post(
@@ -270,9 +280,7 @@ async def post_diagnose_file(
             healthy = form_healthy(upload.fields.get("healthy"))
             recording_id = upload.fields.get("recording_id")
             check_asset_fields(asset_id, healthy, recording_id)
-            baseline = None
-            if asset_id is not None:
-                baseline = await anyio.to_thread.run_sync(load_baseline, store, bundle, asset_id)
+            baseline = await load_baseline(store, bundle, asset_id)
             answer = await workers.diagnose(
                 diagnose_upload,
                 upload.received(),

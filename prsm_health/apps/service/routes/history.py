@@ -8,7 +8,8 @@ from fastapi import APIRouter, Depends, Query, Request
 from fastapi import Path as PathParam
 from fastapi.exceptions import RequestValidationError
 
-from ..history import parse_time
+from prsm_health.monitoring.sqlite_store import parse_time
+
 from ..responses import HTTPError, encode, json_response
 from ..schemas import ASSET_ID_PATTERN, ERROR_RESPONSES, Error, History
 from .deps import Limits, Store

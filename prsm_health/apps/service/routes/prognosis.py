@@ -1,5 +1,5 @@
 """``GET /v1/assets/{asset_id}/prognosis``: the asset's stored diagnoses with operating hours
-as a history (:func:`~..history.prognosis_history`) → the library's prognosis
+as a history (:func:`prsm_health.prognostics.history_of_readings`) → the library's prognosis
 (:func:`prsm_health.prognostics.prognose`) with the service's prognostics model."""
 
 from typing import Annotated, Literal
@@ -8,9 +8,9 @@ import anyio
 from fastapi import APIRouter, Query
 from fastapi import Path as PathParam
 
-from prsm_health.prognostics import METHODS, HistoryError, prognose
+from prsm_health.monitoring.sqlite_store import HistoryStore
+from prsm_health.prognostics import METHODS, HistoryError, history_of_readings, prognose
 
-from ..history import HistoryStore, prognosis_history
 from ..responses import HTTPError, encode, json_response
 from ..schemas import ASSET_ID_PATTERN, Error, Prognosis
 from .deps import RULModel, Store
@@ -31,7 +31,7 @@ def asset_prognosis(store: HistoryStore, model, asset_id: str, method: str | Non
         raise HTTPError(503, NO_MODEL)
     if not store.has_asset(asset_id):
         raise HTTPError(404, f"no diagnoses stored for asset {asset_id!r}")
-    history, notes = prognosis_history(store.operating_history(asset_id))
+    history, notes = history_of_readings(store.operating_history(asset_id))
     if len(history) < 2:
         raise HTTPError(
             422,

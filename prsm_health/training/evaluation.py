@@ -421,7 +421,7 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
     """
     from prsm_health.signals.features import dataset_features
 
-    from .diagnosis import diagnose_indicators
+    from prsm_health.diagnostics.diagnosis import diagnose_indicators
 
     require(split in ("test", "train", "all"), "split", split, "must be test, train or all")
     runs = dataset.runs if split == "all" else dataset.runs[dataset.runs["split"] == split]
@@ -478,7 +478,7 @@ def _num(value) -> float:
 
 
 def _ood_limit() -> float:
-    from .diagnosis import OOD_LIMIT
+    from prsm_health.diagnostics.diagnosis import OOD_LIMIT
 
     return OOD_LIMIT
 
@@ -516,7 +516,7 @@ def fault_report(records: pd.DataFrame) -> dict:
     their mean size, and per true class the share of runs whose set holds each class."""
     from sklearn.metrics import confusion_matrix
 
-    from .diagnosis import CANNOT_TELL
+    from prsm_health.diagnostics.diagnosis import CANNOT_TELL
 
     y = records["fault_class"].astype(str).to_numpy()
     pred = records["predicted_class"].astype(str).to_numpy()

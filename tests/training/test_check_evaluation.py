@@ -6,7 +6,7 @@ import types
 
 import pytest
 
-from prsm_health.diagnostics.check_evaluation import (
+from prsm_health.training.check_evaluation import (
     _accumulated,
     _class_scores,
     _sensitivity,
@@ -117,7 +117,7 @@ def test_the_evidence_rule_trade_off_names_each_unit_from_its_posterior():
 def test_two_state_checks_are_a_degraded_lubricant_under_another_label():
     import pandas as pd
 
-    from prsm_health.diagnostics.check_training import two_states
+    from prsm_health.training.check_training import two_states
 
     table = pd.DataFrame(
         {

@@ -6,7 +6,7 @@ for their own actuator (another recipe file, another instrumentation):
 1. :func:`default_recipe` — the domain-randomised reference recipe
    (``datasets/flight-ema-reference.toml``), or another one measured by another profile;
 2. :func:`train_default_model` — generates it (resumable), trains the clearance estimator and
-   the fault classifier (:func:`prsm_health.diagnostics.training.train`, 3-fold CV), evaluates
+   the fault classifier (:func:`prsm_health.training.train.train`, 3-fold CV), evaluates
    them (:func:`evaluate_default_model`), measures what each indicator group adds
    (:func:`ablation`) and writes the metrics and the model card (:func:`write_model_card`);
 3. :func:`evaluate_default_model` — the model through the diagnosis (gates, OOD score,
@@ -34,15 +34,15 @@ import numpy as np
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, Recipe, generate, load_recipe
 
-from .check_evaluation import check_card_section
-from .diagnosis import DEFAULT_MODEL, OOD_LIMIT, diagnose, load_bundle
-from .evaluation import (
+from prsm_health.training.check_evaluation import check_card_section
+from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, OOD_LIMIT, diagnose, load_bundle
+from prsm_health.training.evaluation import (
     clearance_report,
     evaluate_model,
     fault_report,
     sensitivity_table,
 )
-from .training import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target, train
+from prsm_health.training.train import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target, train
 
 #: The reference recipe of the shipped model (repository layout, like :data:`DEFAULT_MODEL`).
 REFERENCE_RECIPE = DEFAULT_MODEL.parents[1] / "datasets" / "flight-ema-reference.toml"
@@ -173,8 +173,8 @@ def default_severity(
     Returns
     -------
     dict
-        ``per_class``, ``fault`` (:func:`~prsm_health.diagnostics.evaluation.fault_report`) and
-        ``clearance`` (:func:`~prsm_health.diagnostics.evaluation.clearance_report`).
+        ``per_class``, ``fault`` (:func:`~prsm_health.training.evaluation.fault_report`) and
+        ``clearance`` (:func:`~prsm_health.training.evaluation.clearance_report`).
     """
     import pandas as pd
 
@@ -276,7 +276,7 @@ def ablation(dataset_dir: str | Path, features: list[str]) -> list[dict]:
 
     from prsm_health.signals.features import GROUPS, dataset_features
 
-    from .estimators import ClearanceEstimator, FaultClassifier
+    from prsm_health.diagnostics.estimators import ClearanceEstimator, FaultClassifier
 
     table = dataset_features(Dataset(dataset_dir))
     train_rows, test_rows = table[table["split"] == "train"], table[table["split"] == "test"]
@@ -327,7 +327,7 @@ def evaluate_default_model(
     Returns
     -------
     metrics : dict
-        ``off_grid`` (:func:`~prsm_health.diagnostics.evaluation.evaluate_model`'s report),
+        ``off_grid`` (:func:`~prsm_health.training.evaluation.evaluate_model`'s report),
         ``sensitivity``, ``default_severity`` and ``honesty``.
     records : pandas.DataFrame
         The off-grid set's per-run records (for ``plot_evaluation``).
@@ -410,7 +410,7 @@ def train_default_model(
     ------
     PRSMHealthError
         ``evaluate_only`` without a model and its metrics in ``out_dir``; the errors of
-        :func:`~prsm_health.diagnostics.training.train` and of generation.
+        :func:`~prsm_health.training.train.train` and of generation.
     """
     out_dir, work = Path(out_dir), Path(work)
     reference = default_recipe() if reference is None else reference

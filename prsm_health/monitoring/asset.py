@@ -1,10 +1,9 @@
-"""An asset's recorded history — its baseline, accumulated evidence and change statistic — and
-the store of histories on disk that the CLI uses.
+"""An asset's recorded history — its baseline, accumulated evidence and change statistic.
 
 An **asset** is one unit (one actuator) recorded again and again over its life. Its history
 is a sequence of :class:`AssetEntry`, one per recording, in the order the recordings reached
-it, and the sequential state they built: the class :class:`~.baseline.Evidence` and the
-:class:`~.baseline.Cusum` on the baseline distance. :meth:`AssetHistory.record` adds one
+it, and the sequential state they built: the class :class:`~.evidence.Evidence` and the
+:class:`~.evidence.Cusum` on the baseline distance. :meth:`AssetHistory.record` adds one
 diagnosed recording and attaches the asset's state to the diagnosis (``Diagnosis.asset``):
 
 * while the baseline is incomplete (fewer than :data:`BASELINE_RECORDINGS` recordings in
@@ -16,30 +15,32 @@ diagnosed recording and attaches the asset's state to the diagnosis (``Diagnosis
 * recording the same ``recording_id`` again changes nothing: the diagnosis comes back with
   the state stored the first time (an interrupted or repeated run counts each recording once).
 
-:class:`AssetStore` keeps one JSON file per asset in a directory, written atomically; a file
-it cannot read is an error naming the file, never a silent fresh start.
+The histories are kept by a store (:mod:`.store`: one JSON file per asset for the CLI, an
+SQLite database for the service) and changed by the steps of :mod:`.steps`, which the CLI and
+the service both call.
 """
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import hashlib
-import json
 import math
 import re
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
-from urllib.parse import quote, unquote
 
-from prsm_health.core.atomic import write_atomic
-from prsm_health.core.errors import PRSMHealthError, require
+from prsm_health.core.errors import require
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
-from prsm_health.core.jsonable import dumps, finite_or_none
+from prsm_health.core.jsonable import finite_or_none
+from prsm_health.diagnostics.baseline import Baseline
+from prsm_health.diagnostics.contract import (
+    CANNOT_TELL,
+    AssetState,
+    BaselineState,
+    Diagnosis,
+    EvidenceState,
+)
 
-from .baseline import EVIDENCE_NAME_PROBABILITY, Baseline, Cusum, Evidence
-from .contract import CANNOT_TELL, AssetState, BaselineState, Diagnosis, EvidenceState
+from .evidence import EVIDENCE_NAME_PROBABILITY, Cusum, Evidence
 
 #: Recordings a baseline needs before recordings are scored against it. Three is the fewest
 #: whose median is robust (one odd recording of three cannot move it beyond the other two)
@@ -77,7 +78,7 @@ def bundle_priors(bundle, check: bool = True) -> tuple[dict | None, dict | None,
     """What a model bundle tells a unit's history about one kind of recording: (prior scale per
     indicator — the within-unit repeatability, training prior per class, the indicators a
     baseline of that kind is of). A health check (``check``) and a bundle with a check part
-    (:class:`~.check_model.CheckModel`): the check model's; otherwise the window model's
+    (:class:`~prsm_health.diagnostics.check_model.CheckModel`): the check model's; otherwise the window model's
     indicators, no prior scale and no training prior (the defaults of
     :meth:`AssetHistory.record`). A unit's check recordings and its in-service windows have
     baselines of their own: their indicators differ."""
@@ -92,21 +93,6 @@ def bundle_priors(bundle, check: bool = True) -> tuple[dict | None, dict | None,
         )
     names = getattr(bundle, "feature_names", None)
     return None, None, (list(names) if names else None)
-
-
-def file_recording_id(*paths: str | Path) -> str:
-    """A recording's identifier from its file's content (and its column map's, if given):
-    the same recording under another name or path is the same recording."""
-    digest = hashlib.sha256()
-    for path in paths:
-        if path is None:
-            continue
-        try:
-            digest.update(Path(path).read_bytes())
-        except OSError as err:
-            raise PRSMHealthError(f"{path}: cannot read ({err.strerror})") from None
-        digest.update(b"\0")
-    return digest.hexdigest()[:16]
 
 
 def _by_size(changes: Mapping[str, float]) -> dict[str, float]:
@@ -143,7 +129,13 @@ class AssetEntry:
     state : AssetState or None
         The asset's state attached to the diagnosis when it was recorded.
     source : str
-        What the recording was (a file name), for people.
+        How the recording came: ``file`` (a file read by the CLI or uploaded to the
+        service) or the body format of a service request (``json``, ``arrow``, ``parquet``,
+        ``mcap``).
+    filename : str or None
+        The recording's file name, for people.
+    healthy : bool or None
+        The label given with the recording (None: not said).
     """
 
     recording_id: str
@@ -157,6 +149,8 @@ class AssetEntry:
     distance: float | None = None
     state: AssetState | None = None
     source: str = ""
+    filename: str | None = None
+    healthy: bool | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "state", AssetState.of(self.state))
@@ -242,6 +236,7 @@ class AssetHistory:
         training_prior: Mapping[str, float] | None = None,
         names: Sequence[str] | None = None,
         source: str = "",
+        filename: str | None = None,
     ) -> tuple[AssetHistory, Diagnosis]:
         """Add a diagnosed recording: the new history, and the diagnosis with
         ``asset`` (an :class:`AssetState`) attached.
@@ -268,8 +263,8 @@ class AssetHistory:
             None or when it lacks one of the diagnosis's classes.
         names : sequence of str or None
             The indicators of the baseline (default: every one finite in all its recordings).
-        source : str
-            What the recording was (a file name), kept for people.
+        source, filename : str
+            How the recording came and its file name (:class:`AssetEntry`), kept for people.
 
         Returns
         -------
@@ -383,6 +378,8 @@ class AssetHistory:
             distance=distance,
             state=state,
             source=str(source or ""),
+            filename=filename,
+            healthy=healthy,
         )
         history = AssetHistory(self.asset_id, (*self.entries, entry), evidence, cusum)
         return history, dataclasses.replace(
@@ -421,6 +418,7 @@ class AssetHistory:
                 {
                     "recording_id": e.recording_id,
                     "source": e.source,
+                    "filename": e.filename,
                     "time": e.time,
                     "operating_hours": e.operating_hours,
                     "baseline": e.baseline,
@@ -480,163 +478,13 @@ class AssetHistory:
         )
 
 
-class AssetStore:
-    """Asset histories on disk: one JSON file per asset in ``directory`` (created on the
-    first save).
-
-    The file of an asset is its id (``:`` percent-encoded) with ``.json``. :meth:`save` writes
-    a temporary file beside it and renames it over the old one, so a reader (or a run that
-    was interrupted) finds the old history or the new one, never half of one.
-    :meth:`locked` serialises the load–record–save of one asset between processes.
-    """
-
-    SUFFIX = ".json"
-
-    def __init__(self, directory: str | Path):
-        self.directory = Path(directory)
-
-    def path(self, asset_id: str) -> Path:
-        """The file of ``asset_id``."""
-        return self.directory / (quote(validate_asset_id(asset_id), safe="") + self.SUFFIX)
-
-    def load(self, asset_id: str) -> AssetHistory:
-        """The history of ``asset_id``; a new, empty one if it has none.
-
-        Raises
-        ------
-        PRSMHealthError
-            The file exists and cannot be read as a history (truncated, edited, another
-            asset's): the message names the file, which is left as it is.
-        """
-        path = self.path(asset_id)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            return AssetHistory(asset_id)
-        except (OSError, UnicodeDecodeError) as err:
-            raise PRSMHealthError(f"{path}: cannot read the asset history ({err})") from None
-        try:
-            history = AssetHistory.from_json(json.loads(text))
-        except (ValueError, KeyError, TypeError, AttributeError) as err:
-            reason = err if isinstance(err, PRSMHealthError) else f"{type(err).__name__}: {err}"
-            raise PRSMHealthError(
-                f"{path}: not a readable asset history ({reason}); it was left as it is — "
-                "restore it, or move it aside to start the asset afresh"
-            ) from None
-        if history.asset_id != asset_id:
-            raise PRSMHealthError(
-                f"{path}: holds asset {history.asset_id!r}, not {asset_id!r} (asset ids that "
-                "differ only in case share a file on a case-insensitive file system)"
-            )
-        return history
-
-    def save(self, history: AssetHistory) -> None:
-        """Write ``history`` atomically (temporary file, fsync, rename)."""
-        path = self.path(history.asset_id)
-        data = dumps(history.to_json(), indent=1).encode("utf-8")
-        try:
-            self.directory.mkdir(parents=True, exist_ok=True)
-        except OSError as err:
-            raise PRSMHealthError(
-                f"{self.directory}: cannot write asset histories there ({err.strerror})"
-            ) from None
-        write_atomic(path, data, "the asset history")
-
-    def assets(self) -> list[str]:
-        """The ids of the assets stored, sorted."""
-        if not self.directory.is_dir():
-            return []
-        found = []
-        for p in self.directory.iterdir():
-            if p.suffix != self.SUFFIX or p.name.startswith("."):
-                continue
-            asset_id = unquote(p.name[: -len(self.SUFFIX)])
-            if re.fullmatch(ASSET_ID_PATTERN, asset_id):
-                found.append(asset_id)
-        return sorted(found)
-
-    @contextlib.contextmanager
-    def locked(self, asset_id: str) -> Iterator[None]:
-        """Hold the asset's lock (an advisory lock file beside its history, where the system
-        has ``fcntl``): two processes recording the same asset take turns instead of one
-        overwriting the other's entry."""
-        path = self.path(asset_id)
-        try:
-            import fcntl
-        except ImportError:  # no advisory locks (Windows): the atomic save still holds
-            yield
-            return
-        try:
-            self.directory.mkdir(parents=True, exist_ok=True)
-            handle = open(path.with_name(f".{path.name}.lock"), "a")  # noqa: SIM115
-        except OSError as err:
-            raise PRSMHealthError(
-                f"{self.directory}: cannot write asset histories there ({err.strerror})"
-            ) from None
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX)
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
-            handle.close()
-
-
-def diagnose_asset(
-    run,
-    bundle,
-    store: AssetStore,
-    asset_id: str,
-    recording_id: str,
-    *,
-    healthy: bool | None = None,
-    operating_hours: float | None = None,
-    time: str = "",
-    window: float | None = None,
-    source: str = "",
-) -> Diagnosis:
-    """Diagnose a recording of an asset against the asset's history in ``store``, record it
-    and save the history: the diagnosis with its ``asset`` state (what ``prsm-health diagnose
-    --asset`` does).
-
-    The asset's lock is held from load to save; the baseline's indicators and priors come from
-    the bundle (:func:`bundle_priors`). A recording already recorded is diagnosed again and shown with the
-    state stored then; the history is not written again.
-    """
-    from .diagnosis import diagnose  # the model's dependencies only when diagnosing
-
-    validate_asset_id(asset_id)
-    from .check_model import is_check
-
-    prior_scale, training_prior, names = bundle_priors(bundle, check=is_check(run))
-    with store.locked(asset_id):
-        history = store.load(asset_id)
-        baseline = history.baseline(prior_scale, names)
-        diagnosis = diagnose(run, bundle, window=window, baseline=baseline)
-        new, diagnosis = history.record(
-            recording_id,
-            diagnosis,
-            healthy=healthy,
-            operating_hours=operating_hours,
-            time=time,
-            prior_scale=prior_scale,
-            training_prior=training_prior,
-            names=names,
-            source=source,
-        )
-        if new is not history:
-            store.save(new)
-    return diagnosis
-
-
 __all__ = [
     "ASSET_ID_PATTERN",
     "BASELINE_RECORDINGS",
+    "HEALTHY",
     "AssetEntry",
     "AssetHistory",
-    "AssetStore",
     "bundle_priors",
-    "diagnose_asset",
-    "file_recording_id",
     "names_a_fault",
     "validate_asset_id",
 ]

@@ -1,4 +1,4 @@
-"""prsm_health.diagnostics.default_model: the shipped model's recipe, its evaluation sets, its
+"""prsm_health.release.diagnosis_model: the shipped model's recipe, its evaluation sets, its
 honesty checks and its card (tools/release/train_default_model.py is their command line).
 
 The recipe derivations and the card are checked without simulating; one slow test builds a
@@ -12,7 +12,7 @@ import pytest
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Recipe
-from prsm_health.diagnostics.default_model import (
+from prsm_health.release.diagnosis_model import (
     DEFAULT_SEVERITY,
     HONESTY_CASES,
     REFERENCE_RECIPE,

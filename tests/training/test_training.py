@@ -1,4 +1,4 @@
-"""prsm_health.diagnostics.training: datasets too small to train on, the model-file suffix, useless models.
+"""prsm_health.training.train: datasets too small to train on, the model-file suffix, useless models.
 
 Generating runs is the expensive part, so one tiny dataset (8 runs of 0.1 s at 5 kHz) is
 generated per module; it is too small to train on, which is what the refusal tests need. The
@@ -18,9 +18,9 @@ from prsm_health.actuator.states import HealthState
 from prsm_health.apps.cli import main
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, FaultThresholds, Recipe, generate
-from prsm_health.diagnostics import training
-from prsm_health.diagnostics.evaluation import SparseFeatureError
-from prsm_health.diagnostics.training import (
+from prsm_health.training import train as training
+from prsm_health.training.evaluation import SparseFeatureError
+from prsm_health.training.train import (
     calibration_minimums,
     fit_minimum,
     operating_point,

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .contract import CANNOT_TELL
+from prsm_health.diagnostics.contract import CANNOT_TELL
 
 #: Fresh units: a seed the training recipes never used.
 EVAL_UNITS_SEED = 7373
@@ -150,9 +150,10 @@ def evaluate_check_model(bundle, datasets: dict, *, threshold: float = 0.9) -> d
     """
     from prsm_health.datasets import Dataset
 
-    from .baseline import Baseline, Evidence
-    from .check_model import CheckModel
-    from .diagnosis import diagnose
+    from prsm_health.monitoring.evidence import Evidence
+    from prsm_health.diagnostics.baseline import Baseline
+    from prsm_health.diagnostics.check_model import CheckModel
+    from prsm_health.diagnostics.diagnosis import diagnose
 
     model = CheckModel.from_part(bundle.check)
     base = Dataset(datasets["baseline"])
@@ -307,7 +308,7 @@ def _accumulated(units, model, threshold) -> dict:
         well = [u["posterior"].get("spall", 0.0) for u in units if u["state"] == "healthy"]
         if sick and well:
             auc[state] = float(roc_auc_score([1] * len(sick) + [0] * len(well), sick + well))
-    from .baseline import named_class
+    from prsm_health.monitoring.evidence import named_class
 
     trade_off = []
     for t in EVIDENCE_THRESHOLDS:

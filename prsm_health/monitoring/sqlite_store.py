@@ -1,8 +1,9 @@
-"""Diagnoses per asset over time: :class:`HistoryStore` (embedded SQLite, WAL journal), its
-default location (:func:`default_db_path`), its time format (:func:`utc_now`,
-:func:`parse_time`), the table a prognosis is made from (:func:`prognosis_history`) and each
-asset's latest window spectra (:func:`spectra_row`). Each asset's own history — its baseline
-and accumulated evidence — is kept in the store's asset tables (:mod:`.asset_tables`)."""
+"""The service's store: diagnoses per asset over time in an embedded SQLite database
+(:class:`HistoryStore`, WAL journal), its default location (:func:`default_db_path`), its time
+format (:func:`utc_now`, :func:`parse_time`) and each asset's latest window spectra
+(:func:`spectra_row`). Each asset's own history — its baseline and accumulated evidence — is
+kept in the store's asset tables (:mod:`.sqlite_assets`), through the
+:class:`~.store.AssetStore` interface the CLI's file store offers too."""
 
 from __future__ import annotations
 
@@ -19,15 +20,7 @@ from typing import NamedTuple
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps, json_ready
 
-from .asset_tables import (  # noqa: F401 (re-exported: the rows of the store's tables)
-    ASSET_SCHEMA,
-    AssetTables,
-    AssetUpdate,
-    RecordingRow,
-    StoredHistory,
-    _insert,
-    _named,
-)
+from .sqlite_assets import ASSET_SCHEMA, AssetTables, HistoryCache, insert_statement, named_rows
 
 #: Environment variable overriding the default history database path.
 DB_ENV = "PRSM_HEALTH_DB"
@@ -139,8 +132,8 @@ class OperatingRow(NamedTuple):
     design: str | None
 
 
-_INSERT_DIAGNOSIS = _insert("INSERT", "diagnoses", DiagnosisRow)
-_INSERT_SPECTRA = _insert("INSERT OR REPLACE", "spectra", SpectraRow)
+_INSERT_DIAGNOSIS = insert_statement("INSERT", "diagnoses", DiagnosisRow)
+_INSERT_SPECTRA = insert_statement("INSERT OR REPLACE", "spectra", SpectraRow)
 
 
 def utc_now() -> str:
@@ -189,10 +182,9 @@ class HistoryStore(AssetTables):
                 raise PRSMHealthError(f"{self.path}: directory {parent} does not exist")
             if Path(self.path).is_dir():
                 raise PRSMHealthError(f"{self.path}: is a directory, not a database file")
-        self._lock = threading.Lock()
-        #: Parsed asset histories, by asset and stored version, kept by
-        #: :mod:`prsm_health.apps.service.evidence` (one per store: versions are per database).
-        self.parsed_histories = None
+        self._lock = threading.RLock()
+        #: Parsed asset histories, by asset and stored version (versions are per database)
+        self._parsed = HistoryCache()
         try:
             self._conn = sqlite3.connect(
                 self.path, timeout=timeout, isolation_level=None, check_same_thread=False
@@ -238,6 +230,10 @@ class HistoryStore(AssetTables):
 
     @contextlib.contextmanager
     def _transaction(self):
+        """One write transaction (under ``self._lock``); inside one already, that one."""
+        if self._conn.in_transaction:
+            yield
+            return
         self._conn.execute("BEGIN IMMEDIATE")
         try:
             yield
@@ -302,7 +298,7 @@ class HistoryStore(AssetTables):
             total = self._conn.execute(
                 f"SELECT COUNT(*) FROM diagnoses WHERE {where}", args
             ).fetchone()[0]
-            rows = _named(
+            rows = named_rows(
                 self._conn.execute(
                     "SELECT id, received_at, source, filename, window_index, window_start,"
                     " window_end, speed, load, operating_hours, diagnosis FROM diagnoses"
@@ -334,7 +330,7 @@ class HistoryStore(AssetTables):
         receive time and id (the latest received last), the design being the diagnosing
         model's (``model.design`` of the stored diagnosis)."""
         with self._lock:
-            rows = _named(
+            rows = named_rows(
                 self._conn.execute(
                     "SELECT operating_hours, clearance_estimate, clearance_lower,"
                     " clearance_upper, fault_class,"
@@ -349,7 +345,7 @@ class HistoryStore(AssetTables):
     def spectra(self, asset_id: str) -> dict | None:
         """The asset's latest stored spectra (:func:`spectra_row`), or None."""
         with self._lock:
-            rows = _named(
+            rows = named_rows(
                 self._conn.execute("SELECT * FROM spectra WHERE asset_id = ?", (asset_id,))
             )
         if not rows:
@@ -401,7 +397,7 @@ class HistoryStore(AssetTables):
 
     def _summary(self, asset_id: str, count: int, first: str, last: str) -> dict:
         # under self._lock
-        (latest,) = _named(
+        (latest,) = named_rows(
             self._conn.execute(
                 "SELECT received_at, source, filename, window_index, window_start, window_end,"
                 " operating_hours, clearance_estimate, clearance_lower, clearance_upper,"
@@ -554,49 +550,3 @@ def spectra_row(
         channel=channel,
         spectra=text,
     )
-
-
-def prognosis_history(rows: list[OperatingRow]):
-    """The history table a prognosis is made from
-    (:func:`prsm_health.prognostics.prognose`), from :meth:`HistoryStore.operating_history`
-    rows, and notes on the rows left out.
-
-    ``age_hours`` is the stored operating hours; ``clearance``, ``clearance_lower``,
-    ``clearance_upper`` [m] the stored estimate and 90 % interval; ``design`` the diagnosing
-    model's; ``fault_class``. Of several diagnoses at the same operating hours only the latest
-    received is kept (a repeated reading replaces the earlier one); diagnoses without a
-    clearance estimate or interval (a model without a clearance estimator) carry nothing to
-    predict from and are left out, with a note.
-
-    Returns
-    -------
-    (pandas.DataFrame, list of str)
-        The table, oldest first (operating hours strictly increasing), and the notes.
-    """
-    import pandas as pd
-
-    from prsm_health.prognostics import HISTORY_COLUMNS
-
-    usable = [
-        r for r in rows if None not in (r.clearance_estimate, r.clearance_lower, r.clearance_upper)
-    ]
-    notes = []
-    if len(usable) < len(rows):
-        notes.append(
-            f"{len(rows) - len(usable)} stored diagnosis(es) with operating hours but without a "
-            "clearance estimate and interval were left out"
-        )
-    stored = {  # the history's column → the stored row's field
-        "age_hours": "operating_hours",
-        "clearance": "clearance_estimate",
-        "clearance_lower": "clearance_lower",
-        "clearance_upper": "clearance_upper",
-        "fault_class": "fault_class",
-        "design": "design",
-    }
-    table = pd.DataFrame(
-        {column: [getattr(r, name) for r in usable] for column, name in stored.items()},
-        columns=[*HISTORY_COLUMNS, "fault_class", "design"],
-    )
-    table = table.drop_duplicates("age_hours", keep="last").reset_index(drop=True)
-    return table, notes

@@ -1,26 +1,17 @@
-"""An asset's history (prsm_health.diagnostics.asset_history): the baseline fills with its first
+"""An asset's history (prsm_health.monitoring.asset): the baseline fills with its first
 recordings, then evidence and the change statistic accumulate; a recording recorded twice
-counts once; the history and its store on disk round-trip exactly, save atomically and refuse
-a damaged file by name. Synthetic diagnoses, no model."""
+counts once; the history round-trips exactly through JSON. Synthetic diagnoses, no model.
+The stores are tests/monitoring/test_store.py."""
 
 import json
 import math
-import os
 
 import numpy as np
 import pytest
 
-from prsm_health.core.errors import ParameterError, PRSMHealthError
+from prsm_health.core.errors import ParameterError
 from prsm_health.core.jsonable import dumps
-from prsm_health.diagnostics.asset_history import (
-    BASELINE_RECORDINGS,
-    AssetHistory,
-    AssetStore,
-    bundle_priors,
-    names_a_fault,
-    validate_asset_id,
-)
-from prsm_health.diagnostics.baseline import Baseline, Cusum, Evidence
+from prsm_health.diagnostics.baseline import Baseline
 from prsm_health.diagnostics.contract import (
     CANNOT_TELL,
     AssetState,
@@ -29,6 +20,14 @@ from prsm_health.diagnostics.contract import (
     ModelReference,
     Observability,
 )
+from prsm_health.monitoring.asset import (
+    BASELINE_RECORDINGS,
+    AssetHistory,
+    bundle_priors,
+    names_a_fault,
+    validate_asset_id,
+)
+from prsm_health.monitoring.evidence import Cusum, Evidence
 
 CLASSES = ("healthy", "lubrication", "wear")
 
@@ -211,66 +210,6 @@ def test_baseline_of_other_indicators_is_none():
     h, _ = recorded(BASE)
     assert h.baseline(PRIOR, names=["elsewhere"]) is None
     assert h.baseline(PRIOR, names=["b"]).names == ("b",)
-
-
-# ----------------------------------------------------------------------------- AssetStore
-def test_store_round_trip_and_listing(tmp_path):
-    store = AssetStore(tmp_path / "assets")
-    assert store.assets() == []
-    fresh = store.load("pump:7")
-    assert fresh == AssetHistory("pump:7")
-    h, _ = recorded(BASE)
-    h = AssetHistory("pump:7", h.entries, h.evidence, h.cusum)
-    store.save(h)
-    assert store.load("pump:7") == h
-    store.save(AssetHistory("A1"))
-    assert store.assets() == ["A1", "pump:7"]
-    assert store.path("pump:7").name == "pump%3A7.json"
-    # no temporary file left behind
-    assert sorted(p.name for p in store.directory.iterdir()) == ["A1.json", "pump%3A7.json"]
-
-
-def test_save_is_atomic(tmp_path, monkeypatch):
-    store = AssetStore(tmp_path)
-    h, _ = recorded(BASE[:1])
-    store.save(h)
-    before = store.path("unit-1").read_bytes()
-
-    def fail(src, dst):
-        raise OSError("disk full")
-
-    monkeypatch.setattr(os, "replace", fail)
-    longer, _ = recorded(BASE)
-    with pytest.raises(OSError):
-        store.save(longer)
-    # the old history intact, the temporary file removed
-    assert store.path("unit-1").read_bytes() == before
-    assert [p.name for p in tmp_path.iterdir()] == ["unit-1.json"]
-
-
-def test_a_damaged_file_is_an_error_naming_it(tmp_path):
-    store = AssetStore(tmp_path)
-    h, _ = recorded(BASE)
-    store.save(h)
-    path = store.path("unit-1")
-    text = path.read_text()
-    path.write_text(text[: len(text) // 2])  # truncated
-    with pytest.raises(PRSMHealthError, match="unit-1.json: not a readable asset history"):
-        store.load("unit-1")
-    assert path.read_text() == text[: len(text) // 2]  # left as it is
-    path.write_text(json.dumps({"format": 1, "asset_id": "unit-1"}))
-    with pytest.raises(PRSMHealthError, match="unit-1.json"):
-        store.load("unit-1")
-    path.write_text(json.dumps({**h.to_json(), "asset_id": "Unit-1"}))
-    with pytest.raises(PRSMHealthError, match="holds asset 'Unit-1'"):
-        store.load("unit-1")
-
-
-def test_lock_serialises_one_asset(tmp_path):
-    store = AssetStore(tmp_path)
-    with store.locked("u"):
-        store.save(AssetHistory("u"))
-    assert store.assets() == ["u"]
 
 
 def test_distance_is_finite_json(tmp_path):

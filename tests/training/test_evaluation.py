@@ -1,4 +1,4 @@
-"""prsm_health.diagnostics.evaluation: the fault metrics' names, sparse features in CV folds."""
+"""prsm_health.training.evaluation: the fault metrics' names, sparse features in CV folds."""
 
 import numpy as np
 import pandas as pd
@@ -7,7 +7,7 @@ from sklearn.ensemble import HistGradientBoostingClassifier
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import CANNOT_TELL
-from prsm_health.diagnostics.evaluation import (
+from prsm_health.training.evaluation import (
     SparseFeatureError,
     cross_validated_metrics,
     fault_report,

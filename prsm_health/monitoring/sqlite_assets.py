@@ -1,21 +1,27 @@
-"""The store's tables of each asset's own history (:class:`AssetTables`, a part of
-:class:`~.history.HistoryStore`): the history the library keeps
-(:class:`prsm_health.diagnostics.asset_history.AssetHistory`) stored as its head
-(``asset_histories``: evidence, change statistic, a version) and one row per entry
-(``asset_recordings``: the recording, whether it is in the baseline, its distance, the asset's
-state after it), written a recording at a time in the transaction of the request's diagnosis
-rows (:meth:`AssetTables.update_asset`), and read back as the asset's baseline, evidence and
-per-recording states."""
+"""The SQLite store's tables of each asset's own history (:class:`AssetTables`, a part of
+:class:`~.sqlite_store.HistoryStore`): the :class:`~.store.AssetStore` interface on SQLite.
+A history (:class:`~.asset.AssetHistory`) is stored as its head (``asset_histories``: evidence,
+change statistic, the version) and one row per entry (``asset_recordings``: the recording,
+whether it is in the baseline, its distance, the asset's state after it); a recording adds one
+row and rewrites the head, whatever the length of the history, in the transaction that also
+writes the request's diagnosis rows (:meth:`AssetTables.save`'s ``extra``)."""
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import json
 import sqlite3
-from collections.abc import Callable, Mapping
+import threading
+from collections import OrderedDict
+from collections.abc import Iterator, Mapping
 from typing import NamedTuple
 
 from prsm_health.core.jsonable import dumps
-from prsm_health.diagnostics.baseline import EVIDENCE_NAME_PROBABILITY
+
+from .asset import AssetEntry, AssetHistory, validate_asset_id
+from .evidence import EVIDENCE_NAME_PROBABILITY
+from .store import AssetStore, Stored, VersionConflict
 
 #: The tables (schema version 4 of the history database).
 ASSET_SCHEMA = """
@@ -66,35 +72,7 @@ class RecordingRow(NamedTuple):
     entry: str
 
 
-class AssetUpdate(NamedTuple):
-    """What :meth:`HistoryStore.update_asset` writes in one transaction.
-
-    ``head``: the asset's history without its entries (``AssetHistory.to_json()`` but
-    ``entries``; None: the history is unchanged); ``recording``: its new last entry (None:
-    none); ``entries``: only when the history's earlier entries changed too — every entry
-    (``AssetEntry.to_json()``), rewritten in place by recording id, those no longer there
-    removed; ``rows``, ``spectra``: the request's diagnosis rows and latest spectra;
-    ``answer``: whatever the caller wants back (not stored)."""
-
-    head: dict | None
-    rows: list
-    spectra: tuple | None = None
-    recording: RecordingRow | None = None
-    entries: list | None = None
-    answer: object = None
-
-
-class StoredHistory(NamedTuple):
-    """An asset's stored history as :meth:`HistoryStore.update_asset` hands it over: its
-    ``version`` (0: none stored) and, on demand, its JSON (``AssetHistory.to_json()``,
-    reassembled from its head and entry rows: ``load()``, None when none is stored), so that
-    a caller holding that version already parses nothing."""
-
-    version: int
-    load: Callable[[], dict | None]
-
-
-def _insert(verb: str, table: str, row_type: type[NamedTuple]) -> str:
+def insert_statement(verb: str, table: str, row_type: type[NamedTuple]) -> str:
     """The ``INSERT`` statement of a row type, its values bound by column name."""
     columns = row_type._fields
     return (
@@ -103,30 +81,69 @@ def _insert(verb: str, table: str, row_type: type[NamedTuple]) -> str:
 
 
 # (a row of the same recording id is replaced: the history's new entry is its last)
-_INSERT_RECORDING = _insert("INSERT OR REPLACE", "asset_recordings", RecordingRow)
+_INSERT_RECORDING = insert_statement("INSERT OR REPLACE", "asset_recordings", RecordingRow)
 
 
-def _named(cursor: sqlite3.Cursor) -> list[dict]:
+def named_rows(cursor: sqlite3.Cursor) -> list[dict]:
     """A query's rows as dicts by column name (``AS`` names for expressions)."""
     names = [d[0] for d in cursor.description]
     return [dict(zip(names, row)) for row in cursor.fetchall()]
 
 
-class AssetTables:
-    """The asset-history part of :class:`~.history.HistoryStore`: it uses the store's
-    connection, lock and transaction, and its :meth:`~.history.HistoryStore._write_rows`."""
+class HistoryCache:
+    """Parsed asset histories by asset, each valid for one stored version: a load at the
+    version held parses nothing (a history's JSON grows with every recording). Holds at most
+    ``max_entries`` entries in all, the least recently used asset dropped first."""
 
-    def asset_history(self, asset_id: str) -> tuple[int, dict | None]:
-        """The asset's stored history: (version, ``AssetHistory.to_json()``); (0, None)
-        when none is stored."""
-        with self._lock:
-            version = self._history_version(asset_id)
-            return version, self._load_history(asset_id)
+    def __init__(self, max_entries: int = 20_000):
+        self.max_entries = max_entries
+        self._items: OrderedDict[str, tuple[int, AssetHistory]] = OrderedDict()
+        self._lock = threading.Lock()
 
-    def asset_history_version(self, asset_id: str) -> int:
-        """The version of the asset's stored history (0: none)."""
+    def get(self, asset_id: str, version: int) -> AssetHistory | None:
         with self._lock:
-            return self._history_version(asset_id)
+            held = self._items.get(asset_id)
+            if held is None or held[0] != version:
+                return None
+            self._items.move_to_end(asset_id)
+            return held[1]
+
+    def put(self, asset_id: str, version: int, history: AssetHistory) -> None:
+        with self._lock:
+            self._items[asset_id] = (version, history)
+            self._items.move_to_end(asset_id)
+            total = sum(len(h.entries) for _, h in self._items.values())
+            while total > self.max_entries and len(self._items) > 1:
+                _, (_, dropped) = self._items.popitem(last=False)
+                total -= len(dropped.entries)
+
+
+def recording_row(asset_id: str, entry: AssetEntry) -> RecordingRow:
+    """The ``asset_recordings`` row of a history's entry."""
+    data = entry.to_json()
+    state = data.pop("state")
+    return RecordingRow(
+        asset_id=asset_id,
+        recording_id=entry.recording_id,
+        received_at=entry.time,
+        source=entry.source,
+        filename=entry.filename,
+        operating_hours=entry.operating_hours,
+        healthy=entry.healthy,
+        baseline=entry.baseline,
+        distance=entry.distance,
+        fault_class=entry.fault_class,
+        class_probabilities=dumps(entry.class_probabilities, compact=True),
+        asset=dumps(state, compact=True),
+        entry=dumps(data, compact=True),
+    )
+
+
+class AssetTables(AssetStore):
+    """The asset-history part of :class:`~.sqlite_store.HistoryStore`: the store interface
+    on its connection, lock (``self._lock``, re-entrant) and transactions. The lock of an
+    asset (:meth:`locked`) is the database's write lock (``BEGIN IMMEDIATE``): concurrent
+    recordings, from this process or another, apply one after the other."""
 
     def _history_version(self, asset_id: str) -> int:
         row = self._conn.execute(
@@ -150,30 +167,66 @@ class AssetTables:
         ]
         return {**json.loads(head[0]), "entries": entries}
 
-    def update_asset(
-        self, asset_id: str, update: Callable[[StoredHistory], AssetUpdate], *, updated_at: str
-    ) -> tuple[int, AssetUpdate]:
-        """Read, change and write the asset's history in one transaction: ``update`` is given
-        the stored history (:class:`StoredHistory`) and returns the :class:`AssetUpdate` to
-        write — the new history's head and entry, the request's diagnosis rows and spectra.
-        Returns the history's version after it, and the update.
-
-        The write lock is taken before the read (``BEGIN IMMEDIATE``), so concurrent requests
-        for one asset, from this process or another, apply one after the other and none loses
-        the other's update; ``update`` raising writes nothing. A new recording writes its one
-        entry row and the head, whatever the length of the history."""
-        with self._lock, self._transaction():
+    def load(self, asset_id: str) -> Stored:
+        """The asset's stored history and version (a new, empty one at version 0); parsed
+        only when the version held in the cache is not the stored one."""
+        validate_asset_id(asset_id)
+        with self._lock:
             version = self._history_version(asset_id)
-            result = update(StoredHistory(version, lambda: self._load_history(asset_id)))
-            if result.head is not None:
-                version += 1
-                self._write_head(asset_id, version, updated_at, result.head)
-            if result.entries is not None:
-                self._rewrite_entries(asset_id, result.entries)
-            self._write_rows(result.rows, result.spectra)
-            if result.recording is not None:
-                self._conn.execute(_INSERT_RECORDING, result.recording._asdict())
-        return version, result
+            if version == 0:
+                return Stored(0, AssetHistory(asset_id))
+            history = self._parsed.get(asset_id, version)
+            if history is None:
+                history = AssetHistory.from_json(self._load_history(asset_id))
+                self._parsed.put(asset_id, version, history)
+        return Stored(version, history)
+
+    def save(self, history: AssetHistory, *, expected_version: int, extra=None) -> int:
+        """Write ``history`` if the stored version is ``expected_version`` (else
+        :class:`VersionConflict`), with ``extra`` — ``(diagnosis rows, spectra row)`` of the
+        request (:meth:`~.sqlite_store.HistoryStore.add_rows`) — in the same transaction.
+        A history that is the one stored plus one entry writes that entry alone."""
+        asset_id = history.asset_id
+        with self.locked(asset_id):
+            version = self._history_version(asset_id)
+            if version != expected_version:
+                raise VersionConflict(
+                    f"{self.path}: asset {asset_id!r} is at version {version}, not "
+                    f"{expected_version}: another request changed it; load it again"
+                )
+            old = self._parsed.get(asset_id, version) if version else AssetHistory(asset_id)
+            appended = (
+                old is not None
+                and len(history.entries) == len(old.entries) + 1
+                and all(a is b for a, b in zip(history.entries, old.entries))
+            )
+            if not appended:
+                self._conn.execute("DELETE FROM asset_recordings WHERE asset_id = ?", (asset_id,))
+            for entry in history.entries[-1:] if appended else history.entries:
+                self._conn.execute(_INSERT_RECORDING, recording_row(asset_id, entry)._asdict())
+            updated_at = history.entries[-1].time if history.entries else ""
+            self._write_head(asset_id, version + 1, updated_at, _head(history))
+            if extra is not None:
+                self._write_rows(*extra)
+            self._parsed.put(asset_id, version + 1, history)
+            return version + 1
+
+    def store_beside(self, asset_id: str, extra) -> None:
+        """The request's diagnosis rows and spectra (``extra``), the history unchanged."""
+        if extra is not None:
+            with self.locked(asset_id):
+                self._write_rows(*extra)
+
+    @contextlib.contextmanager
+    def locked(self, asset_id: str) -> Iterator[None]:
+        """The database's write lock for the block (one transaction; re-entrant)."""
+        with self._lock, self._transaction():
+            yield
+
+    def asset_ids(self) -> list[str]:
+        with self._lock:
+            rows = self._conn.execute("SELECT asset_id FROM asset_histories ORDER BY asset_id")
+            return [r[0] for r in rows]
 
     def _write_head(self, asset_id: str, version: int, updated_at: str, head: dict) -> None:
         cusum = head.get("cusum") or {}
@@ -186,32 +239,8 @@ class AssetTables:
                 updated_at,
                 cusum.get("reference"),
                 cusum.get("threshold"),
-                dumps({k: v for k, v in head.items() if k != "entries"}, compact=True),
+                dumps(head, compact=True),
             ),
-        )
-
-    def _rewrite_entries(self, asset_id: str, entries: list[dict]) -> None:
-        """The stored entries replaced by ``entries`` (by recording id, in place: their order
-        stays the order recorded); rows of recording ids no longer there removed."""
-        kept = []
-        for e in entries:
-            kept.append(e["recording_id"])
-            self._conn.execute(
-                "UPDATE asset_recordings SET baseline = ?, distance = ?, asset = ?, entry = ?"
-                " WHERE asset_id = ? AND recording_id = ?",
-                (
-                    bool(e.get("baseline")),
-                    e.get("distance"),
-                    dumps(e.get("state"), compact=True),
-                    dumps({k: v for k, v in e.items() if k != "state"}, compact=True),
-                    asset_id,
-                    e["recording_id"],
-                ),
-            )
-        marks = ", ".join("?" * len(kept))
-        self._conn.execute(
-            f"DELETE FROM asset_recordings WHERE asset_id = ? AND recording_id NOT IN ({marks})",
-            (asset_id, *kept),
         )
 
     def recordings(self, asset_id: str, *, limit: int = 100) -> dict:
@@ -225,7 +254,7 @@ class AssetTables:
             total = self._conn.execute(
                 "SELECT COUNT(*) FROM asset_recordings WHERE asset_id = ?", (asset_id,)
             ).fetchone()[0]
-            rows = _named(
+            rows = named_rows(
                 self._conn.execute(
                     "SELECT recording_id, received_at, source, filename, operating_hours,"
                     " healthy, baseline, distance, fault_class, class_probabilities, asset"
@@ -254,7 +283,7 @@ class AssetTables:
         if latest is None:
             return None, None
         state = json.loads(latest[0])
-        members = _named(
+        members = named_rows(
             self._conn.execute(
                 "SELECT recording_id, received_at, source, filename, operating_hours, healthy"
                 " FROM asset_recordings WHERE asset_id = ? AND baseline ORDER BY rowid",
@@ -303,3 +332,10 @@ def _recording(row: Mapping) -> dict:
         "class_probabilities": json.loads(row["class_probabilities"]),
         "asset": json.loads(row["asset"]),
     }
+
+
+def _head(history: AssetHistory) -> dict:
+    """The history's JSON without its entries (stored apart, one row each)."""
+    head = dataclasses.replace(history, entries=()).to_json()
+    head.pop("entries")
+    return head

@@ -29,8 +29,8 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError
 
-from .check_model import CHANGE_PREFIX, change_row, check_reading
-from .training import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target
+from prsm_health.diagnostics.check_model import CHANGE_PREFIX, change_row, check_reading
+from .train import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target
 
 #: Cross-validation folds (by unit).
 CHECK_CV = 3
@@ -132,7 +132,7 @@ def repeatability(baseline_table, names: list[str]) -> dict[str, float]:
 def unit_baselines(baseline_table, names: list[str], prior_scale: dict) -> dict:
     """Unit id → its :class:`~prsm_health.diagnostics.baseline.Baseline` (all its baseline
     recordings)."""
-    from .baseline import Baseline
+    from prsm_health.diagnostics.baseline import Baseline
 
     out = {}
     for unit, group in baseline_table.groupby("unit_id"):
@@ -224,7 +224,7 @@ def _train_check_model(
 
     from prsm_health.datasets import Dataset
 
-    from .estimators import ClearanceEstimator, FaultClassifier
+    from prsm_health.diagnostics.estimators import ClearanceEstimator, FaultClassifier
     from .evaluation import cross_validated_metrics
 
     dirs = [check_dir] if isinstance(check_dir, (str, Path)) else list(check_dir)
@@ -333,8 +333,8 @@ def add_check_model(model_path, part: dict) -> Path:
     """Save the check part of the bundle ``model_path`` beside it
     (:func:`~prsm_health.diagnostics.diagnosis.check_part_path`, written atomically), where
     :func:`~prsm_health.diagnostics.diagnosis.load_bundle` finds it; returns its path."""
-    from .diagnosis import check_part_path
-    from .model_files import load_model, save_model
+    from prsm_health.diagnostics.diagnosis import check_part_path
+    from prsm_health.diagnostics.model_files import load_model, save_model
 
     model, _ = load_model(model_path)
     if not isinstance(model, dict) or "feature_names" not in model:
