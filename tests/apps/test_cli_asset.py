@@ -10,8 +10,8 @@ import pytest
 from sklearn.dummy import DummyClassifier
 
 from prsm_health.apps.cli import main
-from prsm_health.diagnostics import asset_history
 from prsm_health.diagnostics.model_files import save_model
+from prsm_health.monitoring import FileAssetStore
 
 
 @pytest.fixture(scope="module")
@@ -70,8 +70,8 @@ def test_the_same_recording_twice_counts_once(files, tmp_path, capsys):
     assert code == 0
     assert "already in the history of asset pump-1" in out
     assert "1 of 3 recordings" in out
-    history = asset_history.AssetStore(tmp_path).load("pump-1")
-    assert len(history.entries) == 1 and history.entries[0].source == "rec0.csv"
+    history = FileAssetStore(tmp_path).load("pump-1").history
+    assert len(history.entries) == 1 and history.entries[0].filename == "rec0.csv"
 
 
 def test_baseline_then_evidence_and_asset_show(files, tmp_path, capsys):
@@ -110,7 +110,7 @@ def test_healthy_label_and_plain_diagnose_unchanged(files, tmp_path, capsys):
     code, out, _ = run(capsys, *diagnose(files, tmp_path, 1, "--unhealthy", "--json"))
     assert json.loads(out)["asset"]["baseline"]["recordings"] == 0
     code, out, _ = run(capsys, *diagnose(files, tmp_path, 2, "--healthy", "--time", "2024-01-01"))
-    history = asset_history.AssetStore(tmp_path).load("pump-1")
+    history = FileAssetStore(tmp_path).load("pump-1").history
     assert [e.baseline for e in history.entries] == [False, True]
     assert history.entries[1].time == "2024-01-01"
     # without --asset: no asset part, no store written

@@ -24,8 +24,8 @@ from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.apps.cli import main
 from prsm_health.apps.cli.parser import DEFAULT_CV, TRAIN_TARGETS
 from prsm_health.datasets import Recipe, generate
-from prsm_health.training import train as training
 from prsm_health.prognostics import load_prognostics_model
+from prsm_health.training import train as training
 
 FLEET = {
     "name": "tiny-fleet",

@@ -12,10 +12,10 @@ from prsm_health.core.channels import CHANNEL_NAMES
 from prsm_health.core.errors import ModelVersionError
 from prsm_health.datasets import generate
 from prsm_health.diagnostics.diagnosis import diagnose, load_bundle
-from prsm_health.training.train import train
 from prsm_health.io import read_recording
 from prsm_health.io.mcap import write_mcap
 from prsm_health.io.parquet import write_run_parquet
+from prsm_health.training.train import train
 
 # Trains a model on a generated dataset (≈ 20 s) and diagnoses simulated recordings.
 pytestmark = pytest.mark.slow

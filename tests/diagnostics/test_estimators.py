@@ -23,8 +23,8 @@ from prsm_health.diagnostics.estimators import (
     DistributionGuard,
     FaultClassifier,
 )
-from prsm_health.training.evaluation import cross_validated_metrics, permutation_importance_table
 from prsm_health.diagnostics.model_files import _bundle_bytes, load_model, save_model
+from prsm_health.training.evaluation import cross_validated_metrics, permutation_importance_table
 
 # ------------------------------------------------------------------------------------------
 # scikit-learn estimator contract

@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from prsm_health.release.diagnosis_model import default_recipe, point_recipe
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, check_part_path, diagnose, load_bundle
+from prsm_health.release.diagnosis_model import default_recipe, point_recipe
 
 # Simulates thirteen recordings of the reference recipe's points for the shipped model.
 pytestmark = pytest.mark.slow

@@ -12,6 +12,7 @@ import pytest
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Recipe
+from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.release.diagnosis_model import (
     DEFAULT_SEVERITY,
     HONESTY_CASES,
@@ -24,7 +25,6 @@ from prsm_health.release.diagnosis_model import (
     train_default_model,
     write_model_card,
 )
-from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 
 SHIPPED_METRICS = DEFAULT_MODEL.with_name("default.metrics.json")
 SHIPPED_CARD = DEFAULT_MODEL.with_name("MODEL_CARD.md")

@@ -18,6 +18,7 @@ from prsm_health.actuator.states import HealthState
 from prsm_health.apps.cli import main
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, FaultThresholds, Recipe, generate
+from prsm_health.signals.features import FEATURES
 from prsm_health.training import train as training
 from prsm_health.training.evaluation import SparseFeatureError
 from prsm_health.training.train import (
@@ -27,7 +28,6 @@ from prsm_health.training.train import (
     train,
     training_problems,
 )
-from prsm_health.signals.features import FEATURES
 
 TINY = dict(
     name="train-tiny",

@@ -6,10 +6,10 @@
    (units in every state), the same units' baselines (flight-ema-check-baseline.toml), their
    checks as they age from the baseline (flight-ema-check-aging.toml) and their further healthy
    checks (flight-ema-check-healthy.toml);
-2. trains the check model on the three pooled (prsm_health.diagnostics.check_training:
+2. trains the check model on the three pooled (prsm_health.training.check_training:
    clearance, the class alone, the class against the unit's baseline) and saves it beside
    models/default.skops (models/default.check.skops);
-3. generates fresh units (prsm_health.diagnostics.check_evaluation.evaluation_recipes: three
+3. generates fresh units (prsm_health.training.check_evaluation.evaluation_recipes: three
    baseline checks and five checks per state each) and scores the diagnosis on them — one check
    alone, and five checks against the unit's baseline with the evidence accumulated;
 4. writes the numbers into models/default.metrics.json ("check") and re-renders
@@ -24,12 +24,12 @@ import sys
 from pathlib import Path
 
 from prsm_health.datasets import generate, load_recipe
-from prsm_health.diagnostics.check_evaluation import (
+from prsm_health.training.check_evaluation import (
     evaluate_check_model,
     evaluation_recipes,
     generate_evaluation,
 )
-from prsm_health.diagnostics.check_training import (
+from prsm_health.training.check_training import (
     BASELINE_ONLY,
     BASELINE_ONLY_CASES,
     NOT_OBSERVABLE,
@@ -37,7 +37,7 @@ from prsm_health.diagnostics.check_training import (
     add_check_model,
     train_check_model,
 )
-from prsm_health.diagnostics.default_model import write_model_card
+from prsm_health.release.diagnosis_model import write_model_card
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, load_bundle
 
 ROOT = Path(__file__).resolve().parents[2]

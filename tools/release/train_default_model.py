@@ -1,10 +1,10 @@
 """Train the shipped default model (flight-ema) from datasets/flight-ema-reference.toml and write
-its model card: the command line of :mod:`prsm_health.diagnostics.default_model`.
+its model card: the command line of :mod:`prsm_health.release.diagnosis_model`.
 
     python tools/release/train_default_model.py [--workers 2] [--work build] [--evaluate-only]
 
 1. generates the domain-randomised reference dataset (resumable) into WORK/flight-ema-reference;
-2. trains the clearance estimator and fault classifier (prsm_health.diagnostics.training.train) →
+2. trains the clearance estimator and fault classifier (prsm_health.training.train.train) →
    models/default.skops and models/default.metrics.json;
 3. evaluates them through the diagnosis (gates, OOD score, cannot_tell) on an off-grid set: a
    fresh Latin hypercube over the same ranges with another recipe seed (run seeds never used in
@@ -27,7 +27,7 @@ import sys
 from pathlib import Path
 
 from prsm_health.apps.plots import plot_evaluation
-from prsm_health.diagnostics.default_model import (
+from prsm_health.release.diagnosis_model import (
     REFERENCE_RECIPE,
     SHIPPED_INSTRUMENTATION,
     default_recipe,

@@ -126,8 +126,8 @@ def main() -> int:
     from prsm_health.datasets import Dataset
     from prsm_health.datasets.importer import import_recordings
     from prsm_health.diagnostics.diagnosis import load_bundle
-    from prsm_health.diagnostics.evaluation import evaluate_model
-    from prsm_health.diagnostics.training import train
+    from prsm_health.training.evaluation import evaluate_model
+    from prsm_health.training.train import train
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--per-class", type=int, default=20)

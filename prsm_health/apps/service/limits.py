@@ -18,6 +18,19 @@ MAX_TIME = 1e7
 MAX_OPERATING_HOURS = 1e7
 
 
+def _longest_built_in_check() -> float:
+    """Duration [s] of the longest built-in health check (prsm_health.actuator.health_check)."""
+    from prsm_health.actuator.health_check import BUILT_IN
+
+    return max(check.duration for check in BUILT_IN.values())
+
+
+#: Default longest recording of ``POST /v1/diagnose`` [s]: 2 s of in-service signal, or the
+#: longest built-in health check rounded up to the half second when that is longer (2.07 s →
+#: 2.5 s) — a check is one recording, read phase by phase, and must fit in one request.
+DEFAULT_MAX_WINDOW_SECONDS = max(2.0, math.ceil(2.0 * _longest_built_in_check()) / 2.0)
+
+
 @dataclass(frozen=True)
 class ServiceLimits:
     """Bounds on what one request may ask of the service.
@@ -36,7 +49,8 @@ class ServiceLimits:
         Largest body on every other endpoint.
     max_window_seconds : float [s]
         Longest recording ``POST /v1/diagnose`` accepts: ``max_window_seconds · sample_rate``
-        samples.
+        samples (default :data:`DEFAULT_MAX_WINDOW_SECONDS`: the longest built-in health check
+        fits).
     max_upload_samples : int
         Most samples an uploaded recording may hold (checked from the file's metadata before
         it is decoded, when the file has it, and again after).
@@ -66,7 +80,7 @@ class ServiceLimits:
     max_body_decoded_bytes: int = 64 * 2**20
     max_upload_bytes: int = 128 * 2**20
     max_small_body_bytes: int = 64 * 2**10
-    max_window_seconds: float = 2.0
+    max_window_seconds: float = DEFAULT_MAX_WINDOW_SECONDS
     max_upload_samples: int = 1_200_000
     max_upload_decoded_bytes: int = 2**30
     min_sample_rate: float = 1.0

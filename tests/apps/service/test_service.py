@@ -35,6 +35,7 @@ from prsm_health.apps.service import (
     is_loopback,
     serve,
 )
+from prsm_health.apps.service.limits import DEFAULT_MAX_WINDOW_SECONDS
 from prsm_health.apps.service.server import http_implementation
 from prsm_health.apps.service.workers import SHARED_BODY_PREFIX
 from prsm_health.core.channels import CHANNEL_NAMES
@@ -309,11 +310,20 @@ def test_diagnose_rejects_bad_bodies(client, content, ctype, status):
 
 
 def test_diagnose_rejects_too_long_recordings(client):
-    # default limit: 2 s × sample_rate samples
-    body = {"sample_rate": 1000.0, "channels": {"nut_axial_accel": [0.0] * 2001}}
+    # default limit: the longest built-in health check (2.07 s) rounded up to 2.5 s
+    assert DEFAULT_MAX_WINDOW_SECONDS == 2.5
+    body = {"sample_rate": 1000.0, "channels": {"nut_axial_accel": [0.0] * 2501}}
     r = client.post("/v1/diagnose", json=body)
     assert r.status_code == 413
-    assert "at most 2 s" in r.json()["error"]
+    assert "at most 2.5 s" in r.json()["error"]
+
+
+def test_the_longest_built_in_check_fits_one_request():
+    from prsm_health.actuator.health_check import BUILT_IN
+
+    rate = 20_000.0  # the flight-ema logger's rate
+    samples = max(int(round(c.duration * rate)) + 1 for c in BUILT_IN.values())
+    assert samples <= ServiceLimits().max_json_samples(rate)
 
 
 def test_body_size_limit_declared_and_streamed(small_server):

@@ -1,5 +1,5 @@
 """Each asset against its own baseline, its evidence accumulated over its recordings
-(``prsm_health.diagnostics.asset_history`` behind the service), against real servers on
+(``prsm_health.monitoring`` behind the service), against real servers on
 127.0.0.1:
 
 * a sequence of recordings of one asset — three marked healthy (a JSON field, a binary body's
@@ -26,11 +26,14 @@ import pytest
 from live_server import LiveServer
 
 from prsm_health.apps.service import HistoryStore, create_app
-from prsm_health.apps.service.evidence import AssetPart, peek_asset_id, record
-from prsm_health.apps.service.history import history_rows
+from prsm_health.apps.service.diagnosing import (
+    Answer,
+    AssetRequest,
+    peek_asset_id,
+    record_and_encode,
+)
 from prsm_health.apps.service.schemas import AssetRecordings, AssetSummary, Diagnosis
 from prsm_health.core.run import Run
-from prsm_health.diagnostics.asset_history import AssetHistory
 from prsm_health.diagnostics.diagnosis import diagnose, load_bundle
 from prsm_health.io.arrow import write_run_arrow
 from prsm_health.io.parquet import write_run_parquet
@@ -200,7 +203,7 @@ def test_evidence_accumulates_and_survives_a_restart(bundle, runs, tmp_path):
         assert name == leading[-1][0] and p4 > p[-1]
         assert nxt["evidence"]["change_statistic"] > statistic[-1]
     store = HistoryStore(db)
-    history = AssetHistory.from_json(store.asset_history("unit-1")[1])
+    history = store.load("unit-1").history
     assert [e.recording_id for e in history.entries][3:] == ["c0", "c1", "c2", "c3"]
     assert history.evidence.recordings == 4
     store.close()
@@ -221,9 +224,9 @@ def test_concurrent_records_of_one_asset_lose_no_update(bundle, runs, tmp_path):
             start.wait()
             for i in range(5):
                 rid = f"t{k}-{i}"
-                part = AssetPart("unit-2", rid, diagnosis, source="json", healthy=i == 0)
-                rows = history_rows("unit-2", [{"model": {"name": "m", "version": "1"}}])
-                record(stores[k % 2], bundle, part, rows, None, f"2026-01-01T00:00:{k}{i}")
+                asset = AssetRequest("unit-2", rid, source="json", healthy=i == 0)
+                answer = Answer(diagnosis=diagnosis, asset=asset)
+                record_and_encode(stores[k % 2], bundle, answer, f"2026-01-01T00:00:{k}{i}")
         except Exception as exc:  # noqa: BLE001 (reported by the assertion below)
             errors.append(exc)
 
@@ -233,11 +236,12 @@ def test_concurrent_records_of_one_asset_lose_no_update(bundle, runs, tmp_path):
     for t in threads:
         t.join()
     assert errors == []
-    version, stored = stores[0].asset_history("unit-2")
-    history = AssetHistory.from_json(stored)
-    assert version == 20 and history.to_json() == stored  # head + entry rows: the exact JSON
-    held = [s.parsed_histories.get("unit-2", version) for s in stores]
-    assert any(held) and all(h.to_json() == stored for h in held if h is not None)
+    stored = stores[0].load("unit-2")
+    history = stored.history
+    # head + entry rows: a store that parses them afresh reads the history the writers held
+    fresh = HistoryStore(db)
+    assert stored.version == 20 and fresh.load("unit-2").history == history
+    fresh.close()
     assert len(history.entries) == 20 and len({e.recording_id for e in history.entries}) == 20
     assert sum(e.baseline for e in history.entries) == 4
     assert history.evidence.recordings == 16

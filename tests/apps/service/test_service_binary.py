@@ -13,6 +13,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from prsm_health.apps.service import ServiceLimits, create_app
+from prsm_health.core.run import Run
 from prsm_health.diagnostics.diagnosis import load_bundle
 from prsm_health.io.arrow import write_run_arrow
 from prsm_health.io.mcap import write_mcap
@@ -237,10 +238,16 @@ def test_bad_sample_rate_metadata_is_422(app, recording):
 
 
 def test_recording_longer_than_max_window_is_413(app, reversing_run):
-    long = reversing_run(20e-6, duration=2.1, seed=3).without_truth()
+    # 2.6 s of the run's channels repeated (no need to simulate that long: only its length
+    # is checked)
+    run = reversing_run(20e-6, seed=3).without_truth()
+    n = int(2.6 * run.sample_rate)
+    reps = -(-n // len(run))
+    channels = {k: np.tile(v, reps)[:n] for k, v in run.channels.items()}
+    long = Run(np.arange(n) / run.sample_rate, channels, run.sample_rate, dict(run.labels))
     r = _post(app, write_run_arrow(long), ARROW)
     assert r.status_code == 413
-    assert "at most 2 s per request" in r.json()["error"]
+    assert "at most 2.5 s per request" in r.json()["error"]
 
 
 # ----------------------------------------------------------------------------- bombs
@@ -269,7 +276,7 @@ def test_compressed_arrow_bomb_is_413_before_decoding(app, no_decoding):
     assert len(bomb) < 200_000
     r = _post(app, bomb, ARROW)
     assert r.status_code == 413
-    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 400000")
+    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 500000")
 
 
 def test_compressed_parquet_bomb_is_413_before_decoding(app, no_decoding):
@@ -279,7 +286,7 @@ def test_compressed_parquet_bomb_is_413_before_decoding(app, no_decoding):
     assert len(bomb) < 1_000_000
     r = _post(app, bomb, PARQUET)
     assert r.status_code == 413
-    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 400000")
+    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 500000")
 
 
 @pytest.mark.parametrize("kind", ["arrow-zstd", "parquet", "mcap"])

@@ -31,12 +31,11 @@ from live_server import LiveServer
 from prsm_health import prognostics
 from prsm_health.apps.cli import main
 from prsm_health.apps.service import HistoryStore, create_app
-from prsm_health.apps.service.history import prognosis_history
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import load_bundle
 from prsm_health.io.arrow import write_run_arrow
 from prsm_health.io.parquet import write_run_parquet
-from prsm_health.prognostics import RULModel, prognose, save_prognostics_model
+from prsm_health.prognostics import RULModel, history_of_readings, prognose, save_prognostics_model
 
 TOKEN = "prognosis-token-81c2"
 Z90 = 1.6448536269514722
@@ -230,12 +229,12 @@ def test_prognosis_history_orders_by_hours_and_keeps_the_latest_of_equal_hours(t
         )
     store.add("a", [_diagnosis(99e-6, 98e-6, 100e-6)], received_at=_stamp(4))  # no hours: unused
     store.add("a", [_diagnosis(None, None, None)], received_at=_stamp(5), operating_hours=400.0)
-    table, notes = prognosis_history(store.operating_history("a"))
+    table, notes = history_of_readings(store.operating_history("a"))
     assert table["age_hours"].tolist() == [100.0, 200.0, 300.0]
     assert table["clearance"].tolist() == [10e-6, 12e-6, 14e-6]  # the later 200 h reading
     assert set(table["design"]) == {"paper01"} and set(table["fault_class"]) == {"wear"}
     assert len(notes) == 1 and "1 stored diagnosis(es)" in notes[0]
-    table, notes = prognosis_history([])
+    table, notes = history_of_readings([])
     assert table.empty and notes == []
     store.close()
 
