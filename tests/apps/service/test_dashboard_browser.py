@@ -82,10 +82,11 @@ def chromium_path():
 
 
 @pytest.fixture(scope="module")
-def service(tmp_path_factory):
+def service(tmp_path_factory, short_check_run):
     """A real server with a token, and its data: press-1 (three diagnoses at 0, 400 and 800
     operating hours, sent as JSON, Arrow and MCAP), press-2 (no nut axial acceleration: no
-    spectra), rig-3 (an upload whose file name carries markup)."""
+    spectra), rig-3 (an upload whose file name carries markup), check-4 (a health check
+    uploaded with its asset id: read whole, stored like any recording)."""
     d = tmp_path_factory.mktemp("dashboard")
     runs = [_recording(c, seed) for seed, c in enumerate((10e-6, 14e-6, 19e-6))]
     app = create_app(None, d / "history.sqlite", TOKEN, bundle=load_bundle(), warmup=False)
@@ -122,7 +123,17 @@ def service(tmp_path_factory):
                 data={"asset_id": "rig-3"},
             )
         )
-        assert [a.status_code for a in answers] == [200] * 5, [a.text for a in answers]
+        check = write_run_parquet(short_check_run().without_truth(), d / "check.parquet")
+        answers.append(
+            c.post(
+                "/v1/diagnose/file",
+                files={"file": ("check.parquet", check.read_bytes())},
+                data={"asset_id": "check-4"},
+            )
+        )
+        assert [a.status_code for a in answers] == [200] * 6, [a.text for a in answers]
+        assert answers[-1].json()["diagnosis"]["check_phases"]  # read phase by phase
+        assert c.get("/v1/assets/check-4").json()["diagnoses"] == 1
         assert c.get("/v1/assets/press-1/prognosis").status_code == 200
         live.parquet = parquet
         yield live
@@ -233,9 +244,10 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
     page.goto(service.url + "/")
     _loaded(page)
     rows = page.locator("#fleet tbody tr")
-    assert rows.count() == 3
+    assert rows.count() == 4
     assets = watch.received()["v1/assets?prognosis=true&limit=200"]["assets"]
-    assert {a["asset_id"] for a in assets} == {"press-1", "press-2", "rig-3"}
+    assert {a["asset_id"] for a in assets} == {"press-1", "press-2", "rig-3", "check-4"}
+    assert page.locator("#fleet tbody tr", has_text="check-4").count() == 1
     press1 = page.locator("#fleet tbody tr", has_text="press-1")
     cells = press1.locator("td").all_text_contents()
     brief = next(a for a in assets if a["asset_id"] == "press-1")["prognosis"]
