@@ -22,8 +22,6 @@ from __future__ import annotations
 
 from importlib import import_module
 
-__version__ = "0.1.0"
-
 #: The layers, lowest first: each is a folder of this package, and a module imports only from
 #: its own layer and those below it (docs/architecture.md; tests/test_architecture.py checks it).
 LAYERS = (
@@ -45,6 +43,7 @@ LAYERS = (
 
 #: Public name → module that defines it (relative to the package).
 _EXPORTS = {
+    "__version__": ".core.version",
     "PRESETS": ".actuator.design",
     "GearGeometry": ".actuator.design",
     "MassProperties": ".actuator.design",
@@ -91,7 +90,7 @@ _ALIASES = {
     "load_model": (".diagnostics.diagnosis", "load_bundle"),
 }
 
-__all__ = sorted([*_EXPORTS, *_ALIASES, "__version__"])
+__all__ = sorted([*_EXPORTS, *_ALIASES])
 
 
 def __getattr__(name: str):

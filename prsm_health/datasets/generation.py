@@ -311,7 +311,7 @@ def _finalise(store: DatasetStore, recipe: Recipe, formats: str) -> None:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from prsm_health import __version__
+    from prsm_health.core.version import __version__
 
     store.refresh()  # the workers' shards, not a listing cached before they wrote them
     rows = []

@@ -147,8 +147,8 @@ def import_recordings(
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from prsm_health import __version__
     from prsm_health.actuator.faults import FAULT_CLASSES
+    from prsm_health.core.version import __version__
 
     from .store import dataset_counts
 

@@ -30,6 +30,7 @@ import sklearn
 from prsm_health.core.atomic import write_atomic
 from prsm_health.core.errors import ModelVersionError, ParameterError, PRSMHealthError, require
 from prsm_health.core.jsonable import json_ready
+from prsm_health.core.version import __version__
 
 __all__ = ["load_model", "save_model"]
 
@@ -45,18 +46,11 @@ _MOVED_MODULES = {'"prsm_health.estimators"': '"prsm_health.diagnostics.estimato
 _SKOPS_SCHEMA = "schema.json"
 
 
-def _package_version() -> str:
-    # Imported lazily: prsm_health/__init__ may import this module before defining it.
-    from prsm_health import __version__
-
-    return __version__
-
-
 def _current_versions() -> dict[str, str]:
     import skops
 
     return {
-        "prsm_health": _package_version(),
+        "prsm_health": __version__,
         "scikit-learn": sklearn.__version__,
         "numpy": np.__version__,
         "skops": skops.__version__,

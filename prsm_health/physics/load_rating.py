@@ -75,6 +75,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.core.errors import ParameterError, require
 
 from .stiffness.thread_geometry import normal_load, thread_contacts
@@ -246,6 +247,25 @@ def load_ratings(
     )
     params = WearParameters() if fatigue is None else fatigue
     require(isinstance(params, WearParameters), "fatigue", params, "must be WearParameters")
+    try:
+        key = (hash(design), static_pressure, params)
+    except TypeError:  # a design holding an unhashable value: its fingerprint instead
+        key = (design_fingerprint(design), static_pressure, params)
+    found = _RATINGS.get(key)
+    if found is None or found[0] != design:
+        found = (design, _ratings(design, static_pressure, params))
+        _RATINGS[key] = found
+    return found[1]
+
+
+#: The ratings of the designs met in this process, by design (a frozen, hashable dataclass) and
+#: method parameters: one thread-load solution (≈ 20–60 ms) per design, shared by every caller —
+#: a check reading's no-load threshold, the contact mode's duty band, a scenario's labels, the
+#: life model. Callers share the result: read it, never modify its ``per_side``.
+_RATINGS: dict = {}
+
+
+def _ratings(design: PRSMDesign, static_pressure: float, params: WearParameters) -> LoadRatings:
     z, i = design.n_rollers, design.engaged_threads
 
     geometry = PartGeometry.of(design)

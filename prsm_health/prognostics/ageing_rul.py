@@ -118,8 +118,10 @@ class AgeingRUL:
             seed=seed,
         )
 
-    def _prior_particles(self, rng, mean, cov, n: int | None = None) -> dict:
-        """``n`` (default ``n_particles``) draws of the state from the prior."""
+    def prior_particles(self, rng, mean, cov, n: int | None = None) -> dict:
+        """``n`` (default ``n_particles``) draws of the filter's state from the prior: the
+        clearances uniform in ``initial_clearance``, (log wear, log lubricant life) normal with
+        ``mean`` and ``cov``, no degradation yet; a dict of arrays by state name."""
         n = self.n_particles if n is None else int(n)
         b0 = rng.uniform(*self.initial_clearance, n)
         params = rng.multivariate_normal(mean, cov, n)
@@ -143,7 +145,7 @@ class AgeingRUL:
         rng = np.random.default_rng(self.seed)
         model = self.model(int(rng.integers(2**31)))
         model.parameters["parameter_drift"] = PARAMETER_DRIFT
-        x0 = self._prior_particles(rng, self.prior_mean, self.prior_cov)
+        x0 = self.prior_particles(rng, self.prior_mean, self.prior_cov)
         samples = UnweightedSamples(
             [{k: float(v[i]) for k, v in x0.items()} for i in range(self.n_particles)],
             _type=model.StateContainer,

@@ -57,6 +57,7 @@ from prsm_health.core.errors import (
     require_positive,
 )
 from prsm_health.core.jsonable import json_ready
+from prsm_health.core.version import __version__
 
 from .degradation import (
     curve,
@@ -103,13 +104,6 @@ MIN_TRAINING_UNITS = 3
 _FORMAT = "prsm_health-prognostics"
 _FORMAT_VERSION = 1
 _FORMS = ("exponential", "linear")
-
-
-def _package_version() -> str:
-    # Imported lazily: prsm_health/__init__ is outside the layers and may import this module.
-    from prsm_health import __version__
-
-    return __version__
 
 
 # --------------------------------------------------------------------------------------------
@@ -536,7 +530,7 @@ class RULModel:
     def _base_model_dict(self, name: str) -> dict:
         return {
             "name": name,
-            "version": _package_version(),
+            "version": __version__,
             "design": self.design,
             "design_fingerprint": self.design_id[1],
             "units_trained": len(self.units_),
@@ -684,7 +678,7 @@ class RULModel:
         out = {
             "format": _FORMAT,
             "format_version": _FORMAT_VERSION,
-            "version": _package_version(),
+            "version": __version__,
             "params": {
                 "method": self.method,
                 "threshold": self.threshold,
@@ -728,7 +722,7 @@ class RULModel:
         if d.get("format_version") != _FORMAT_VERSION:
             raise ModelVersionError(
                 f"prognostics model format version {d.get('format_version')!r}; this "
-                f"prsm_health {_package_version()} reads version {_FORMAT_VERSION}"
+                f"prsm_health {__version__} reads version {_FORMAT_VERSION}"
             )
         try:
             model = cls(**d["params"])

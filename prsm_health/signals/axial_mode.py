@@ -9,7 +9,7 @@ across the gap is far from sinusoidal) can outgrow it. So it is tracked inside t
 the physics puts it for the unit's loads and clearances:
 
 * :func:`contact_mode_frequency` — the mode of the simulator's model linearised on the loaded
-  flanks (:func:`prsm_health.simulation.dynamics.simulate.linearised_modes`, flanks at paper
+  flanks (:func:`prsm_health.simulation.dynamics.modes.nut_modes`, flanks at paper
   04's tangent stiffness at the load) whose frequency depends most on the thread stiffness,
   among the modes a force on the nut makes the nut's acceleration respond to;
 * :func:`gap_frequency_ratio` — the free frequency of an impact pair (a mass between two
@@ -48,6 +48,7 @@ from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.core.disk_cache import cached_float
 from prsm_health.core.errors import require
+from prsm_health.physics.load_rating import load_ratings
 
 from .spectra import welch_psd
 
@@ -104,37 +105,6 @@ def _loaded_drive_train(drive_train: DriveTrain | None) -> DriveTrain:
     return replace(dt, gear_backlash=0.0, thrust_bearing_play=0.0)
 
 
-def _nut_modes(design: PRSMDesign, load: float, drive_train: DriveTrain, law_scale: float):
-    """(eigenvalues [1/s], peak nut accelerance per mode [1/kg]) of the linearised model."""
-    from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
-    from prsm_health.simulation.dynamics import layout as L
-    from prsm_health.simulation.dynamics.model import SimulationOptions, build_model
-    from prsm_health.simulation.dynamics.simulate import linearised_modes
-
-    # the flank law linearised at the load: paper 04's tangent stiffness there (the Hertzian
-    # law's power-law fit would move it by < 0.3 %)
-    options = SimulationOptions(
-        contact_law="linear", variation=ManufacturingVariation.ideal(), operating_load=load
-    )
-    profile = OperatingProfile(duration=0.1, speed=100.0, load=load)
-    model = build_model(design, HealthState.uniform(0.0), profile, options, 0, drive_train)
-    if law_scale != 1.0:
-        params = model.params.copy()
-        params[L.P_K_THREAD_S] *= law_scale
-        params[L.P_K_THREAD_N] *= law_scale
-        model = replace(model, params=params)
-    values, vectors, free = linearised_modes(model)
-    v_nut = free.index(model.n_coordinates + L.Q_ZN)
-    # Modal expansion of the state-space response, H(s) = Σ r_j/(s − λ_j): residue r_j of mode
-    # j from a force on the nut (the input row of the nut's velocity, 1/m_N) to the nut's
-    # velocity; the acceleration is s·H, whose peak at s = iω_j is ≈ ω_j·|r_j|/|Re λ_j|
-    left = np.linalg.inv(vectors)
-    residue = vectors[v_nut, :] * left[:, v_nut] / model.params[L.P_M_N]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        peak = np.abs(residue * values.imag / values.real)
-    return values, peak
-
-
 @lru_cache(maxsize=1)
 def _model_fingerprint() -> str:
     """Hash of the code the contact mode is computed by: this module and the layers that build
@@ -170,8 +140,11 @@ def _contact_mode(design: PRSMDesign, load: float, drive_train: DriveTrain) -> f
 
 
 def _computed_contact_mode(design: PRSMDesign, load: float, drive_train: DriveTrain) -> float:
-    values, peak = _nut_modes(design, load, drive_train, 1.0)
-    stiffer, _ = _nut_modes(design, load, drive_train, 1.0 + SENSITIVITY_STEP)
+    # imported here: the simulator's model loads numba, which reading a signal needs only now
+    from prsm_health.simulation.dynamics.modes import nut_modes
+
+    values, peak = nut_modes(design, load, drive_train)
+    stiffer, _ = nut_modes(design, load, drive_train, 1.0 + SENSITIVITY_STEP)
     f = values.imag / (2 * math.pi)
     candidates = np.flatnonzero((f > MODE_RANGE[0]) & (f < MODE_RANGE[1]) & np.isfinite(peak))
     require(
@@ -197,7 +170,7 @@ def contact_mode_frequency(
 
     The model of the simulator (screw on its thrust bearing and drive, rollers, carrier, nut,
     payload on its linkage) linearised on the loaded flanks at the axial ``load``
-    (:func:`~prsm_health.simulation.dynamics.simulate.linearised_modes`): the flanks at paper
+    (:func:`~prsm_health.simulation.dynamics.modes.nut_modes`): the flanks at paper
     04's tangent stiffness there (the Hertzian load–deflection curve's slope), identical
     rollers, the reduction's backlash and the thrust bearing's play closed. Of the modes between :data:`MODE_RANGE` that a force on the nut makes
     the nut's acceleration respond to (peak accelerance ≥ :data:`VISIBLE_SHARE` of the largest),
@@ -423,17 +396,8 @@ def contact_band(
 
 
 @lru_cache(maxsize=32)
-def _dynamic_rating(design: PRSMDesign) -> float:
-    # C_a, once per design: its thread-load solution takes ≈ 20–60 ms, and every window's
-    # reference frequency needs it
-    from prsm_health.physics.load_rating import load_ratings
-
-    return float(load_ratings(design).dynamic)
-
-
-@lru_cache(maxsize=32)
 def _duty_band(design: PRSMDesign, drive_train: DriveTrain) -> tuple[float, float]:
-    rating = _dynamic_rating(design)
+    rating = load_ratings(design).dynamic
     loads = (DUTY_LOAD_SHARES[0] * rating, DUTY_LOAD_SHARES[1] * rating)
     return contact_band(
         design, loads, DUTY_CLEARANCES, drive_train=drive_train, ramp_time=DUTY_RAMP_TIME
@@ -504,7 +468,7 @@ def reference_frequency(
     """
     from prsm_health.actuator.states import DEFAULT_LOAD_SHARE
 
-    rating = _dynamic_rating(design)
+    rating = load_ratings(design).dynamic
     if load is None or not math.isfinite(load):
         load = DEFAULT_LOAD_SHARE * rating
     steps = math.log(max(abs(load), 1.0) / rating) / math.log(REFERENCE_STEP)

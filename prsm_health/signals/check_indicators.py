@@ -368,13 +368,6 @@ def spectral_centroid(x: np.ndarray, sample_rate: float, band=CENTROID_BAND) -> 
     return float(np.sum(f[inside] * p[inside]) / total) if total > 0 else math.nan
 
 
-@lru_cache(maxsize=32)
-def dynamic_rating(design: PRSMDesign) -> float:
-    """The design's dynamic load rating C_a [N], computed once per design (the thread-load
-    solution behind it takes ~60 ms, the rest of a check's reading ~30 ms)."""
-    return float(load_ratings(design).dynamic)
-
-
 @lru_cache(maxsize=16)
 def _band_sos(low: float, high: float, sample_rate: float) -> np.ndarray:
     # designed once per band and rate: the design costs more than filtering a phase
@@ -520,7 +513,7 @@ def check_indicators(
     if gear_ratio is None:
         gear_ratio = run.labels.get("gear_ratio", 1.0)
     gear_ratio = float(gear_ratio) if _is_number(gear_ratio) and gear_ratio > 0 else 1.0
-    found, missing = find_roles(phase_conditions(run), dynamic_rating(design))
+    found, missing = find_roles(phase_conditions(run), load_ratings(design).dynamic)
     roles: dict[str, str] = {}
     if "housing_temperature" in run.channels:
         out["check_temperature"] = float(np.mean(run.channels["housing_temperature"]))

@@ -62,26 +62,13 @@ from .instrumentation import (
     load_instrumentation,
 )
 
-#: The ratings of the designs met in this process, by design (a design is a frozen, hashable
-#: dataclass): computing them takes ≈ 20 ms, a scenario's construction ≈ 0.2 ms otherwise, and a
-#: recipe builds one scenario per run.
-_RATINGS: dict = {}
-
 
 def design_ratings(design: PRSMDesign) -> dict[str, float]:
     """``{"C_a": …, "C_0a": …}`` [N]: the basic dynamic and static axial load ratings of
-    ``design`` (:func:`~prsm_health.physics.load_rating.load_ratings`), computed once per
-    design and process."""
-    try:
-        key = hash(design)
-    except TypeError:  # a design holding an unhashable value: its fingerprint instead
-        key = design_fingerprint(design)
-    found = _RATINGS.get(key)
-    if found is None or found[0] != design:
-        ratings = load_ratings(design)
-        found = (design, {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)})
-        _RATINGS[key] = found
-    return dict(found[1])
+    ``design`` (:func:`~prsm_health.physics.load_rating.load_ratings`, computed once per design
+    and process)."""
+    ratings = load_ratings(design)
+    return {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)}
 
 
 _GROUPS = {

@@ -195,7 +195,7 @@ def test_bad_inputs(model, tmp_path, capsys, reversing_run):
 def test_model_from_another_version(model, tmp_path, capsys, monkeypatch, reversing_run):
     import prsm_health.diagnostics.model_files as est
 
-    monkeypatch.setattr(est, "_package_version", lambda: "9.9.0")
+    monkeypatch.setattr(est, "__version__", "9.9.0")
     with pytest.raises(ModelVersionError):
         load_bundle(model[0])
     write_run_parquet(reversing_run(10e-6), tmp_path / "r.parquet")

@@ -35,10 +35,10 @@ from prsm_health.actuator.states import HealthState, ManufacturingVariation, Ope
 from prsm_health.physics.kinematics import speed_ratios
 from prsm_health.physics.load_rating import load_ratings
 from prsm_health.signals.gear_indicators import time_synchronous_average
-from prsm_health.simulation.dynamics import _kernels
 from prsm_health.simulation.dynamics import layout as L
 from prsm_health.simulation.dynamics.model import SimulationOptions, build_model
 from prsm_health.simulation.dynamics.simulate import (
+    integrate,
     integration_step,
     max_stable_step,
     settled_state,
@@ -70,17 +70,10 @@ def roller_forces(model, duration: float, mismatch: float | None = None) -> dict
     y = settled_state(model, h, model.options.settle_time)
     n = model.n_rollers
     n_out = int(round(duration * RATE))
-    work = [np.empty(model.n_state) for _ in range(5)]
     aux = np.zeros(L.n_aux(n))
-    raw = np.empty((1, L.N_CHANNELS))
     out = np.empty((n_out, L.N_AUX_PER_ROLLER, n))
     for k in range(n_out):
-        status, _ = _kernels.integrate(
-            y, k * factor * h, h, factor, factor + 1, model.params, model.rollers,
-            model.mesh_table, model.motion, model.load_knots, model.errors, raw, *work, aux,
-        )  # fmt: skip
-        if status:
-            raise RuntimeError("non-finite state")
+        integrate(model, y, h, factor, t0=k * factor * h, record=False, aux=aux)
         out[k] = aux[L.N_AUX :].reshape(L.N_AUX_PER_ROLLER, n)
     return {
         "cap_s": out[:, L.AR_CAP_S],

@@ -208,7 +208,7 @@ def _ideal_unit(model, unit, history, fitted, draws, noise, rng) -> list[bool]:
     rates = np.where(np.isfinite(duty["usage_rate"]), duty["usage_rate"], 1.0)
     loads = duty["load"]
     sigma = model.parameters["usage_sigma"]
-    x = fitted._prior_particles(rng, fitted.prior_mean, fitted.prior_cov, draws)
+    x = fitted.prior_particles(rng, fitted.prior_mean, fitted.prior_cov, draws)
     log_lik, now, hits = np.zeros(draws), 0.0, []
     for k in range(len(t)):
         while now < t[k] - 1e-9:  # the logged usage over the interval before diagnosis k

@@ -17,13 +17,13 @@ import argparse
 import re
 from datetime import datetime
 
-from prsm_health import __version__
 from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS
 from prsm_health.actuator.health_check import BUILT_IN as BUILT_IN_CHECKS
 from prsm_health.actuator.states import DEFAULT_LOAD, DRIVES, LOADS, MOTIONS, RAMP_SHAPES
 from prsm_health.core.errors import ParameterError
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
 from prsm_health.core.quantities import parse_force
+from prsm_health.core.version import __version__
 
 from .options import (
     HelpFormatter,

@@ -14,8 +14,8 @@ from pathlib import Path
 from fastapi import FastAPI
 from fastapi.openapi.utils import get_openapi
 
-from prsm_health import __version__
 from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.version import __version__
 from prsm_health.diagnostics.diagnosis import load_bundle
 from prsm_health.monitoring.sqlite_store import HistoryStore, default_db_path
 

@@ -445,6 +445,6 @@ def _library() -> str:
     """The Header record's library field: this package and the mcap library, with versions."""
     from mcap.writer import LIBRARY_IDENTIFIER
 
-    from prsm_health import __version__
+    from prsm_health.core.version import __version__
 
     return f"prsm_health/{__version__}; {LIBRARY_IDENTIFIER}"

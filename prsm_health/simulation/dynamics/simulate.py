@@ -282,6 +282,7 @@ def integrate(
     t0: float = 0.0,
     record: bool = True,
     progress: bool = False,
+    aux: np.ndarray | None = None,
 ) -> np.ndarray:
     """Advance the state ``y`` of ``model`` in place by ``n_steps`` RK4 steps of ``h`` [s] from
     ``t0`` [s] — the integration :func:`simulate` runs (the numba kernel, called on 20 ms of
@@ -302,6 +303,10 @@ def integrate(
         Record the truth signals at every step; False: nothing recorded (settling).
     progress : bool
         Show a progress bar (tqdm).
+    aux : ndarray or None
+        Length ``layout.n_aux(model.n_rollers)``: filled in place with the auxiliary outputs of
+        the last right-hand side evaluated (the layout's ``A_*`` entries, then each roller's
+        ``AR_*`` block: its tractions, their Coulomb limits, its gear mesh force).
 
     Returns
     -------
@@ -316,7 +321,10 @@ def integrate(
     """
     raw = np.empty((n_steps if record else 1, L.N_CHANNELS))
     work = [np.empty(model.n_state) for _ in range(5)]
-    aux = np.zeros(L.n_aux(model.n_rollers))
+    if aux is None:
+        aux = np.zeros(L.n_aux(model.n_rollers))
+    elif aux.shape != (L.n_aux(model.n_rollers),) or aux.dtype != np.float64:
+        raise ValueError(f"aux must be float64 of length {L.n_aux(model.n_rollers)}")
     chunk = max(1, min(n_steps, int(0.02 / h)))  # 20 ms of simulated time per kernel call
     bar = None
     if progress:
