@@ -25,6 +25,9 @@ from prsm_health.io.parquet import write_run_parquet
 from prsm_health.monitoring import FileAssetStore, asset_baseline
 from prsm_health.monitoring.sqlite_store import HistoryStore
 
+# six 1 s health checks simulated and diagnosed twice: ≈ 20 s
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def checks(short_check_run, tmp_path_factory):

@@ -147,5 +147,5 @@ def test_a_request_cuts_its_windows_once(bundle, rig_csv, tmp_path, monkeypatch)
     path.write_bytes(rig_csv)
     upload = ReceivedUpload(path, "rig.csv", ".csv", len(rig_csv), MAP, "map.toml")
     answer = diagnosing.diagnose_upload(bundle, upload, ServiceLimits(), "press-1", "now")
-    assert answer.history and answer.spectra is not None
+    assert answer.asset is not None and answer.spectra is not None
     assert calls == [8000]
