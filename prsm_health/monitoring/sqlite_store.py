@@ -477,13 +477,14 @@ def history_rows(
     speed: float | None = None,
     load: float | None = None,
     operating_hours: float | None = None,
+    texts: list[str] | None = None,
 ) -> list[DiagnosisRow]:
     """The database rows of diagnoses (contract dicts; a ``window`` key places one in its
-    recording) for :meth:`HistoryStore.add_rows`. The service builds them where the diagnosis
-    ran."""
+    recording) for :meth:`HistoryStore.add_rows`; ``texts``: their JSON when already encoded
+    (the service's answer, stored as it was sent), else encoded here."""
     received_at = received_at or utc_now()
     rows = []
-    for d in diagnoses:
+    for i, d in enumerate(diagnoses):
         c = d.get("clearance") or {}
         w = d.get("window") or {}
         model = d.get("model") or {}
@@ -506,7 +507,7 @@ def history_rows(
                 class_probabilities=dumps(d.get("class_probabilities", {})),
                 model_name=str(model.get("name", "")),
                 model_version=str(model.get("version", "")),
-                diagnosis=dumps(d),
+                diagnosis=dumps(d) if texts is None else texts[i],
             )
         )
     return rows

@@ -131,14 +131,15 @@ def record_and_encode(store: HistoryStore, bundle, answer: Answer, received_at: 
 
     def rows(_history, recorded: Diagnosis):
         result = json_ready(dataclasses.replace(recorded, windows=windows).to_json())
-        if answer.upload is None:
+        texts = None
+        if answer.upload is None:  # one row: the answer itself, stored as sent
             if len(result.get("windows", [])) <= 1:
                 result.pop("windows", None)
-            made["answer"] = result
-            stored = [result]
+            made["answer"] = encode(result)
+            stored, texts = [result], [made["answer"].decode()]
         else:
             per_window = result.pop("windows", [])
-            made["answer"] = {"diagnosis": result, "windows": per_window, **answer.upload}
+            made["answer"] = encode({"diagnosis": result, "windows": per_window, **answer.upload})
             stored = per_window or [result]
         history = history_rows(
             a.asset_id,
@@ -149,6 +150,7 @@ def record_and_encode(store: HistoryStore, bundle, answer: Answer, received_at: 
             speed=a.speed,
             load=a.load,
             operating_hours=a.operating_hours,
+            texts=texts,
         )
         return history, answer.spectra
 
@@ -165,7 +167,7 @@ def record_and_encode(store: HistoryStore, bundle, answer: Answer, received_at: 
         filename=a.filename,
         extra=rows,
     )
-    return encode(made["answer"])
+    return made["answer"]
 
 
 def last_window_spectra(
