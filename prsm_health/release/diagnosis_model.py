@@ -8,7 +8,8 @@ for their own actuator (another recipe file, another instrumentation):
 2. :func:`train_default_model` — generates it (resumable), trains the clearance estimator and
    the fault classifier (:func:`prsm_health.training.train.train`, 3-fold CV), evaluates
    them (:func:`evaluate_default_model`), measures what each indicator group adds
-   (:func:`ablation`) and writes the metrics and the model card (:func:`write_model_card`);
+   (:func:`ablation`) and writes the metrics and the model card
+   (:func:`~prsm_health.release.diagnosis_card.write_model_card`);
 3. :func:`evaluate_default_model` — the model through the diagnosis (gates, OOD score,
    ``cannot_tell``) on an off-grid set (:func:`off_grid_recipe`: a fresh Latin hypercube over
    the same ranges, run seeds never used in training), a sensitivity table over every varied
@@ -33,9 +34,8 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, Recipe, generate, load_recipe
-
-from prsm_health.training.check_evaluation import check_card_section
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, OOD_LIMIT, diagnose, load_bundle
+from prsm_health.release.diagnosis_card import write_model_card
 from prsm_health.training.evaluation import (
     clearance_report,
     evaluate_model,
@@ -274,9 +274,8 @@ def ablation(dataset_dir: str | Path, features: list[str]) -> list[dict]:
     """
     from sklearn.metrics import f1_score
 
-    from prsm_health.signals.features import GROUPS, dataset_features
-
     from prsm_health.diagnostics.estimators import ClearanceEstimator, FaultClassifier
+    from prsm_health.signals.features import GROUPS, dataset_features
 
     table = dataset_features(Dataset(dataset_dir))
     train_rows, test_rows = table[table["split"] == "train"], table[table["split"] == "test"]
@@ -382,7 +381,7 @@ def train_default_model(
 
     Writes ``out_dir/default.skops``, ``out_dir/default.metrics.json`` (training metrics,
     :func:`evaluate_default_model`'s, :func:`ablation`, feature names, channels, sample rate)
-    and ``out_dir/MODEL_CARD.md`` (:func:`model_card`).
+    and ``out_dir/MODEL_CARD.md`` (:func:`~prsm_health.release.diagnosis_card.model_card`).
 
     Parameters
     ----------
@@ -503,233 +502,3 @@ def recipe_for_instrumentation(reference: Recipe, instrumentation: str) -> Recip
         k: v for k, v in reference.sweep.items() if not k.startswith("instrumentation.")
     }
     return Recipe.from_dict(source)
-
-
-# --------------------------------------------------------------------------------------------
-# Model card
-# --------------------------------------------------------------------------------------------
-
-
-def write_model_card(metrics: dict, model_path: str | Path, card_path: str | Path | None = None):
-    """Write :func:`model_card` of ``metrics`` for the model file ``model_path`` (its size is
-    measured) to ``card_path`` (default: ``MODEL_CARD.md`` beside the model); returns the path."""
-    model_path = Path(model_path)
-    card_path = model_path.with_name("MODEL_CARD.md") if card_path is None else Path(card_path)
-    card_path.write_text(model_card(metrics, model_path.stat().st_size))
-    return card_path
-
-
-def _um(x) -> str:
-    return "–" if x is None else f"{1e6 * x:.2f} µm"
-
-
-def _f(x, digits: int = 3) -> str:
-    return "–" if x is None else f"{x:.{digits}f}"
-
-
-def model_card(metrics: dict, size: int) -> str:
-    """The model card (Markdown) from :func:`train_default_model`'s metrics and the model file's
-    size [bytes]: every number in it is measured; the prose describes the shipped recipe."""
-    ct, cv, og = metrics["clearance_test"], metrics["clearance_cv"], metrics["off_grid"]
-    ft, fcv = metrics["fault_test"], metrics["fault_cv"]
-    ogc, ogf = og["clearance"], og["fault"]
-    recipe = metrics["model"]
-    per_class = "\n".join(
-        f"| {c} | {_f(ogf['f1_by_class'][c], 2)} | "
-        + " | ".join(str(v) for v in ogf["confusion"]["matrix"][i])
-        + " |"
-        for i, c in enumerate(ogf["confusion"]["true"])
-    )
-    head = " | ".join(ogf["confusion"]["predicted"])
-    dsf = metrics["default_severity"]["fault"]
-    ds_head = " | ".join(dsf["confusion"]["predicted"])
-    ds_rows = "\n".join(
-        f"| {c} | {_f(dsf['f1_by_class'][c], 2)} | "
-        + " | ".join(str(v) for v in dsf["confusion"]["matrix"][i])
-        + " |"
-        for i, c in enumerate(dsf["confusion"]["true"])
-    )
-    members = sorted({k for row in dsf["set_membership"].values() for k in row})
-    set_head = " | ".join(members)
-    set_rows = "\n".join(
-        f"| {c} | " + " | ".join(_f(row.get(k, 0.0), 2) for k in members) + " |"
-        for c, row in dsf["set_membership"].items()
-    )
-    ablation_rows = "\n".join(
-        f"| {r['features']} | {r['n_features']} | {_um(r['mae'])} | {r['coverage']:.3f} | "
-        f"{_um(r['width'])} | {r['macro_f1']:.3f} |"
-        for r in metrics["ablation"]
-    )
-    sensitivity_rows = "\n".join(
-        f"| `{r['parameter']}` | {r['low']:.4g} … {r['high']:.4g} | {r['n']} | {_um(r['bias'])} | "
-        f"{_um(r['mae'])} | {_f(r['coverage'])} |"
-        for r in metrics["sensitivity"]
-    )
-    honesty_rows = "\n".join(
-        f"| {label} | {h['n']} | {h['ood_flagged']} | {h['median_ood_score']:.2f} | "
-        f"{h['cannot_tell']} | {h['confident_wrong']} | {h['warned']} |"
-        for label, h in metrics["honesty"].items()
-    )
-
-    def importance(key):
-        rows = [r for r in metrics.get(key, []) if r["kind"] == "group"]
-        return "\n".join(
-            f"| {r['name']} | {r['importance_mean']:.4f} ± {r['importance_std']:.4f} |"
-            for r in rows
-        )
-
-    return f"""# Model card — `models/default.skops` (instrumentation `flight-ema`)
-
-*Generated by `tools/release/train_default_model.py`; every number below was measured by it.*
-
-**What it is.** The default diagnosis model of `prsm-health diagnose` / `replay` / the service,
-for a paper-01 PRSM measured by the `flight-ema` instrumentation (resolver, phase-current
-torque, LVDT on the output rod, one axial MEMS accelerometer; no load cell —
-docs/instrumentation.md): a `ClearanceEstimator` (gradient-boosted point model; gradient-boosted
-quantiles of its out-of-fold residual, conformally calibrated to a 90 % interval), a
-`FaultClassifier` (gradient boosting, sigmoid-calibrated probabilities) and a
-`DistributionGuard` (k-nearest-neighbour out-of-distribution score), on the
-{len(metrics["feature_names"])} indicators of `prsm_health.signals.features` this instrumentation gives,
-over {recipe["window"]:g} s windows at {metrics["sample_rate"]:g} Hz. File size
-{size / 1e6:.2f} MB; prsm_health, scikit-learn and numpy versions are recorded in the file and
-checked on load. Required channels: {", ".join(metrics["channels"])}.
-
-**Data.** `datasets/flight-ema-reference.toml`, domain-randomised: {metrics["runs"]["train"]}
-training and {metrics["runs"]["test"]} held-out runs (random 20 % split) of a Latin hypercube over
-clearance 0–40 µm, uneven wear, preload 0–5 µm, speed 50–130 rad/s, mean load ±400 N with a
-300–2500 N swing at 4–16 Hz and 1–20 ms reversal ramps, lubricant degradation 0–1,
-temperature 10–70 °C, the fault cases of docs/faults.md (spalls on screw, nut, roller; ring-
-and roller-gear tooth cracks; a tooth pit; preload loss) at 0.5–1.5× default severity, contact
-damping 0.02–0.034 and restitution 0.4–0.8, coupling stiffness and damping, payload, linkage
-stiffness, accelerometer/LVDT/torque noise; sensor gains, offsets and harmonic errors and the
-manufacturing scatter drawn per run from their documented spreads. Classes (precedence):
-spall > tooth_damage > severe_wear (b ≥ 30 µm) > wear (b ≥ 15 µm) > preload_loss (≥ 50 % lost)
-> lubrication (degradation ≥ 0.5) > healthy.
-
-## Metrics
-
-Clearance through the diagnosis (gates and OOD score applied: an interval is the whole trained
-range where the clearance was not observable or the window out of distribution); fault macro-F1
-counts `cannot_tell` as a miss.
-
-| set | clearance MAE | 90 % coverage | mean width | fault macro-F1 (models alone: argmax; through the diagnosis: class sets) |
-|---|---|---|---|---|
-| 3-fold CV on train (grouped by operating point; models alone) | {_um(cv["mae"])} | {_f(cv["interval_coverage"])} | {_um(cv["mean_interval_width"])} | {_f(fcv["macro_f1_classifier"])} |
-| held-out split ({ct["n"]} runs; models alone) | {_um(ct["mae"])} | {_f(ct["interval_coverage"])} | {_um(ct["mean_interval_width"])} | {_f(ft["macro_f1_classifier"])} |
-| off-grid ({ogc["n"]} runs: a fresh hypercube, recipe seed + 1, run seeds never used in training; through the diagnosis) | {_um(ogc["mae"])} | {_f(ogc["coverage"])} | {_um(ogc["mean_width"])} | {_f(ogf["macro_f1_all"])} |
-
-Off-grid: clearance observable in {_f(ogc["observable_fraction"], 2)} of the runs; out of
-distribution {_f(og["ood"]["flagged_fraction"], 3)}; `cannot_tell` {_f(ogf["cannot_tell_fraction"], 3)};
-macro-F1 of the runs given a class {_f(ogf["macro_f1_named"])}.
-
-Figures of the off-grid set: [predicted vs true clearance](figures/clearance.png),
-[class calibration](figures/calibration.png) (the probabilities are cautious: the share correct
-lies above the top probability), [confusion matrix](figures/confusion.png).
-
-### Each class at its default severity
-
-{metrics["default_severity"]["per_class"]} runs per class, on otherwise healthy units (clearance
-< 12 µm, lubricant degradation < 0.4) except where the class is the clearance or the lubricant,
-everything else drawn from the reference ranges, fresh seeds: fault macro-F1
-**{_f(metrics["default_severity"]["fault"]["macro_f1_all"])}** (`cannot_tell` counted as a miss;
-{_f(metrics["default_severity"]["fault"]["macro_f1_named"])} over the runs given a class,
-`cannot_tell` {_f(metrics["default_severity"]["fault"]["cannot_tell_fraction"], 3)}); clearance MAE
-{_um(metrics["default_severity"]["clearance"]["mae"])}, coverage
-{_f(metrics["default_severity"]["clearance"]["coverage"])}.
-
-| class | F1 | {ds_head} |
-|---|---|{"---|" * len(metrics["default_severity"]["fault"]["confusion"]["predicted"])}
-{ds_rows}
-
-**Named classes and class sets.** A diagnosis names the most probable class when its
-probability reaches 0.5, else it answers `cannot_tell`; beside it, the model's 90 % class set
-(per-class conformal thresholds from the calibration folds: `FaultClassifier.predict_set`)
-lists the classes the evidence cannot rule out, in a warning when it holds more than the named
-class. At default severity the sets hold the true class in {_f(dsf["set_coverage"])} of the runs, with
-{_f(dsf["mean_set_size"], 2)} classes on average; confident wrong answers (a class named, wrong,
-top probability > 0.6): {_f(dsf["confident_wrong_fraction"], 3)} of the runs (off-grid:
-{_f(ogf["confident_wrong_fraction"], 3)}). Share of each class's runs whose set holds each
-class (rows true):
-
-| class | {set_head} |
-|---|{"---|" * len(members)}
-{set_rows}
-
-### Fault classes (off-grid): F1 and confusion (rows true, columns predicted)
-
-| class | F1 | {head} |
-|---|---|{"---|" * len(ogf["confusion"]["predicted"])}
-{per_class}
-
-## Honesty checks (simulated recordings the model must not answer confidently)
-
-Six recordings each, from test-split points of the reference recipe with new seeds. A
-*confident wrong* class is a class other than the truth and `cannot_tell` with probability > 0.6.
-
-| recording | n | OOD flagged (score > {OOD_LIMIT:g}) | median OOD score | `cannot_tell` | confident wrong | warned |
-|---|---|---|---|---|---|---|
-{honesty_rows}
-
-## Sensitivity (off-grid runs in thirds of each varied element's range)
-
-How the clearance estimate shifts across each chain element's range: bias (estimate − truth),
-MAE and interval coverage of the runs in each third.
-
-| element | range | n | bias | MAE | coverage |
-|---|---|---|---|---|---|
-{sensitivity_rows}
-
-## What each indicator group adds (held-out split, both models retrained without it)
-
-| features | n | clearance MAE | 90 % coverage | mean width | fault macro-F1 (argmax) |
-|---|---|---|---|---|---|
-{ablation_rows}
-
-Permutation importance (held-out, groups permuted together) — clearance (drop of R²):
-
-| group | importance |
-|---|---|
-{importance("clearance_importance")}
-
-Fault class (drop of accuracy):
-
-| group | importance |
-|---|---|
-{importance("fault_importance")}
-
-## What it does not cover
-
-- One design (paper01); another design's recording is refused when it says its design, and
-  scored out of distribution when it does not (honesty checks), not diagnosed.
-- One instrumentation (flight-ema). A recording without one of its channels is diagnosed with
-  what it has, the clearance is not observable without the LVDT, and the class is
-  `cannot_tell`.
-- Contact damping ratios above 0.034 (the RK4 step would have to shrink, docs/performance.md),
-  clearances beyond 40 µm, speeds beyond 50–130 rad/s, loads beyond the trained swing: the
-  diagnosis warns outside the trained speed and drive-torque ranges.
-- Clearance is not observable without a load or motion reversal (steady load holds each roller
-  on one flank): the interval is the trained range and the class `cannot_tell`.
-- **Faults this chain cannot tell apart.** Gear tooth damage has no signature in these
-  channels (docs/faults.md); spalls at default severity barely do at these loads, and the
-  impacts of the clearance at every reversal dominate the envelope; a lubricant's extra
-  friction is hidden in a drive torque dominated by an axial load no sensor measures (no load
-  cell on a flight EMA); a partial preload loss changes the play by a few µm, inside the
-  clearance's own spread. Only wear and severe wear are seen (by the lost motion: the argmax of
-  the classifier reaches F1 ≈ 0.7–0.9 on them, ablation and earlier cards). But a spall or a
-  cracked tooth may sit on a worn unit too (the taxonomy names the localised fault first), and
-  nothing in these channels rules it out: the class set keeps spall and tooth damage for nearly
-  every window, and the warning says so beside what it *does* rule out (healthy and
-  lubrication for most worn units, the class-set table); the clearance estimate and its
-  interval carry the wear. The issue asked for a fault macro-F1 ≥ 0.9 at default severities;
-  this instrumentation cannot give it honestly: naming the most probable class whatever its
-  probability (the previous card, 2026-11-24) scored 0.34, and gave a wrong class to 25–29 of
-  the 30 runs of healthy, preload loss, spall and tooth damage (14 of lubrication), at
-  probabilities of 0.25–0.3; naming only classes that reach 0.5 scores
-  {_f(dsf["macro_f1_all"])} with {_f(dsf["confident_wrong_fraction"], 3)} confident wrong answers.
-  No indicator we tried (time-synchronous averages, envelope lines at the defect frequencies,
-  spectral kurtosis, plain-spectrum lines at the defect frequencies) changed that (ablation
-  table, docs/faults.md). What would: a load cell, a tangential accelerometer, longer windows
-  at higher load (docs/faults.md).
-- Real recordings differ from the simulator (mounting, transfer paths, temperature): validate
-  on measured data (`prsm-health import`, `prsm-health evaluate`) before trusting it.
-""" + check_card_section(metrics.get("check", {}))

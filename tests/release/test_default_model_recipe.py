@@ -1,7 +1,8 @@
 """prsm_health.release.diagnosis_model: the shipped model's recipe, its evaluation sets, its
-honesty checks and its card (tools/release/train_default_model.py is their command line).
+honesty checks (tools/release/train_default_model.py is their command line; the card:
+test_diagnosis_card.py).
 
-The recipe derivations and the card are checked without simulating; one slow test builds a
+The recipe derivations are checked without simulating; one slow test builds a
 tiny model end to end through ``train_default_model`` (≈ 1–1.5 min on 2 cores).
 """
 
@@ -12,22 +13,16 @@ import pytest
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Recipe
-from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.release.diagnosis_model import (
     DEFAULT_SEVERITY,
     HONESTY_CASES,
     REFERENCE_RECIPE,
     default_recipe,
     default_severity_recipes,
-    model_card,
     off_grid_recipe,
     point_recipe,
     train_default_model,
-    write_model_card,
 )
-
-SHIPPED_METRICS = DEFAULT_MODEL.with_name("default.metrics.json")
-SHIPPED_CARD = DEFAULT_MODEL.with_name("MODEL_CARD.md")
 
 
 @pytest.fixture(scope="module")
@@ -82,19 +77,6 @@ def test_point_recipe_is_one_run_of_the_point_with_changes(reference):
 def test_honesty_cases_cover_design_instrumentation_regime_and_channels():
     changed = {key for change in HONESTY_CASES.values() for key in change}
     assert changed == {"design", "instrumentation", "profile", "channels"}
-
-
-def test_card_of_the_shipped_metrics_is_the_shipped_card(tmp_path):
-    # The card is generated from the metrics file, never edited by hand: regenerating it from
-    # the shipped metrics gives the shipped card, character for character.
-    metrics = json.loads(SHIPPED_METRICS.read_text())
-    size = DEFAULT_MODEL.stat().st_size
-    assert model_card(metrics, size) == SHIPPED_CARD.read_text()
-    model = tmp_path / "m.skops"
-    model.write_bytes(b"x" * 1234)
-    path = write_model_card(metrics, model)
-    assert path == tmp_path / "MODEL_CARD.md"
-    assert "File size\n0.00 MB" in path.read_text()
 
 
 def test_evaluate_only_needs_a_model(tmp_path, reference):

@@ -24,6 +24,8 @@ import sys
 from pathlib import Path
 
 from prsm_health.datasets import generate, load_recipe
+from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, load_bundle
+from prsm_health.release.diagnosis_card import write_model_card
 from prsm_health.training.check_evaluation import (
     evaluate_check_model,
     evaluation_recipes,
@@ -37,8 +39,6 @@ from prsm_health.training.check_training import (
     add_check_model,
     train_check_model,
 )
-from prsm_health.release.diagnosis_model import write_model_card
-from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, load_bundle
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -27,6 +27,7 @@ import sys
 from pathlib import Path
 
 from prsm_health.apps.plots import plot_evaluation
+from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.release.diagnosis_model import (
     REFERENCE_RECIPE,
     SHIPPED_INSTRUMENTATION,
@@ -34,7 +35,6 @@ from prsm_health.release.diagnosis_model import (
     instrumentation_experiment,
     train_default_model,
 )
-from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 
 ROOT = Path(__file__).resolve().parents[2]
 MODELS = DEFAULT_MODEL.parent
