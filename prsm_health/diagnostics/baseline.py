@@ -50,6 +50,7 @@ CENTRE_FLOOR = 0.01
 #: … nor below this fraction of the prior scale, where one is given.
 PRIOR_FLOOR = 0.1
 
+
 def finite_float(value) -> float | None:
     """``value`` as a finite float, or None (missing, None, NaN, ±inf, not a number)."""
     if value is None or isinstance(value, bool):

@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError
-
 from prsm_health.diagnostics.check_model import CHANGE_PREFIX, change_row, check_reading
+
 from .train import CLEARANCE_PARAMS, FAULT_PARAMS, clearance_target
 
 #: Cross-validation folds (by unit).
@@ -223,8 +223,8 @@ def _train_check_model(
     import pandas as pd
 
     from prsm_health.datasets import Dataset
-
     from prsm_health.diagnostics.estimators import ClearanceEstimator, FaultClassifier
+
     from .evaluation import cross_validated_metrics
 
     dirs = [check_dir] if isinstance(check_dir, (str, Path)) else list(check_dir)

@@ -419,9 +419,8 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
         bounds, class, top probability, observability, OOD score) for plots and sensitivity
         tables.
     """
-    from prsm_health.signals.features import dataset_features
-
     from prsm_health.diagnostics.diagnosis import diagnose_indicators
+    from prsm_health.signals.features import dataset_features
 
     require(split in ("test", "train", "all"), "split", split, "must be test, train or all")
     runs = dataset.runs if split == "all" else dataset.runs[dataset.runs["split"] == split]

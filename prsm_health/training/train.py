@@ -519,14 +519,18 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     # One OpenMP thread: a few hundred samples gain nothing from threads, and spin-waiting
     # threads of two busy processes on 2 cores made training 50× slower (docs/performance.md).
     from prsm_health.datasets import Dataset
+    from prsm_health.diagnostics.estimators import (
+        ClearanceEstimator,
+        DistributionGuard,
+        FaultClassifier,
+    )
+    from prsm_health.diagnostics.model_files import save_model
 
-    from prsm_health.diagnostics.estimators import ClearanceEstimator, DistributionGuard, FaultClassifier
     from .evaluation import (
         cross_validated_metrics,
         permutation_importance_table,
         sparse_feature_errors,
     )
-    from prsm_health.diagnostics.model_files import save_model
 
     require(target in TARGETS, "target", target, f"must be one of {', '.join(TARGETS)}")
     if not out.parent.exists():

@@ -12,10 +12,10 @@ from prsm_health.datasets import Dataset
 from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
 from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
-from prsm_health.training.evaluation import evaluate_model
-from prsm_health.training.train import train as train_model
 from prsm_health.io import read_recording
 from prsm_health.monitoring import FileAssetStore, diagnose_asset
+from prsm_health.training.evaluation import evaluate_model
+from prsm_health.training.train import train as train_model
 
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
