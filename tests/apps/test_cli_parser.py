@@ -8,8 +8,7 @@ import sys
 
 import pytest
 
-from prsm_health.apps.cli import build_parser
-from prsm_health.apps.cli import parser as cli_parser
+from prsm_health.apps.cli import build_parser, live_options, prognose_options, simulate_options
 from prsm_health.apps.cli.options import HelpFormatter, Parser, has_default
 
 #: Default spellings the help used before it had one form: "(default 10e-6)", "(0)", "(1)",
@@ -87,13 +86,17 @@ def test_mirrored_constants_are_the_librarys():
     from prsm_health.prognostics import METHODS
     from prsm_health.simulation.instrumentation import DEFAULT_PROFILE
 
-    assert cli_parser.DEFAULT_PROFILE == DEFAULT_PROFILE
-    assert (cli_parser.LIVE_HOST, cli_parser.LIVE_PORT, cli_parser.LIVE_MESSAGE_BUDGET) == (
+    assert simulate_options.DEFAULT_PROFILE == DEFAULT_PROFILE
+    assert (
+        live_options.LIVE_HOST,
+        live_options.LIVE_PORT,
+        live_options.LIVE_MESSAGE_BUDGET,
+    ) == (
         live.DEFAULT_HOST,
         live.DEFAULT_PORT,
         live.MESSAGE_BUDGET,
     )
-    assert sorted(cli_parser.PROGNOSIS_METHODS) == sorted(METHODS)
+    assert sorted(prognose_options.PROGNOSIS_METHODS) == sorted(METHODS)
 
 
 def test_help_loads_no_heavy_library():
