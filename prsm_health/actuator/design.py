@@ -362,6 +362,27 @@ class PRSMDesign:
             f"must equal d_n/d_r = {thread_ratio:.4g} within {LEAD_TOLERANCE:.0%} "
             "(gear and thread rolling must agree)",
         )
+        self._validate_gear_fits_nut()
+
+    def _validate_gear_fits_nut(self) -> None:
+        # The roller gear turns on the roller's axis, on the orbit d_c = d_s + d_r: the internal
+        # pair's centre distance m·(z_ring − z_roller)/2 must be the orbit radius, i.e. the ring
+        # gear's pitch circle is the nut's (the teeth ratio is checked against d_n/d_r above).
+        g = self.gear
+        orbit = self.orbit_diameter
+        tooth_gap = g.ring_teeth - g.roller_teeth
+        low, high = ((1 - s * CONCENTRIC_TOLERANCE) * orbit / tooth_gap for s in (1, -1))
+        require(
+            low <= g.module <= high,
+            "gear.module",
+            g.module,
+            f"must lie in [{low:.6g}, {high:.6g}] m with gear.ring_teeth = {g.ring_teeth} and "
+            f"gear.roller_teeth = {g.roller_teeth}: the ring gear (pitch diameter "
+            f"module·ring_teeth = {g.ring_pitch_diameter:.6g} m) must fit the nut (d_n = "
+            f"{self.nut_diameter:.6g} m), its centre distance module·(ring_teeth − "
+            f"roller_teeth)/2 the roller orbit radius (d_s + d_r)/2 = {orbit / 2:.6g} m within "
+            f"{CONCENTRIC_TOLERANCE:.1%}",
+        )
 
     def _validate_roller_count(self) -> None:
         # Neighbouring rollers must not touch: chord between centres > roller major diameter.

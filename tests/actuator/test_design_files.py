@@ -87,6 +87,8 @@ def test_template_then_check(tmp_path, capsys):
         ),
         ("pitch = 0.002", 'pitch = "0.002"', "design.pitch = "),
         ("nut_diameter = 0.0325", "nut_diameter = 0.04", "design.nut_diameter = "),
+        # a ring gear of twice the nut's pitch diameter (the teeth ratio still d_n/d_r)
+        ("module = 0.0005", "module = 0.001", "gear.module = 0.001 is invalid: must lie in ["),
     ],
 )
 def test_check_refuses_a_bad_file_in_one_line(old, new, message, tmp_path, capsys):
