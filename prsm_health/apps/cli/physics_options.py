@@ -4,6 +4,7 @@ kinematics, stiffness, friction."""
 from __future__ import annotations
 
 from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS
+from prsm_health.actuator.states import DEFAULT_SPEED
 
 from .options import (
     DESIGN_HELP,
@@ -56,7 +57,12 @@ def add_physics_commands(command) -> None:
 
     p = command("kinematics", "speed ratios and characteristic frequencies of a design")
     p.add_argument("--design", type=design, default=DEFAULT_PRESET, help=DESIGN_HELP)
-    p.add_argument("--speed", type=finite_float, required=True, help="screw speed [rad/s]")
+    p.add_argument(
+        "--speed",
+        type=finite_float,
+        default=DEFAULT_SPEED,
+        help="screw speed [rad/s] (as simulate)",
+    )
     add_json(p)
     p.set_defaults(handler="physics:kinematics")
 

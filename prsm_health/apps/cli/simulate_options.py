@@ -6,7 +6,14 @@ import argparse
 
 from prsm_health.actuator.design import DEFAULT_PRESET
 from prsm_health.actuator.health_check import BUILT_IN as BUILT_IN_CHECKS
-from prsm_health.actuator.states import DEFAULT_LOAD, DRIVES, LOADS, MOTIONS, RAMP_SHAPES
+from prsm_health.actuator.states import (
+    DEFAULT_LOAD,
+    DEFAULT_SPEED,
+    DRIVES,
+    LOADS,
+    MOTIONS,
+    RAMP_SHAPES,
+)
 from prsm_health.core.errors import ParameterError
 from prsm_health.core.quantities import parse_force
 
@@ -98,7 +105,7 @@ def add_simulate_command(command) -> None:
         default_text="the health file's, else 1",
         help="friction multiplier [-]",
     )
-    s.add_argument("--speed", type=finite_float, default=100.0, help="screw speed [rad/s]")
+    s.add_argument("--speed", type=finite_float, default=DEFAULT_SPEED, help="screw speed [rad/s]")
     s.add_argument(
         "--load",
         type=force,
