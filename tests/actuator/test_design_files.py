@@ -2,6 +2,8 @@
 `--design FILE`, scenarios and recipes with a design file."""
 
 import json
+import math
+import re
 from dataclasses import fields
 from pathlib import Path
 
@@ -107,6 +109,20 @@ def test_show_table_and_json(capsys):
     assert main(["design", "show", str(ROOT / "datasets/designs/paper01.toml")]) == 0
     out = capsys.readouterr().out
     assert "gear.module" in out and "0.0005 m" in out and "masses.screw_inertia" in out
+
+
+def test_show_prints_the_lead_and_angles_in_degrees(capsys):
+    design = preset("paper01")
+    assert main(["design", "show", "paper01"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    rows = dict(re.split(r"\s{2,}", line, maxsplit=1) for line in lines)
+    assert rows["contact_angle"].startswith(f"{math.degrees(design.contact_angle):.6g} °")
+    assert rows["gear.pressure_angle"].startswith(
+        f"{math.degrees(design.gear.pressure_angle):.6g} °"
+    )
+    assert rows["lead (screw and nut, starts × pitch)"] == f"{design.screw_lead:.6g} m"
+    lead_angle = math.degrees(math.atan(design.screw_lead / (math.pi * design.screw_diameter)))
+    assert rows["lead angle λ_s (screw)"] == f"{lead_angle:.6g} °"
 
 
 def test_simulate_with_a_design_file_equals_the_preset(tmp_path, capsys):
