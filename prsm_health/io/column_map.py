@@ -19,7 +19,7 @@ import numpy as np
 from prsm_health.actuator.design import PRESETS, PRSMDesign
 from prsm_health.actuator.design_files import design_fingerprint, design_reference, load_design
 from prsm_health.core.channels import CHANNEL_NAMES
-from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.errors import PRSMHealthError, nearest_key, unknown_key_message
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml, tomllib
 
@@ -177,10 +177,9 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
     ``base`` is the folder a ``design`` file's relative path is read against; None (a map
     given as text) refuses a design file."""
     unknown = sorted(set(data) - set(MAP_KEYS))
-    if unknown:
-        raise PRSMHealthError(
-            f"{where}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(MAP_KEYS)}"
-        )
+    if unknown:  # named as design files name theirs: the nearest key, the allowed ones
+        key = unknown[0]
+        raise PRSMHealthError(f"{where}: {unknown_key_message('map', key, data[key], MAP_KEYS)}")
     columns = data.get("columns")
     if not isinstance(columns, dict) or not columns:
         raise PRSMHealthError(
@@ -188,9 +187,11 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
         )
     for name, column in columns.items():
         if name not in QUANTITY:
+            nearest = nearest_key(name, QUANTITY)
+            hint = "" if nearest is None else f" (did you mean {nearest!r}?)"
             raise PRSMHealthError(
-                f"{where}: [columns] {name!r} is not a channel; use time, motor_current or one of "
-                f"{', '.join(CHANNEL_NAMES)}"
+                f"{where}: [columns] {name!r} is not a channel{hint}; use time, motor_current or "
+                f"one of {', '.join(CHANNEL_NAMES)}"
             )
         if not isinstance(column, str) or not column:
             raise PRSMHealthError(f"{where}: [columns] {name} = {column!r} must be a column name")

@@ -145,7 +145,13 @@ def test_import_cli_and_mcap(rig, tmp_path, capsys):
         ),
         (
             lambda r: r.joinpath("map.toml").write_text(MAP.replace("nut_position =", "nut_pos =")),
-            "not a channel",
+            "'nut_pos' is not a channel (did you mean 'nut_position'?)",
+        ),
+        (
+            lambda r: r.joinpath("map.toml").write_text(
+                MAP.replace("sample_rate =", "sampl_rate =")
+            ),
+            "unknown key 'sampl_rate' in [map] (did you mean 'sample_rate'?)",
         ),
         (
             lambda r: r.joinpath("map.toml").write_text(
