@@ -16,10 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
-from prsm_health.actuator.design import PRESETS, PRSMDesign
+from prsm_health.actuator.design import PRESETS, PRSMDesign, require_metres
 from prsm_health.actuator.design_files import design_fingerprint, design_reference, load_design
 from prsm_health.core.channels import CHANNEL_NAMES
-from prsm_health.core.errors import PRSMHealthError, nearest_key, unknown_key_message
+from prsm_health.core.errors import (
+    ParameterError,
+    PRSMHealthError,
+    nearest_key,
+    unknown_key_message,
+)
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml, tomllib
 
@@ -232,6 +237,10 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
         value = data.get(key)
         if value is not None and not (isinstance(value, (int, float)) and value > 0):
             raise PRSMHealthError(f"{where}: {key} = {value!r} must be a positive number")
+    try:
+        require_metres("lead", data.get("lead"))
+    except ParameterError as exc:
+        raise PRSMHealthError(f"{where}: {exc}") from None
     if "motor_current" in columns:
         if data.get("torque_constant") is None:
             raise PRSMHealthError(

@@ -89,6 +89,10 @@ def test_template_then_check(tmp_path, capsys):
         ),
         ("pitch = 0.002", 'pitch = "0.002"', "design.pitch = "),
         ("nut_diameter = 0.0325", "nut_diameter = 0.04", "design.nut_diameter = "),
+        # a length typed in mm is blamed on its own key, not on a length computed from it
+        ("pitch = 0.002", "pitch = 2", "design.pitch = 2 is invalid: must be ≤ 0.1 m"),
+        ("screw_diameter = 0.0195", "screw_diameter = 19.5", "design.screw_diameter = 19.5 "),
+        ("face_width = 0.003", "face_width = 3", "gear.face_width = 3 "),
         # a ring gear of twice the nut's pitch diameter (the teeth ratio still d_n/d_r)
         ("module = 0.0005", "module = 0.001", "gear.module = 0.001 is invalid: must lie in ["),
     ],

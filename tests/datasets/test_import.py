@@ -148,6 +148,10 @@ def test_import_cli_and_mcap(rig, tmp_path, capsys):
             "'nut_pos' is not a channel (did you mean 'nut_position'?)",
         ),
         (
+            lambda r: r.joinpath("map.toml").write_text(MAP.replace("lead = 0.005", "lead = 5")),
+            "lead = 5 is invalid: must be ≤ 0.1 m: lengths are in metres",
+        ),
+        (
             lambda r: r.joinpath("map.toml").write_text(
                 MAP.replace("sample_rate =", "sampl_rate =")
             ),
