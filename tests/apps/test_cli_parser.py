@@ -129,3 +129,25 @@ def test_every_handler_exists():
         module, _, function = handler.partition(":")
         module = importlib.import_module(f"prsm_health.apps.cli.{module}")
         assert callable(getattr(module, function)), (path, handler)
+
+
+def test_the_formats_doc_names_the_default_step():
+    # docs/formats.md once called a 5 µs step "the command line's"; the default is "auto"
+    from pathlib import Path
+
+    from prsm_health.simulation.dynamics.model import (
+        AUTO_MAX_STEP,
+        AUTO_STABLE_FRACTION,
+        SimulationOptions,
+    )
+
+    default = build_parser().parse_args(["simulate"]).max_step
+    assert default == SimulationOptions().max_step
+    text = (Path(__file__).resolve().parents[2] / "docs" / "formats.md").read_text()
+    text = " ".join(text.split())
+    assert not re.search(r"command line's [\d.]+ µs step", text)
+    assert f'The default step, `max_step = "{default}"` (the command line\'s `--max-step`' in text
+    assert (
+        f"takes {AUTO_STABLE_FRACTION:g} of the stable step, at most {AUTO_MAX_STEP * 1e6:g} µs"
+        in text
+    )
