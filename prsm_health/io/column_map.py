@@ -22,6 +22,7 @@ from prsm_health.core.channels import CHANNEL_NAMES
 from prsm_health.core.errors import (
     ParameterError,
     PRSMHealthError,
+    a_or_an,
     nearest_key,
     unknown_key_message,
 )
@@ -215,8 +216,8 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
         if UNITS[unit][0] != QUANTITY[name]:
             accepted = [u for u, (q, _) in UNITS.items() if q == QUANTITY[name]]
             raise PRSMHealthError(
-                f"{where}: column {column!r} ({name}) is a {QUANTITY[name]}, but its unit "
-                f"{unit!r} is a {UNITS[unit][0]}; use one of {', '.join(accepted)}"
+                f"{where}: column {column!r} ({name}) is {a_or_an(QUANTITY[name])}, but its "
+                f"unit {unit!r} is {a_or_an(UNITS[unit][0])}; use one of {', '.join(accepted)}"
             )
     stray = sorted(set(units) - set(columns.values()))
     if stray:

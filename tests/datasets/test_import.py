@@ -141,7 +141,7 @@ def test_import_cli_and_mcap(rig, tmp_path, capsys):
             lambda r: r.joinpath("map.toml").write_text(
                 MAP.replace('pos_mm = "mm"', 'pos_mm = "deg"')
             ),
-            "is a length",
+            "(nut_position) is a length, but its unit 'deg' is an angle",
         ),
         (
             lambda r: r.joinpath("map.toml").write_text(MAP.replace("nut_position =", "nut_pos =")),
