@@ -18,9 +18,10 @@ Import from here, not from the modules: their split is this package's business.
 from .fitting import FitReport, cross_validate_units, diagnosed_threshold, fit_prognostics_model
 from .fleet import fleet_histories, simulated_histories
 from .history import HISTORY_COLUMNS, HistoryError, read_history, validate_history
+from .method import HORIZON_FACTOR
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
 from .prognosis import Prognosis
-from .rul import HORIZON_FACTOR, METHODS, RULModel, prognose
+from .rul import METHODS, RULModel, prognose
 
 __all__ = [
     "DEFAULT_PROGNOSTICS_MODEL",

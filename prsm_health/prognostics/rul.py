@@ -49,28 +49,9 @@ from prsm_health.core.jsonable import json_ready
 from .ageing_rul import AgeingRUL, PhysicsRUL
 from .degradation import FORMS, DegradationRUL
 from .history import Z90, model_design, one_line, validate_history
-from .method import (
-    CAPPED_WARNING_FRACTION,
-    HORIZON_FACTOR,
-    MIN_TRAINING_UNITS,
-    Estimate,
-    FleetSummary,
-    RULMethod,
-    TrainingFleet,
-    UnitHistory,
-)
+from .method import Estimate, FleetSummary, RULMethod, TrainingFleet, UnitHistory
 from .prognosis import Prognosis
 from .similarity import SimilarityRUL
-
-__all__ = [
-    "CAPPED_WARNING_FRACTION",
-    "HORIZON_FACTOR",
-    "METHODS",
-    "MIN_TRAINING_UNITS",
-    "SHORT_HISTORY_FRACTION",
-    "RULModel",
-    "prognose",
-]
 
 #: Methods :meth:`RULModel.predict` accepts. ``"degradation"`` uses the form chosen at
 #: fit time; ``"degradation-exponential"`` / ``"degradation-linear"`` force a form.

@@ -113,7 +113,7 @@ def test_domain_randomised_group_fields():
     for bad, needle in [
         ({"drive_train": {"coupling_stiff": [1e3, 2e3]}}, "coupling_stiff"),
         ({"drive_train": {"coupling_stiffness": [-1e3, 2e3]}}, "coupling_stiffness"),
-        ({"colour": {"red": [0, 1]}}, "unknown key"),
+        ({"colour": {"red": [0, 1]}}, r"unknown table \[colour\] in \[sweep\]"),
     ]:
         with pytest.raises(RecipeError, match=needle):
             Recipe.from_dict(dict(base, sweep={"mode": "random", "samples": 3, **bad}))
