@@ -11,7 +11,9 @@
 - No layer module imports the package root (``import prsm_health``, ``from prsm_health import
   X``, ``from .. import X``): the root re-exports every layer lazily, so importing it climbs.
 - No import cycle between modules, lazy imports and the root's re-exports included.
-- No module over ~800 lines unless it does one job (named below).
+- A module over ~800 lines is flagged for review: it is split by job, or its one job is named
+  below. The number is a review flag, not a target: a module is never squeezed under it
+  (shortened comments, merged lines) — the rule is one job per module, length follows.
 """
 
 import ast
@@ -25,6 +27,7 @@ PACKAGE = Path(prsm_health.__file__).resolve().parent
 ROOT = PACKAGE.parent
 ROOT_NAME = PACKAGE.name
 LAYERS = prsm_health.LAYERS
+#: The review flag (not a target to fit under): a longer module gets a look at its jobs.
 MAX_LINES = 800
 
 #: Modules over MAX_LINES that each do one job, and which.
@@ -266,7 +269,10 @@ def test_no_import_cycle():
 def test_module_does_one_job_or_is_short(module):
     rel = str(module.relative_to(PACKAGE))
     lines = len(module.read_text().splitlines())
-    assert lines <= MAX_LINES or rel in ONE_JOB, f"{rel}: {lines} lines (split it, or name its job)"
+    assert lines <= MAX_LINES or rel in ONE_JOB, (
+        f"{rel}: {lines} lines, flagged for review: split it by job, or name its one job in "
+        "ONE_JOB (do not squeeze it under the flag)"
+    )
 
 
 def test_the_docs_list_the_layers_in_order():

@@ -43,6 +43,39 @@ CONCENTRIC_TOLERANCE = 5e-3
 #: (paper 03 §1, Jones et al.), which no standard PRSM tolerates.
 LEAD_TOLERANCE = 1e-2
 
+#: Largest plausible value [m] of a design's lengths (PRSM screws run from a few mm to a few
+#: hundred mm, pitches and gear modules from 0.5 to a few mm): a larger value is a length typed
+#: in millimetres, refused naming its own key before any check that combines lengths would
+#: blame another (``pitch = 2`` would otherwise fail as a negative screw root diameter).
+LENGTH_LIMITS = {"pitch": 0.1, "lead": 0.1, "module": 0.1, "screw_free_length": 10.0}
+#: For every other length of a design.
+DEFAULT_LENGTH_LIMIT = 1.0
+#: The lengths [m] of :class:`PRSMDesign` itself (the gear's are checked by the gear).
+LENGTHS = (
+    "screw_diameter",
+    "roller_diameter",
+    "nut_diameter",
+    "pitch",
+    "nut_outer_diameter",
+    "screw_free_length",
+    "screw_bore_diameter",
+    "thread_addendum",
+    "roller_profile_radius",
+    "nut_length",
+)
+
+
+def require_metres(field: str, value) -> None:
+    """Refuse a length that reads as millimetres: above its :data:`LENGTH_LIMITS`."""
+    limit = LENGTH_LIMITS.get(field.rsplit(".", 1)[-1], DEFAULT_LENGTH_LIMIT)
+    if isinstance(value, (int, float)) and value > limit:
+        raise ParameterError(
+            field,
+            value,
+            f"must be ≤ {limit:g} m: lengths are in metres — typed in millimetres? "
+            f"{value:g} mm = {value * 1e-3:g} m",
+        )
+
 
 @dataclass(frozen=True)
 class Material:
@@ -127,6 +160,8 @@ class GearGeometry:
             f"must be an integer in [6, ring_teeth = {self.ring_teeth})",
         )
         require_positive("gear.module", self.module)
+        for name in ("module", "face_width"):
+            require_metres(f"gear.{name}", getattr(self, name))
         require_range(
             "gear.pressure_angle",
             self.pressure_angle,
@@ -257,6 +292,8 @@ class PRSMDesign:
             "screw_free_length",
         ):
             require_positive(f"design.{name}", getattr(self, name))
+        for name in LENGTHS:
+            require_metres(f"design.{name}", getattr(self, name))
         require_range(
             "design.contact_angle",
             self.contact_angle,
@@ -361,6 +398,27 @@ class PRSMDesign:
             ratio,
             f"must equal d_n/d_r = {thread_ratio:.4g} within {LEAD_TOLERANCE:.0%} "
             "(gear and thread rolling must agree)",
+        )
+        self._validate_gear_fits_nut()
+
+    def _validate_gear_fits_nut(self) -> None:
+        # The roller gear turns on the roller's axis, on the orbit d_c = d_s + d_r: the internal
+        # pair's centre distance m·(z_ring − z_roller)/2 must be the orbit radius, i.e. the ring
+        # gear's pitch circle is the nut's (the teeth ratio is checked against d_n/d_r above).
+        g = self.gear
+        orbit = self.orbit_diameter
+        tooth_gap = g.ring_teeth - g.roller_teeth
+        low, high = ((1 - s * CONCENTRIC_TOLERANCE) * orbit / tooth_gap for s in (1, -1))
+        require(
+            low <= g.module <= high,
+            "gear.module",
+            g.module,
+            f"must lie in [{low:.6g}, {high:.6g}] m with gear.ring_teeth = {g.ring_teeth} and "
+            f"gear.roller_teeth = {g.roller_teeth}: the ring gear (pitch diameter "
+            f"module·ring_teeth = {g.ring_pitch_diameter:.6g} m) must fit the nut (d_n = "
+            f"{self.nut_diameter:.6g} m), its centre distance module·(ring_teeth − "
+            f"roller_teeth)/2 the roller orbit radius (d_s + d_r)/2 = {orbit / 2:.6g} m within "
+            f"{CONCENTRIC_TOLERANCE:.1%}",
         )
 
     def _validate_roller_count(self) -> None:

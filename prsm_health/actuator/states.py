@@ -44,6 +44,8 @@ RAMP_SHAPES = ("linear", "cosine")
 DEFAULT_LOAD_SHARE = 0.2
 #: :data:`DEFAULT_LOAD_SHARE` as the force the profile holds until a design resolves it.
 DEFAULT_LOAD = ForceSpec(DEFAULT_LOAD_SHARE, "C_a")
+#: The screw speed of an :class:`OperatingProfile` not told otherwise [rad/s].
+DEFAULT_SPEED = 100.0
 #: A share of a rating is at most this many times the rating (the scenario refuses anything
 #: above the static rating C_0a anyway; this only catches a percentage written as a fraction).
 _MAX_SHARE = 100.0
@@ -238,7 +240,7 @@ class OperatingProfile:
 
     duration: float = 0.2
     motion: str = "constant"
-    speed: float = 100.0
+    speed: float = DEFAULT_SPEED
     accel_time: float = 0.02
     motion_period: float = 0.1
     load_profile: str = "constant"

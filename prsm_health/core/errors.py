@@ -148,6 +148,12 @@ def require_range(
     require(ok, field, value, f"must lie in {brackets[0]}{low:g}, {high:g}{brackets[1]}{suffix}")
 
 
+def a_or_an(noun: str) -> str:
+    """``noun`` with its indefinite article, for messages built from names: "an angle",
+    "a length", "an instrumentation profile" (by its first letter: the package's nouns)."""
+    return f"{'an' if noun[:1].lower() in 'aeiou' else 'a'} {noun}"
+
+
 def nearest_key(key: str, allowed: Iterable[str]) -> str | None:
     """The allowed key closest to a mistyped ``key`` (:func:`difflib.get_close_matches`), or
     None when none is close."""

@@ -7,7 +7,7 @@ import json
 import sys
 from pathlib import Path
 
-from .errors import PRSMHealthError
+from .errors import PRSMHealthError, a_or_an
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -24,9 +24,9 @@ def read_toml(path: str | Path, what: str, error: type[PRSMHealthError] = PRSMHe
     except FileNotFoundError:
         raise error(f"{path}: no such {what}") from None
     except IsADirectoryError:
-        raise error(f"{path}: is a directory, not a {what}") from None
+        raise error(f"{path}: is a directory, not {a_or_an(what)}") from None
     except UnicodeDecodeError:
-        raise error(f"{path}: not a text file (expected a {what} in TOML)") from None
+        raise error(f"{path}: not a text file (expected {a_or_an(what)} in TOML)") from None
     except tomllib.TOMLDecodeError as exc:
         raise error(f"{path}: not valid TOML ({exc})") from None
 

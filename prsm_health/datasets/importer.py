@@ -38,6 +38,7 @@ import json
 import math
 import os
 import shutil
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -91,9 +92,18 @@ def _labels(path: Path, names: list[str]):
     duplicated = sorted(set(table["recording"][table["recording"].duplicated()]))
     if duplicated:
         raise PRSMHealthError(f"{path}: recording(s) labelled twice: {', '.join(duplicated)}")
-    stray = sorted(set(table["recording"]) - set(names))
-    if stray:
-        raise PRSMHealthError(f"{path}: labels for recording(s) not given: {', '.join(stray)}")
+    extra = ~table["recording"].isin(names)
+    if extra.any():  # a labels table of the whole campaign, some recordings imported: fine
+        rows = [
+            f"data row {i + 1} ({name})"
+            for i, name in zip(np.flatnonzero(extra), table["recording"][extra])
+        ]
+        warnings.warn(
+            f"{path}: {len(rows)} label row(s) for recordings not given, ignored: "
+            f"{', '.join(rows)}",
+            stacklevel=3,
+        )
+        table = table[~extra].reset_index(drop=True)
     unlabelled = sorted(set(names) - set(table["recording"]))
     if unlabelled:
         raise PRSMHealthError(f"{path}: no labels for recording(s) {', '.join(unlabelled)}")

@@ -38,7 +38,9 @@ from prsm_health.core.errors import (
     ParameterError,
     PRSMHealthError,
     RecipeError,
+    nearest_key,
     require_known_keys,
+    unknown_key_message,
 )
 from prsm_health.core.quantities import parse_force
 from prsm_health.core.run import Run
@@ -142,6 +144,10 @@ class Recipe:
         if isinstance(data["sweep"], dict):
             data["sweep"] = flat_sweep(data["sweep"])
         faults = data.pop("faults", {})
+        if isinstance(faults, dict):
+            require_known_keys(
+                "faults", faults, [f.name for f in fields(FaultThresholds)], error=RecipeError
+            )
         try:
             thresholds = FaultThresholds(**faults)
         except TypeError as exc:
@@ -202,16 +208,13 @@ class Recipe:
         check(isinstance(sweep, dict), "sweep", sweep, "must be a table")
         mode = sweep.get("mode", "grid")
         check(mode in SWEEP_MODES, "sweep.mode", mode, f"must be one of {', '.join(SWEEP_MODES)}")
-        unknown = sorted(
-            set(sweep) - set(swept_keys(sweep)) - {"mode", "repeats", "samples", FAULT_CASE_KEY}
-        )
-        check(
-            not unknown,
-            "sweep",
-            unknown,
-            f"unknown key(s); allowed: mode, repeats, samples, {FAULT_CASE_KEY}, "
-            f"{', '.join(SWEPT)}, and fields of {', '.join(SWEPT_GROUPS)} as group.field",
-        )
+        known = ["mode", "repeats", "samples", FAULT_CASE_KEY, *SWEPT]
+        unknown = sorted(set(sweep) - set(swept_keys(sweep)) - set(known))
+        if unknown:  # named as design files name theirs: the nearest key, the allowed ones
+            raise RecipeError(
+                f"recipe: {unknown_key_message('sweep', unknown[0], sweep[unknown[0]], known)}, "
+                f"and fields of {', '.join(SWEPT_GROUPS)} as group.field"
+            )
         self._validate_fault_cases(check)
         repeats = sweep.get("repeats", 1)
         check(
@@ -388,17 +391,18 @@ class Recipe:
         check(isinstance(units, dict), "units", units, "must be a table {count = …, seed = …}")
         if not units:
             return
-        unknown = sorted(set(units) - {"count", "seed", "build"})
-        check(not unknown, "units", units, f"unknown key(s) {unknown}; allowed: count, seed, build")
+        require_known_keys("units", units, ["count", "seed", "build"], error=RecipeError)
         build = units.get("build", {})
         check(isinstance(build, dict), "units.build", build, "must be a table of [min, max]")
         for key, value in build.items():
+            nearest = nearest_key(key, UNIT_BUILD)
             check(
                 key in UNIT_BUILD
                 or key.split(".")[0] in ("options", "drive_train", "instrumentation"),
                 f"units.build.{key}",
                 value,
-                f"must be one of {', '.join(UNIT_BUILD)} or an options./drive_train./"
+                ("" if nearest is None else f"did you mean {nearest!r}? ")
+                + f"must be one of {', '.join(UNIT_BUILD)} or an options./drive_train./"
                 "instrumentation. field (what a unit is built and installed with)",
             )
             check(is_range(value), f"units.build.{key}", value, "must be [min, max]")

@@ -137,6 +137,16 @@ def _number(value) -> float:
     return math.nan if value is None else float(value)
 
 
+def baseline_only_note(cls: str, reason: str) -> str:
+    """The note of a class one check alone cannot show but the unit's baseline can, saying
+    how to get that reading."""
+    return (
+        f"not observable by one check alone: {cls} — {reason}; against this unit's baseline "
+        "(its first health checks) it is observable: diagnose the unit's checks under its "
+        "asset id (diagnose --asset ID, or the service's asset_id) to read them against it"
+    )
+
+
 def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
     """Diagnosis of one health-check recording by the bundle's check model.
 
@@ -204,11 +214,7 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
     for cls, reason in model.not_observable.items():
         notes.append(f"not observable by this check: {cls} — {reason}")
     if not relative:
-        for cls, reason in model.baseline_only.items():
-            notes.append(
-                f"not observable by one check alone: {cls} — {reason}; against this unit's "
-                "baseline (its first health checks) it is"
-            )
+        notes += [baseline_only_note(cls, reason) for cls, reason in model.baseline_only.items()]
     if baseline is None and model.fault_relative is not None:
         notes.append(
             "read alone: no baseline of this unit (its first health checks); against a "

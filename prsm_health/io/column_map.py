@@ -16,10 +16,16 @@ from pathlib import Path
 
 import numpy as np
 
-from prsm_health.actuator.design import PRESETS, PRSMDesign
+from prsm_health.actuator.design import PRESETS, PRSMDesign, require_metres
 from prsm_health.actuator.design_files import design_fingerprint, design_reference, load_design
 from prsm_health.core.channels import CHANNEL_NAMES
-from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.errors import (
+    ParameterError,
+    PRSMHealthError,
+    a_or_an,
+    nearest_key,
+    unknown_key_message,
+)
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml, tomllib
 
@@ -177,10 +183,9 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
     ``base`` is the folder a ``design`` file's relative path is read against; None (a map
     given as text) refuses a design file."""
     unknown = sorted(set(data) - set(MAP_KEYS))
-    if unknown:
-        raise PRSMHealthError(
-            f"{where}: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(MAP_KEYS)}"
-        )
+    if unknown:  # named as design files name theirs: the nearest key, the allowed ones
+        key = unknown[0]
+        raise PRSMHealthError(f"{where}: {unknown_key_message('map', key, data[key], MAP_KEYS)}")
     columns = data.get("columns")
     if not isinstance(columns, dict) or not columns:
         raise PRSMHealthError(
@@ -188,9 +193,11 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
         )
     for name, column in columns.items():
         if name not in QUANTITY:
+            nearest = nearest_key(name, QUANTITY)
+            hint = "" if nearest is None else f" (did you mean {nearest!r}?)"
             raise PRSMHealthError(
-                f"{where}: [columns] {name!r} is not a channel; use time, motor_current or one of "
-                f"{', '.join(CHANNEL_NAMES)}"
+                f"{where}: [columns] {name!r} is not a channel{hint}; use time, motor_current or "
+                f"one of {', '.join(CHANNEL_NAMES)}"
             )
         if not isinstance(column, str) or not column:
             raise PRSMHealthError(f"{where}: [columns] {name} = {column!r} must be a column name")
@@ -209,8 +216,8 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
         if UNITS[unit][0] != QUANTITY[name]:
             accepted = [u for u, (q, _) in UNITS.items() if q == QUANTITY[name]]
             raise PRSMHealthError(
-                f"{where}: column {column!r} ({name}) is a {QUANTITY[name]}, but its unit "
-                f"{unit!r} is a {UNITS[unit][0]}; use one of {', '.join(accepted)}"
+                f"{where}: column {column!r} ({name}) is {a_or_an(QUANTITY[name])}, but its "
+                f"unit {unit!r} is {a_or_an(UNITS[unit][0])}; use one of {', '.join(accepted)}"
             )
     stray = sorted(set(units) - set(columns.values()))
     if stray:
@@ -231,6 +238,10 @@ def parse_column_map(data: dict, where: str = "map", *, base: Path | None = None
         value = data.get(key)
         if value is not None and not (isinstance(value, (int, float)) and value > 0):
             raise PRSMHealthError(f"{where}: {key} = {value!r} must be a positive number")
+    try:
+        require_metres("lead", data.get("lead"))
+    except ParameterError as exc:
+        raise PRSMHealthError(f"{where}: {exc}") from None
     if "motor_current" in columns:
         if data.get("torque_constant") is None:
             raise PRSMHealthError(

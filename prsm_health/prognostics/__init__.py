@@ -1,8 +1,12 @@
 """Prognostics: remaining useful life from a unit's history of diagnoses (docs/prognostics.md).
 
 - :mod:`.history` — the history table: columns, reading a file, validation with row-naming errors
-- :mod:`.degradation` — the Bayesian degradation model's arithmetic (Gebraeel et al. 2005)
-- :mod:`.rul` — :class:`RULModel` (degradation model, similarity baseline) → :class:`Prognosis`
+- :mod:`.method` — the interface the RUL methods implement (``fit`` on a training fleet,
+  ``predict`` from a unit's history)
+- :mod:`.degradation` — the Bayesian degradation model (Gebraeel et al. 2005)
+- :mod:`.similarity` — the similarity baseline (Wang et al. 2008)
+- :mod:`.ageing_model`, :mod:`.ageing_rul` — the physics model: the PRSM's ageing in progpy
+- :mod:`.rul` — :class:`RULModel` (the three methods) → :class:`Prognosis`
 - :mod:`.model_files` — JSON model files
 - :mod:`.fleet` — a fleet dataset's snapshots diagnosed into histories
 - :mod:`.fitting` — a model fitted for a fleet of any design, scored on its held-out units
@@ -20,9 +24,10 @@ from .history import (
     read_history,
     validate_history,
 )
+from .method import HORIZON_FACTOR
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
 from .prognosis import Prognosis
-from .rul import HORIZON_FACTOR, METHODS, RULModel, prognose
+from .rul import METHODS, RULModel, prognose
 
 __all__ = [
     "DEFAULT_PROGNOSTICS_MODEL",

@@ -1,5 +1,5 @@
-"""RUL by the PRSM's ageing model: progpy's particle filter on a unit's diagnoses, progpy's
-Monte Carlo predictor to the wear limit.
+"""The physics method of RUL (:class:`PhysicsRUL`): the PRSM's ageing model, progpy's particle
+filter on a unit's diagnoses, progpy's Monte Carlo predictor to the wear limit.
 
 :class:`AgeingRUL` holds the model's physics (the rate tables of
 :func:`~prsm_health.prognostics.ageing_model.rate_tables`, from the fleet recipe's ``[life]``),
@@ -34,6 +34,7 @@ import numpy as np
 from prsm_health.core.errors import require
 
 from .history import duty_arrays, history_arrays
+from .method import CAPPED_WARNING_FRACTION, Estimate, RULMethod, TrainingFleet, UnitHistory
 from .prognosis import QUANTILES
 
 #: Broad prior of (log_wear, log_lubricant_life) the training units are filtered from.
@@ -273,8 +274,8 @@ class AgeingRUL:
         the calibration — without it the diagnosis is taken as unbiased) and
         ``failure_age_hours``.
         """
-        lives = histories.groupby("unit_id")["failure_age_hours"].first()
-        horizon = horizon or 3.0 * float(lives.max())
+        if horizon is None:
+            horizon = 3.0 * float(histories["failure_age_hours"].max())
         _, z, sd = history_arrays(histories)
         bias, gain, scale = 0.0, 1.0, 1.0
         if "clearance_mean_true" in histories.columns:
@@ -331,3 +332,77 @@ class AgeingRUL:
     def from_dict(cls, d: dict) -> AgeingRUL:
         d = dict(d)
         return cls(d.pop("tables"), **d)
+
+
+class PhysicsRUL(RULMethod):
+    """The physics method: an :class:`AgeingRUL` behind the RUL-method interface.
+
+    Parameters
+    ----------
+    tables : dict or None
+        :func:`~prsm_health.prognostics.ageing_model.rate_tables` of the fleet recipe, for
+        :meth:`fit`.
+    spec : LifeSpec or None
+        The fleet recipe's ``[life]``, for :meth:`fit`.
+    seed : int
+        Seed of the fitted estimator.
+    estimator : AgeingRUL or None
+        An estimator already fitted (e.g. read from a model file): ``estimator_``.
+    """
+
+    name = "physics"
+
+    def __init__(self, tables=None, spec=None, *, seed: int = 0, estimator=None):
+        self.tables, self.spec, self.seed = tables, spec, seed
+        if estimator is not None:
+            self.estimator_ = estimator
+
+    def fit(self, fleet: TrainingFleet) -> PhysicsRUL:
+        require(
+            self.tables is not None and self.spec is not None,
+            "physics",
+            None,
+            "needs the fleet recipe's rate tables and [life] to be fitted",
+        )
+        self.estimator_ = AgeingRUL.fit(
+            self.tables,
+            self.spec,
+            fleet.histories,
+            seed=self.seed,
+            horizon=fleet.summary.horizon,
+        )
+        return self
+
+    def predict(self, history: UnitHistory) -> Estimate:
+        return self._estimate(
+            self.estimator_.predict_arrays(history.t, history.value, history.sd, **history.duty)
+        )
+
+    def predict_prefixes(self, history: UnitHistory, min_rows: int) -> list[Estimate]:
+        # one pass of the filter gives every prefix's prediction
+        ruls = self.estimator_.predict_prefix_arrays(
+            history.t, history.value, history.sd, min_rows=min_rows, **history.duty
+        )
+        return [self._estimate(rul) for rul in ruls]
+
+    def _estimate(self, result: dict) -> Estimate:
+        from .ageing_model import PRSMAgeing  # progpy: imported only where prognostics run
+
+        ageing = self.estimator_
+        model = {
+            "name": self.name,
+            "states": list(PRSMAgeing.states),
+            "posterior": result["posterior"],
+            "failure_clearance": ageing.tables["failure_clearance"],
+            "n_particles": ageing.n_particles,
+            "n_samples": ageing.n_samples,
+            "capped_fraction": result["capped_fraction"],
+        }
+        warnings = []
+        if result["capped_fraction"] > CAPPED_WARNING_FRACTION:
+            warnings.append(
+                f"{result['capped_fraction']:.0%} of the predicted units do not reach the wear "
+                f"limit within the horizon; their RUL is capped at {ageing.horizon:.4g} h"
+            )
+        rul = {k: result[k] for k in ("estimate", "lower", "upper")}
+        return Estimate(rul, model, warnings)

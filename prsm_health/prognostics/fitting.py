@@ -17,6 +17,7 @@ import pandas as pd
 from prsm_health.actuator.design_files import design_fingerprint, same_design
 from prsm_health.core.errors import PRSMHealthError, require
 
+from .ageing_rul import PhysicsRUL
 from .fleet import fleet_histories
 from .metrics import evaluate_units, pooled_scores
 from .rul import RULModel
@@ -260,20 +261,14 @@ def _fitted_model(
         n_samples=n_samples,
         random_state=random_state,
     )
-    # fit validates each unit's history against the model: histories of another design fail
-    model.fit(train, {u: failure[u] for u in train["unit_id"].unique()})
-    model.ageing_ = None
+    physics = None
     if spec is not None:
-        from .ageing_model import rate_tables
-        from .ageing_rul import AgeingRUL
+        from .ageing_model import rate_tables  # progpy: imported only where the physics is
 
-        model.ageing_ = AgeingRUL.fit(
-            rate_tables(design, spec),
-            spec,
-            train,
-            seed=0 if random_state is None else random_state,
-            horizon=model.horizon_,
-        )
+        seed = 0 if random_state is None else random_state
+        physics = PhysicsRUL(rate_tables(design, spec), spec, seed=seed)
+    # fit validates each unit's history against the model: histories of another design fail
+    model.fit(train, {u: failure[u] for u in train["unit_id"].unique()}, physics=physics)
     return model
 
 

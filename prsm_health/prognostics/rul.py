@@ -7,28 +7,19 @@ unit fails when its true clearance reaches ``threshold`` [m]. A :class:`RULModel
 fitted on a training fleet (the histories of units run to failure and their failure ages) and
 predicts a :class:`Prognosis`: the RUL [h] with a 90 % interval (5 % and 95 % quantiles).
 
-Two methods:
+The model holds three methods behind one interface (:class:`~.method.RULMethod`: ``fit`` on a
+training fleet, ``predict`` from a unit's history), each in its own module:
 
-- ``"degradation"`` (default), after Gebraeel et al. [1]_: the exponential degradation model
-  ``S(t) = phi + theta exp(beta t + eps)``, i.e. ``L(t) = ln(S - phi) = ln theta + beta t + eps``,
-  ``eps ~ N(0, sigma^2)`` [1]_, or its linear form ``S(t) = theta + beta t + eps``.
-  ``(ln theta, beta)`` has a bivariate Gaussian prior fitted on the training fleet (per-unit
-  weighted least-squares fits, their mean and covariance, as in [1]_), updated by the unit's
-  history into a Gaussian posterior (the conjugate update of [1]_, with a known variance per
-  diagnosis: ``sigma^2`` plus the measurement variance implied by the diagnosis' 90 % interval,
-  ``(half-width / 1.645)^2``, propagated through the log). The RUL distribution comes from
-  ``n_samples`` posterior draws, each solved for its crossing of the threshold (one draw of
-  ``eps`` per sample: the signal error at the crossing, as in the residual-life distribution
-  of [1]_). Which form a fitted model uses is chosen by the leave-one-unit-out RMSE of RUL on
-  the training fleet.
-- ``"similarity"``, after Wang et al. [2]_: each training unit's smoothed trajectory (its fitted
-  degradation curve) and failure age form a library; the history is aligned to each library
-  curve by the time shift that minimizes its measurement-weighted squared distance, the library
-  units are weighted by a (tempered) Gaussian kernel of that distance, and the RUL is the
-  weighted median (interval: weighted 5 % and 95 % quantiles) of the library units' remaining
-  lives past the aligned age.
+- ``"degradation"`` (default), the Bayesian degradation model after Gebraeel et al. [1]_
+  (:class:`~.degradation.DegradationRUL`);
+- ``"similarity"``, the similarity baseline after Wang et al. [2]_
+  (:class:`~.similarity.SimilarityRUL`);
+- ``"physics"``, the PRSM's ageing model in progpy, when fitted on a fleet dataset whose
+  ``[life]`` recipe gives the physics (:class:`~.ageing_rul.PhysicsRUL`).
 
-Metrics and the fleet evaluation are in :mod:`prsm_health.prognostics.metrics`.
+This module gathers the fleet, dispatches to a method and turns its estimate into a
+:class:`Prognosis` with the warnings every method shares; it also reads and writes the
+model's dict. Metrics and the fleet evaluation are in :mod:`prsm_health.prognostics.metrics`.
 
 References
 ----------
@@ -37,13 +28,10 @@ References
 .. [2] T. Wang, J. Yu, D. Siegel, J. Lee, "A similarity-based prognostics approach for
    remaining useful life estimation of engineered systems", Int. Conf. on Prognostics and
    Health Management (PHM 2008), Denver, 2008.
-.. [3] D. A. Harville, "Maximum likelihood approaches to variance component estimation and to
-   related problems", JASA 72 (1977) 320-338 (the restricted likelihood used for ``sigma^2``).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 
 import numpy as np
@@ -59,28 +47,12 @@ from prsm_health.core.errors import (
 from prsm_health.core.jsonable import json_ready
 from prsm_health.core.version import __version__
 
-from .degradation import (
-    curve,
-    fit_sigma2,
-    posterior,
-    prior,
-    profile_phi,
-    sample_gaussian,
-    transform,
-    wls_by_unit,
-    y_threshold,
-)
-from .history import (
-    Z90,
-    HistoryError,
-    duty_arrays,
-    history_arrays,
-    model_design,
-    one_line,
-    validate_history,
-)
-from .prognosis import QUANTILES, Prognosis
-from .similarity import similarity_rul
+from .ageing_rul import AgeingRUL, PhysicsRUL
+from .degradation import FORMS, DegradationRUL
+from .history import Z90, model_design, one_line, validate_history
+from .method import Estimate, FleetSummary, RULMethod, TrainingFleet, UnitHistory
+from .prognosis import Prognosis
+from .similarity import SimilarityRUL
 
 #: Methods :meth:`RULModel.predict` accepts. ``"degradation"`` uses the form chosen at
 #: fit time; ``"degradation-exponential"`` / ``"degradation-linear"`` force a form.
@@ -91,70 +63,22 @@ METHODS = (
     "similarity",
     "physics",
 )
-#: RUL is capped at this multiple of the training fleet's longest life [-] (the horizon):
-#: posterior samples that never reach the threshold (wear rate <= 0) or reach it later get it.
-HORIZON_FACTOR = 3.0
-#: A capped fraction of samples above this moves the 95 % quantile: then a warning says so.
-CAPPED_WARNING_FRACTION = 0.05
 #: A history spanning less than this fraction of the fleet's median life gets a warning.
 SHORT_HISTORY_FRACTION = 0.1
-#: Fewest training units: the leave-one-unit-out prior needs a covariance of at least 2 others.
-MIN_TRAINING_UNITS = 3
 
 _FORMAT = "prsm_health-prognostics"
 _FORMAT_VERSION = 1
-_FORMS = ("exponential", "linear")
-
-
-# --------------------------------------------------------------------------------------------
-# Prognosis
-# --------------------------------------------------------------------------------------------
-
-
-# --------------------------------------------------------------------------------------------
-# The model
-# --------------------------------------------------------------------------------------------
 
 
 class RULModel:
-    """RUL from a history of diagnoses: Bayesian degradation model and similarity baseline.
+    """RUL from a history of diagnoses: the degradation model, the similarity baseline and,
+    where fitted, the physics model.
 
     ``__init__`` stores its arguments; :meth:`fit` learns from a training fleet (attributes
-    ending in ``_``); :meth:`predict` returns a :class:`Prognosis`.
-
-    Fitting, degradation model [1]_:
-
-    1. The exponential form's baseline ``phi`` [m] is the fleet's initial clearance level
-       ``c_ref`` (the smallest first diagnosis of a training unit) minus a margin, the margin
-       (between 0.1 % and 100 % of ``threshold - c_ref``) chosen by the profile likelihood of
-       the diagnosed clearances. Diagnoses within one measurement standard deviation of
-       ``phi`` are clipped to ``phi`` + one standard deviation (their log carries no wear
-       information; their variance is then 1 in log units); a history with values at or below
-       ``phi`` gets a warning.
-    2. ``sigma^2`` is the pooled residual variance of per-unit lines, estimated by restricted
-       maximum likelihood [3]_ with each diagnosis' measurement variance added (floored at
-       1e-16 in model units).
-    3. Per-unit weighted least-squares ``(a, b)`` = ``(ln theta, beta)`` (exponential) or
-       ``(theta, beta)`` (linear) give the prior mean and covariance (sample covariance, which
-       includes the per-unit estimation error: a slightly wide, conservative prior).
-    4. The form (exponential or linear) is the one with the lower leave-one-unit-out RMSE of
-       RUL over all history prefixes of >= 2 diagnoses of the training units (each unit
-       predicted with the prior of the others; ``phi`` and ``sigma^2`` kept from the whole
-       fleet; the point prediction is the posterior mean's crossing). Ties go to exponential.
-
-    Prediction: the posterior of ``(a, b)`` given the history (conjugate update), ``n_samples``
-    draws of it and of ``eps``, each solved for the crossing age ``(y_D - a - eps) / b`` with
-    ``y_D = ln(threshold - phi)`` or ``threshold``; RUL = crossing age - current age, clipped
-    to [0, horizon], the horizon being ``3 x`` the fleet's longest life (samples with
-    ``b <= 0`` never cross and get the horizon). When the latest clearance estimate is at or
-    above the threshold the RUL is 0 with a warning.
-
-    Similarity model [2]_: :mod:`prsm_health.prognostics.similarity` (the alignment, the kernel).
-
-    Physics model (``"physics"``, when fitted by :func:`~prsm_health.prognostics.fit_prognostics_model`
-    on a fleet dataset, whose ``[life]`` recipe gives the physics): the PRSM's ageing as a
-    progpy model, a particle filter on the diagnoses, progpy's Monte Carlo prediction
-    (:mod:`prsm_health.prognostics.ageing_rul`).
+    ending in ``_``); :meth:`predict` returns a :class:`Prognosis`. The methods are in their
+    modules (module docstring). Every prediction's RUL is clipped to [0, horizon], the horizon
+    being ``HORIZON_FACTOR`` x the fleet's longest life; when the latest clearance estimate
+    is at or above the threshold the RUL is 0 with a warning.
 
     Parameters
     ----------
@@ -178,6 +102,11 @@ class RULModel:
 
     Attributes
     ----------
+    degradation_ : DegradationRUL
+        The degradation model; ``form_``, ``loo_rmse_`` and ``forms_`` are its.
+    similarity_ : SimilarityRUL
+    ageing_ : AgeingRUL or None
+        The physics model's estimator (None: no physics part).
     form_ : {"exponential", "linear"}
         Degradation form chosen at fit time.
     loo_rmse_ : dict
@@ -193,12 +122,6 @@ class RULModel:
         RUL cap [h]: ``HORIZON_FACTOR`` x the longest training life.
     c_ref_ : float
         The fleet's initial clearance level [m].
-
-    References
-    ----------
-    .. [1] N. Z. Gebraeel, M. A. Lawley, R. Li, J. K. Ryan, IIE Transactions 37 (2005) 543-557.
-    .. [2] T. Wang, J. Yu, D. Siegel, J. Lee, PHM 2008.
-    .. [3] D. A. Harville, JASA 72 (1977) 320-338.
     """
 
     def __init__(
@@ -264,7 +187,7 @@ class RULModel:
         return model_design(self.design, self.design_fingerprint)
 
     def _is_fitted(self) -> bool:
-        return hasattr(self, "forms_")
+        return hasattr(self, "degradation_")
 
     def _require_fitted(self) -> None:
         if not self._is_fitted():
@@ -274,8 +197,8 @@ class RULModel:
 
     # ---------------------------------------------------------------------------- fitting
 
-    def fit(self, histories: pd.DataFrame, failure_ages: Mapping) -> RULModel:
-        """Fit both methods on a training fleet run to failure.
+    def fit(self, histories: pd.DataFrame, failure_ages: Mapping, physics=None) -> RULModel:
+        """Fit the methods on a training fleet run to failure.
 
         Parameters
         ----------
@@ -285,6 +208,8 @@ class RULModel:
         failure_ages : Mapping
             Unit id -> true age at failure [h] (when its true clearance reached
             ``threshold``), > 0 for every unit in ``histories``.
+        physics : PhysicsRUL or None
+            The physics method to fit too (it needs the fleet recipe); None: no physics part.
 
         Returns
         -------
@@ -299,122 +224,31 @@ class RULModel:
             that starts at or above the threshold.
         """
         self._check_params()
-        require(
-            isinstance(histories, pd.DataFrame) and "unit_id" in histories.columns,
-            "histories",
-            type(histories).__name__,
-            "must be a pandas DataFrame with a unit_id column",
-        )
-        if isinstance(failure_ages, pd.Series):
-            failure_ages = failure_ages.to_dict()
-        require(
-            isinstance(failure_ages, Mapping),
-            "failure_ages",
-            type(failure_ages).__name__,
-            "must be a mapping unit_id -> age at failure [h]",
-        )
-        units, parts, lives = [], [], []
-        for uid, rows in histories.groupby("unit_id", sort=True):
-            uid = uid.item() if isinstance(uid, np.generic) else uid
-            try:
-                part = validate_history(rows, self)
-            except HistoryError as err:
-                raise HistoryError(f"unit {uid!r}: {err}", err.field, err.value) from None
-            require(uid in failure_ages, "failure_ages", uid, "has no failure age for this unit")
-            life = failure_ages[uid]
-            require(
-                isinstance(life, (int, float, np.number)) and math.isfinite(life) and life > 0,
-                f"failure_ages[{uid!r}]",
-                life,
-                "must be a finite age > 0 [h]",
-            )
-            units.append(uid)
-            parts.append(part)
-            lives.append(float(life))
-        require(
-            len(units) >= MIN_TRAINING_UNITS,
-            "histories",
-            f"{len(units)} unit(s)",
-            f"a prognostics model needs at least {MIN_TRAINING_UNITS} training units",
-        )
-        lives = np.array(lives)
-        c_ref = float(min(p["clearance"].iloc[0] for p in parts))
-        require(
-            self.threshold > c_ref,
-            "threshold",
-            float(self.threshold),
-            f"must exceed the fleet's initial clearance {c_ref:.6g} m",
-        )
-        self.units_ = units
-        self.failure_ages_ = lives
-        self.t_scale_ = float(np.median(lives))
-        self.horizon_ = HORIZON_FACTOR * float(lives.max())
-        self.c_ref_ = c_ref
-
-        codes = np.concatenate([np.full(len(p), i) for i, p in enumerate(parts)])
-        t, value, sd = (np.concatenate(x) for x in zip(*(history_arrays(p) for p in parts)))
-        tau = t / self.t_scale_
-        n_units = len(units)
-        thr = float(self.threshold)
-
-        phi = profile_phi(tau, value, sd, codes, n_units, c_ref, thr)
-        self.forms_ = {}
-        for form in _FORMS:
-            form_phi = phi if form == "exponential" else 0.0
-            y, m, _ = transform(form, value, sd, form_phi, thr)
-            sigma2, _ = fit_sigma2(tau, y, m, codes, n_units)
-            a, b, _ = wls_by_unit(tau, y, 1.0 / (sigma2 + m), codes, n_units)
-            params = np.column_stack([a, b])
-            mean, cov = prior(params)
-            residual = value - curve(form, a[codes], b[codes], tau, form_phi, thr)
-            excess = np.bincount(codes, residual**2 - sd**2, n_units) / np.bincount(
-                codes, None, n_units
-            )
-            self.forms_[form] = {
-                "phi": form_phi,
-                "sigma2": sigma2,
-                "mean": mean,
-                "cov": cov,
-                "params": params,
-                "residual_var": np.clip(excess, 0.0, None),
-            }
-        self.loo_rmse_ = {form: self._loo_rmse(form, codes, tau, t, value, sd) for form in _FORMS}
-        self.form_ = min(_FORMS, key=lambda f: (self.loo_rmse_[f], _FORMS.index(f)))
+        fleet = TrainingFleet.from_histories(histories, failure_ages, self.threshold, self)
+        self._set_fleet(fleet.summary)
+        self.degradation_ = DegradationRUL(self.n_samples, self.random_state).fit(fleet)
+        self.similarity_ = SimilarityRUL(self.degradation_).fit(fleet)
+        self.ageing_ = None if physics is None else physics.fit(fleet).estimator_
         return self
 
-    def _loo_rmse(self, form, codes, tau, t, value, sd) -> float:
-        """Leave-one-unit-out RMSE of RUL [h] of one form over every prefix of >= 2 rows."""
-        state = self.forms_[form]
-        thr = float(self.threshold)
-        y, m, _ = transform(form, value, sd, state["phi"], thr)
-        w = 1.0 / (state["sigma2"] + m)
-        y_d = y_threshold(form, state["phi"], thr)
-        errors = []
-        for u in range(len(self.units_)):
-            keep = np.arange(len(self.units_)) != u
-            mean0, cov0 = prior(state["params"][keep])
-            p0 = np.linalg.inv(cov0)
-            r0 = p0 @ mean0
-            rows = codes == u
-            wu, tu, yu = w[rows], tau[rows], y[rows]
-            a00 = p0[0, 0] + np.cumsum(wu)
-            a01 = p0[0, 1] + np.cumsum(wu * tu)
-            a11 = p0[1, 1] + np.cumsum(wu * tu * tu)
-            b0 = r0[0] + np.cumsum(wu * yu)
-            b1 = r0[1] + np.cumsum(wu * tu * yu)
-            det = a00 * a11 - a01 * a01
-            a = (a11 * b0 - a01 * b1) / det
-            b = (a00 * b1 - a01 * b0) / det
-            with np.errstate(divide="ignore", invalid="ignore"):
-                crossing = np.where(b > 0, (y_d - a) / b, np.inf) * self.t_scale_
-            ages = t[rows]
-            rul = np.clip(crossing - ages, 0.0, self.horizon_)
-            rul = np.where(value[rows] >= thr, 0.0, rul)
-            true = self.failure_ages_[u] - ages
-            use = (np.arange(rows.sum()) >= 1) & (true >= 0)
-            errors.append(rul[use] - true[use])
-        errors = np.concatenate(errors)
-        return float(np.sqrt(np.mean(errors**2))) if errors.size else math.inf
+    def _set_fleet(self, fleet: FleetSummary) -> None:
+        self.units_ = fleet.units
+        self.failure_ages_ = fleet.lives
+        self.t_scale_ = fleet.t_scale
+        self.horizon_ = fleet.horizon
+        self.c_ref_ = fleet.c_ref
+
+    @property
+    def form_(self) -> str:
+        return self.degradation_.form_
+
+    @property
+    def forms_(self) -> dict:
+        return self.degradation_.forms_
+
+    @property
+    def loo_rmse_(self) -> dict:
+        return self.degradation_.loo_rmse_
 
     # ---------------------------------------------------------------------------- prediction
 
@@ -443,10 +277,9 @@ class RULModel:
         PRSMHealthError
             An unfitted model.
         """
-        self._require_fitted()
-        method = self._resolve_method(method)
-        clean = validate_history(history, self)
-        return self._predict_arrays(*history_arrays(clean), method, duty_arrays(clean))
+        rul_method = self._method(method)
+        unit = UnitHistory.from_table(validate_history(history, self))
+        return self._prognosis(unit, rul_method.predict(unit))
 
     def predict_prefixes(self, history: pd.DataFrame, method=None, min_rows: int = 2) -> list:
         """Prognoses at every prefix of the history, each from the rows up to it only.
@@ -465,49 +298,59 @@ class RULModel:
         list of Prognosis
             One per prefix of ``min_rows`` … ``len(history)`` rows, in age order.
         """
-        self._require_fitted()
-        method = self._resolve_method(method)
+        rul_method = self._method(method)
         require(
             isinstance(min_rows, (int, np.integer)) and min_rows >= 2,
             "min_rows",
             min_rows,
             "must be an integer >= 2",
         )
-        clean = validate_history(history, self)
-        t, value, sd = history_arrays(clean)
-        if method == "physics":  # one pass of the filter gives every prefix's prediction
-            ruls = self._ageing().predict_prefix_arrays(
-                t, value, sd, min_rows=min_rows, **duty_arrays(clean)
-            )
-            return [
-                self._prognosis(t[:k], value[:k], sd[:k], *self._physics(rul))
-                for k, rul in zip(range(min_rows, len(t) + 1), ruls)
-            ]
+        unit = UnitHistory.from_table(validate_history(history, self))
+        estimates = rul_method.predict_prefixes(unit, min_rows)
         return [
-            self._predict_arrays(t[:k], value[:k], sd[:k], method)
-            for k in range(min_rows, len(t) + 1)
+            self._prognosis(unit.prefix(k), estimate)
+            for k, estimate in zip(range(min_rows, len(unit.t) + 1), estimates)
         ]
 
-    def _resolve_method(self, method) -> str:
+    def _method(self, method) -> RULMethod:
+        """The fitted method a prediction by ``method`` (default ``self.method``) uses."""
+        self._require_fitted()
         method = self.method if method is None else method
         require(method in METHODS, "method", method, f"must be one of {', '.join(METHODS)}")
-        return method
-
-    def _predict_arrays(self, t, value, sd, method, duty=None) -> Prognosis:
         if method == "similarity":
-            rul, model = self._similarity(t, value, sd)
-            more = []
-        elif method == "physics":
-            result = self._ageing().predict_arrays(t, value, sd, **(duty or {}))
-            rul, model, more = self._physics(result)
-        else:
-            form = self.form_ if method == "degradation" else method.split("-", 1)[1]
-            rul, model, more = self._degradation(form, t, value, sd)
-        return self._prognosis(t, value, sd, rul, model, more)
+            return self.similarity_
+        if method == "physics":
+            return PhysicsRUL(estimator=self._ageing())
+        if method == "degradation":
+            return self.degradation_
+        return self.degradation_.with_form(method.split("-", 1)[1])
 
-    def _prognosis(self, t, value, sd, rul, model, more) -> Prognosis:
+    def _ageing(self):
+        ageing = getattr(self, "ageing_", None)
+        if ageing is None:
+            raise PRSMHealthError(
+                "this prognostics model has no physics part: fit it with "
+                "fit_prognostics_model on a fleet dataset (its [life] recipe gives the physics)"
+            )
+        return ageing
+
+    def _prognosis(self, unit: UnitHistory, estimate: Estimate) -> Prognosis:
+        """A method's estimate as a :class:`Prognosis`: the model's design and fleet, the
+        health indicator and the warnings every method shares."""
         thr = float(self.threshold)
-        warnings = self._history_warnings(t, value, sd) + list(more)
+        t, value, sd = unit.t, unit.value, unit.sd
+        rul = estimate.rul_hours
+        model = {
+            "name": estimate.model["name"],
+            "version": __version__,
+            "design": self.design,
+            "design_fingerprint": self.design_id[1],
+            "units_trained": len(self.units_),
+            "threshold": thr,
+            "horizon_hours": self.horizon_,
+            **estimate.model,
+        }
+        warnings = self._history_warnings(t, value, sd) + list(estimate.warnings)
         indicator = {
             "name": "clearance",
             "unit": "m",
@@ -526,17 +369,6 @@ class RULModel:
             )
             rul = {"estimate": 0.0, "lower": 0.0, "upper": 0.0}
         return Prognosis(rul_hours=rul, health_indicator=indicator, model=model, warnings=warnings)
-
-    def _base_model_dict(self, name: str) -> dict:
-        return {
-            "name": name,
-            "version": __version__,
-            "design": self.design,
-            "design_fingerprint": self.design_id[1],
-            "units_trained": len(self.units_),
-            "threshold": float(self.threshold),
-            "horizon_hours": self.horizon_,
-        }
 
     def _history_warnings(self, t, value, sd) -> list:
         warnings = []
@@ -561,115 +393,6 @@ class RULModel:
                 "health indicator decreasing: no wear trend yet, interval is the fleet's"
             )
         return warnings
-
-    def _degradation(self, form, t, value, sd):
-        state = self.forms_[form]
-        thr = float(self.threshold)
-        phi = state["phi"]
-        y, m, below = transform(form, value, sd, phi, thr)
-        warnings = []
-        if below.any():
-            warnings.append(
-                f"{int(below.sum())} of {len(value)} diagnoses at or below the model's baseline "
-                f"phi = {phi:.4g} m (the fleet's initial clearance level minus a margin): "
-                "clipped; this unit starts tighter than the training fleet"
-            )
-        tau = t / self.t_scale_
-        mean, cov = posterior(state["mean"], state["cov"], tau, y, state["sigma2"] + m)
-        rng = np.random.default_rng(self.random_state)
-        draws = sample_gaussian(rng, mean, cov, int(self.n_samples))
-        eps = rng.standard_normal(int(self.n_samples)) * math.sqrt(state["sigma2"])
-        a, b = draws[:, 0], draws[:, 1]
-        y_d = y_threshold(form, phi, thr)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            crossing = np.where(b > 0, (y_d - a - eps) / b, np.inf) * self.t_scale_
-        rul = crossing - t[-1]
-        capped = float(np.mean(rul >= self.horizon_))
-        rul = np.clip(rul, 0.0, self.horizon_)
-        low, mid, high = np.quantile(rul, QUANTILES)
-        if capped > CAPPED_WARNING_FRACTION:
-            warnings.append(
-                f"{capped:.0%} of the posterior samples never reach the threshold (wear rate "
-                f"<= 0) or reach it beyond the horizon; their RUL is capped at {self.horizon_:.4g} "
-                f"h ({HORIZON_FACTOR:g}x the fleet's longest life)"
-            )
-        scale = (
-            np.array([1.0, 1.0 / self.t_scale_])
-            if form == "exponential"
-            else np.array([thr, thr / self.t_scale_])
-        )
-        model = self._base_model_dict(f"degradation-{form}")
-        model.update(
-            {
-                "parameters": ["ln_theta", "beta_per_hour"]
-                if form == "exponential"
-                else ["theta_m", "beta_m_per_hour"],
-                "posterior_mean": (mean * scale).tolist(),
-                "posterior_cov": (cov * np.outer(scale, scale)).tolist(),
-                "phi": phi,
-                "sigma2": state["sigma2"],
-                "n_samples": int(self.n_samples),
-                "capped_fraction": capped,
-                "selection": {"form": self.form_, "loo_rmse_hours": dict(self.loo_rmse_)},
-            }
-        )
-        rul_hours = {"estimate": float(mid), "lower": float(low), "upper": float(high)}
-        return rul_hours, model, warnings
-
-    def _ageing(self):
-        ageing = getattr(self, "ageing_", None)
-        if ageing is None:
-            raise PRSMHealthError(
-                "this prognostics model has no physics part: fit it with "
-                "fit_prognostics_model on a fleet dataset (its [life] recipe gives the physics)"
-            )
-        return ageing
-
-    def _physics(self, result: dict):
-        """A physics prediction (:class:`~prsm_health.prognostics.ageing_rul.AgeingRUL`) as
-        (RUL, model dict, warnings)."""
-        from .ageing_model import PRSMAgeing  # progpy: imported only where prognostics run
-
-        ageing = self._ageing()
-        rul = {k: result[k] for k in ("estimate", "lower", "upper")}
-        model = self._base_model_dict("physics")
-        model.update(
-            {
-                "states": list(PRSMAgeing.states),
-                "posterior": result["posterior"],
-                "failure_clearance": ageing.tables["failure_clearance"],
-                "n_particles": ageing.n_particles,
-                "n_samples": ageing.n_samples,
-                "capped_fraction": result["capped_fraction"],
-            }
-        )
-        warnings = []
-        if result["capped_fraction"] > CAPPED_WARNING_FRACTION:
-            warnings.append(
-                f"{result['capped_fraction']:.0%} of the predicted units do not reach the wear "
-                f"limit within the horizon; their RUL is capped at {ageing.horizon:.4g} h"
-            )
-        return rul, model, warnings
-
-    def _similarity(self, t, value, sd):
-        state = self.forms_[self.form_]
-        rul, details = similarity_rul(
-            state["params"],
-            state["residual_var"],
-            form=self.form_,
-            phi=state["phi"],
-            threshold=float(self.threshold),
-            lives=self.failure_ages_,
-            t_scale=self.t_scale_,
-            horizon=self.horizon_,
-            t=t,
-            value=value,
-            sd=sd,
-        )
-        model = self._base_model_dict("similarity")
-        model.update(details)
-        model["nearest_unit"] = self.units_[model.pop("nearest")]
-        return rul, model
 
     # ---------------------------------------------------------------------------- persistence
 
@@ -729,18 +452,20 @@ class RULModel:
             model._check_params()
             fitted = d["fitted"]
             if fitted is not None:
-                model.units_ = list(fitted["units"])
-                model.failure_ages_ = np.asarray(fitted["failure_ages"], dtype=np.float64)
-                model.t_scale_ = float(fitted["t_scale"])
-                model.horizon_ = float(fitted["horizon"])
-                model.c_ref_ = float(fitted["c_ref"])
-                model.loo_rmse_ = {f: float(fitted["loo_rmse"][f]) for f in _FORMS}
+                fleet = FleetSummary(
+                    units=list(fitted["units"]),
+                    lives=np.asarray(fitted["failure_ages"], dtype=np.float64),
+                    threshold=float(model.threshold),
+                    t_scale=float(fitted["t_scale"]),
+                    horizon=float(fitted["horizon"]),
+                    c_ref=float(fitted["c_ref"]),
+                )
+                loo_rmse = {f: float(fitted["loo_rmse"][f]) for f in FORMS}
                 form = fitted["form"]
-                if form not in _FORMS:
+                if form not in FORMS:
                     raise ValueError(f"unknown form {form!r}")
-                model.form_ = form
                 forms = {}
-                for name in _FORMS:
+                for name in FORMS:
                     s = fitted["forms"][name]
                     forms[name] = {
                         "phi": float(s["phi"]),
@@ -750,16 +475,18 @@ class RULModel:
                         "params": np.asarray(s["params"], dtype=np.float64).reshape(-1, 2),
                         "residual_var": np.asarray(s["residual_var"], dtype=np.float64),
                     }
-                    units = len(model.units_)
-                    if len(forms[name]["params"]) != units or len(model.failure_ages_) != units:
+                    units = len(fleet.units)
+                    if len(forms[name]["params"]) != units or len(fleet.lives) != units:
                         raise ValueError("unit count mismatch")
                     if not all(np.all(np.isfinite(v)) for v in forms[name].values()):
                         raise ValueError("non-finite parameter")
-                model.forms_ = forms
-                if fitted.get("ageing") is not None:
-                    from .ageing_rul import AgeingRUL
-
-                    model.ageing_ = AgeingRUL.from_dict(fitted["ageing"])
+                model._set_fleet(fleet)
+                model.degradation_ = DegradationRUL(model.n_samples, model.random_state).restored(
+                    fleet, forms, form, loo_rmse
+                )
+                model.similarity_ = SimilarityRUL(model.degradation_)
+                ageing = fitted.get("ageing")
+                model.ageing_ = None if ageing is None else AgeingRUL.from_dict(ageing)
         except ParameterError as err:
             raise PRSMHealthError(f"malformed prognostics model ({one_line(err)})") from None
         except (KeyError, TypeError, ValueError, AttributeError) as err:

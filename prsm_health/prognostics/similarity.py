@@ -1,4 +1,4 @@
-"""The similarity baseline of :class:`~prsm_health.prognostics.RULModel` (Wang et al. 2008):
+"""The similarity baseline, one of the RUL methods (:class:`SimilarityRUL`; Wang et al. 2008):
 a history aligned to each training unit's fitted degradation curve, the units weighted by a
 tempered Gaussian kernel of the alignment distance, the RUL their weighted remaining lives
 (Wang, Yu, Siegel & Lee, PHM 2008).
@@ -25,7 +25,8 @@ import math
 
 import numpy as np
 
-from .degradation import curve, weighted_quantiles
+from .degradation import DegradationRUL, curve, weighted_quantiles
+from .method import Estimate, RULMethod, TrainingFleet, UnitHistory
 from .prognosis import QUANTILES
 
 # Similarity alignment: the aligned first diagnosis may lie this fraction of a library unit's
@@ -101,3 +102,46 @@ def similarity_rul(
     }
     rul_hours = {"estimate": float(mid), "lower": float(low_q), "upper": float(high_q)}
     return rul_hours, details
+
+
+class SimilarityRUL(RULMethod):
+    """The similarity baseline as a RUL method (module docstring): its library is the
+    training units' fitted curves of the form ``library`` (a :class:`DegradationRUL`) chose,
+    and their failure ages.
+
+    Parameters
+    ----------
+    library : DegradationRUL
+        Fitted by :meth:`fit` unless already fitted on the same fleet.
+    """
+
+    name = "similarity"
+
+    def __init__(self, library: DegradationRUL):
+        self.library = library
+
+    def fit(self, fleet: TrainingFleet) -> SimilarityRUL:
+        if getattr(self.library, "fleet_", None) is not fleet.summary:
+            self.library.fit(fleet)
+        return self
+
+    def predict(self, history: UnitHistory) -> Estimate:
+        library = self.library
+        fleet = library.fleet_
+        state = library.forms_[library.form_]
+        rul, details = similarity_rul(
+            state["params"],
+            state["residual_var"],
+            form=library.form_,
+            phi=state["phi"],
+            threshold=fleet.threshold,
+            lives=fleet.lives,
+            t_scale=fleet.t_scale,
+            horizon=fleet.horizon,
+            t=history.t,
+            value=history.value,
+            sd=history.sd,
+        )
+        model = {"name": self.name, **details}
+        model["nearest_unit"] = fleet.units[model.pop("nearest")]
+        return Estimate(rul, model, [])

@@ -45,6 +45,7 @@ import numpy as np
 
 from prsm_health.core.errors import (
     ParameterError,
+    a_or_an,
     require,
     require_known_keys,
     require_range,
@@ -153,7 +154,7 @@ class Instrumentation:
                 spec is None or isinstance(spec, kind),
                 f"instrumentation.{channel}",
                 type(spec).__name__,
-                f"must be a {kind.__name__} or None",
+                f"must be {a_or_an(kind.__name__)} or None",
             )
         require(
             bool(self.fitted),

@@ -81,6 +81,20 @@ def test_gear_ratio_must_match_thread_ratio():
         d.with_(gear=dataclasses.replace(d.gear, roller_teeth=12))
 
 
+def test_ring_gear_must_fit_the_nut():
+    # The roller gear sits on the roller orbit d_c = d_s + d_r: the internal pair's centre
+    # distance m·(z_ring − z_roller)/2 must be d_c/2 (paper01: 0.5 mm × (65 − 13) = 26 mm).
+    d = preset("paper01")
+    gap = d.gear.ring_teeth - d.gear.roller_teeth
+    fits = d.orbit_diameter / gap
+    d.with_(gear=dataclasses.replace(d.gear, module=fits * 1.004))  # within 0.5 %
+    for module in (fits * 1.006, 2 * fits):
+        with pytest.raises(
+            ParameterError, match=r"gear\.module .*ring_teeth = 65.*roller_teeth = 13"
+        ):
+            d.with_(gear=dataclasses.replace(d.gear, module=module))
+
+
 def test_recirculating_roller_limit():
     d = preset("paper03")
     # Paper 03 eqs. (11)–(13) with α = 90°, d_c = 39.5 mm, one 1 mm lead: N < π·39.5/2 = 62.0

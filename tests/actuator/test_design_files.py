@@ -2,6 +2,8 @@
 `--design FILE`, scenarios and recipes with a design file."""
 
 import json
+import math
+import re
 from dataclasses import fields
 from pathlib import Path
 
@@ -87,6 +89,12 @@ def test_template_then_check(tmp_path, capsys):
         ),
         ("pitch = 0.002", 'pitch = "0.002"', "design.pitch = "),
         ("nut_diameter = 0.0325", "nut_diameter = 0.04", "design.nut_diameter = "),
+        # a length typed in mm is blamed on its own key, not on a length computed from it
+        ("pitch = 0.002", "pitch = 2", "design.pitch = 2 is invalid: must be ≤ 0.1 m"),
+        ("screw_diameter = 0.0195", "screw_diameter = 19.5", "design.screw_diameter = 19.5 "),
+        ("face_width = 0.003", "face_width = 3", "gear.face_width = 3 "),
+        # a ring gear of twice the nut's pitch diameter (the teeth ratio still d_n/d_r)
+        ("module = 0.0005", "module = 0.001", "gear.module = 0.001 is invalid: must lie in ["),
     ],
 )
 def test_check_refuses_a_bad_file_in_one_line(old, new, message, tmp_path, capsys):
@@ -105,6 +113,20 @@ def test_show_table_and_json(capsys):
     assert main(["design", "show", str(ROOT / "datasets/designs/paper01.toml")]) == 0
     out = capsys.readouterr().out
     assert "gear.module" in out and "0.0005 m" in out and "masses.screw_inertia" in out
+
+
+def test_show_prints_the_lead_and_angles_in_degrees(capsys):
+    design = preset("paper01")
+    assert main(["design", "show", "paper01"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    rows = dict(re.split(r"\s{2,}", line, maxsplit=1) for line in lines)
+    assert rows["contact_angle"].startswith(f"{math.degrees(design.contact_angle):.6g} °")
+    assert rows["gear.pressure_angle"].startswith(
+        f"{math.degrees(design.gear.pressure_angle):.6g} °"
+    )
+    assert rows["lead (screw and nut, starts × pitch)"] == f"{design.screw_lead:.6g} m"
+    lead_angle = math.degrees(math.atan(design.screw_lead / (math.pi * design.screw_diameter)))
+    assert rows["lead angle λ_s (screw)"] == f"{lead_angle:.6g} °"
 
 
 def test_simulate_with_a_design_file_equals_the_preset(tmp_path, capsys):

@@ -40,6 +40,15 @@ def test_kinematics_json(capsys):
     assert data["frequencies"]["gear_mesh"] == pytest.approx(387.94, abs=0.01)
 
 
+def test_kinematics_speed_defaults_as_simulate(capsys):
+    from prsm_health.apps.cli import build_parser
+
+    simulate = build_parser().parse_args(["simulate"]).speed
+    code, out, _ = run(capsys, "kinematics", "--json")
+    assert code == 0
+    assert json.loads(out)["screw_speed"] == simulate
+
+
 def test_stiffness_gear_json_contract(capsys):
     code, out, _ = run(capsys, *GEAR, "--internal", "--threaded-tooth", "--json")
     assert code == 0

@@ -8,8 +8,7 @@ import sys
 
 import pytest
 
-from prsm_health.apps.cli import build_parser
-from prsm_health.apps.cli import parser as cli_parser
+from prsm_health.apps.cli import build_parser, live_options, prognose_options, simulate_options
 from prsm_health.apps.cli.options import HelpFormatter, Parser, has_default
 
 #: Default spellings the help used before it had one form: "(default 10e-6)", "(0)", "(1)",
@@ -87,13 +86,17 @@ def test_mirrored_constants_are_the_librarys():
     from prsm_health.prognostics import METHODS
     from prsm_health.simulation.instrumentation import DEFAULT_PROFILE
 
-    assert cli_parser.DEFAULT_PROFILE == DEFAULT_PROFILE
-    assert (cli_parser.LIVE_HOST, cli_parser.LIVE_PORT, cli_parser.LIVE_MESSAGE_BUDGET) == (
+    assert simulate_options.DEFAULT_PROFILE == DEFAULT_PROFILE
+    assert (
+        live_options.LIVE_HOST,
+        live_options.LIVE_PORT,
+        live_options.LIVE_MESSAGE_BUDGET,
+    ) == (
         live.DEFAULT_HOST,
         live.DEFAULT_PORT,
         live.MESSAGE_BUDGET,
     )
-    assert sorted(cli_parser.PROGNOSIS_METHODS) == sorted(METHODS)
+    assert sorted(prognose_options.PROGNOSIS_METHODS) == sorted(METHODS)
 
 
 def test_help_loads_no_heavy_library():
@@ -126,3 +129,25 @@ def test_every_handler_exists():
         module, _, function = handler.partition(":")
         module = importlib.import_module(f"prsm_health.apps.cli.{module}")
         assert callable(getattr(module, function)), (path, handler)
+
+
+def test_the_formats_doc_names_the_default_step():
+    # docs/formats.md once called a 5 µs step "the command line's"; the default is "auto"
+    from pathlib import Path
+
+    from prsm_health.simulation.dynamics.model import (
+        AUTO_MAX_STEP,
+        AUTO_STABLE_FRACTION,
+        SimulationOptions,
+    )
+
+    default = build_parser().parse_args(["simulate"]).max_step
+    assert default == SimulationOptions().max_step
+    text = (Path(__file__).resolve().parents[2] / "docs" / "formats.md").read_text()
+    text = " ".join(text.split())
+    assert not re.search(r"command line's [\d.]+ µs step", text)
+    assert f'The default step, `max_step = "{default}"` (the command line\'s `--max-step`' in text
+    assert (
+        f"takes {AUTO_STABLE_FRACTION:g} of the stable step, at most {AUTO_MAX_STEP * 1e6:g} µs"
+        in text
+    )

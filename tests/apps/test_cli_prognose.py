@@ -16,7 +16,7 @@ import pytest
 
 from prsm_health.apps.cli import main
 from prsm_health.apps.cli.output import hours
-from prsm_health.apps.cli.parser import PROGNOSIS_METHODS
+from prsm_health.apps.cli.prognose_options import PROGNOSIS_METHODS
 from prsm_health.datasets import Recipe, generate
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.prognostics import (

@@ -22,7 +22,7 @@ import pytest
 from prsm_health.actuator.design import preset
 from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.apps.cli import main
-from prsm_health.apps.cli.parser import DEFAULT_CV, TRAIN_TARGETS
+from prsm_health.apps.cli.models_options import DEFAULT_CV, TRAIN_TARGETS
 from prsm_health.datasets import Recipe, generate
 from prsm_health.prognostics import load_prognostics_model
 from prsm_health.training import train as training

@@ -80,3 +80,19 @@ def test_errors_survive_a_process_pool(error):
     copy = pickle.loads(pickle.dumps(error))
     assert type(copy) is type(error) and str(copy) == str(error)
     assert isinstance(copy, PRSMHealthError)
+
+
+def test_messages_built_from_names_take_their_article(tmp_path):
+    # "is a angle", "not a instrumentation profile": the article follows the noun
+    from prsm_health.core.errors import a_or_an
+    from prsm_health.core.tomlfile import read_toml
+
+    names = ("angle", "length", "Accelerometer", "instrumentation profile")
+    assert [a_or_an(n) for n in names] == [
+        "an angle",
+        "a length",
+        "an Accelerometer",
+        "an instrumentation profile",
+    ]
+    with pytest.raises(PRSMHealthError, match="is a directory, not an instrumentation profile"):
+        read_toml(tmp_path, "instrumentation profile")

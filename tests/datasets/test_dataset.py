@@ -113,7 +113,7 @@ def test_domain_randomised_group_fields():
     for bad, needle in [
         ({"drive_train": {"coupling_stiff": [1e3, 2e3]}}, "coupling_stiff"),
         ({"drive_train": {"coupling_stiffness": [-1e3, 2e3]}}, "coupling_stiffness"),
-        ({"colour": {"red": [0, 1]}}, "unknown key"),
+        ({"colour": {"red": [0, 1]}}, r"unknown table \[colour\] in \[sweep\]"),
     ]:
         with pytest.raises(RecipeError, match=needle):
             Recipe.from_dict(dict(base, sweep={"mode": "random", "samples": 3, **bad}))
@@ -370,3 +370,29 @@ def test_generate_both_formats(recipe_path, tmp_path):
     assert run.labels["run_id"] == 2
     stored = Dataset(tmp_path / "m").run(2)
     assert np.allclose(run["nut_axial_accel"], stored["nut_axial_accel"], rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "change, needle",
+    [
+        (
+            {"sweep": {"clearence": [1e-6]}},
+            "unknown key 'clearence' in [sweep] (did you mean 'clearance'?)",
+        ),
+        (
+            {"units": {"count": 2, "sead": 1}},
+            "unknown key 'sead' in [units] (did you mean 'seed'?)",
+        ),
+        ({"faults": {"spal": 1e-4}}, "unknown key 'spal' in [faults] (did you mean 'spall'?)"),
+        (
+            {"units": {"count": 2, "seed": 1, "build": {"preloa": [0, 1e-6]}}},
+            "did you mean 'preload'?",
+        ),
+    ],
+)
+def test_a_mistyped_recipe_key_names_the_nearest_one(change, needle):
+    # as a design file's: difflib's nearest allowed key (core.errors.nearest_key)
+    base = dict(name="x", design="paper01", duration=0.01, sample_rate=10000, seed=1, sweep={})
+    with pytest.raises(RecipeError) as caught:
+        Recipe.from_dict({**base, **change})
+    assert needle in str(caught.value)

@@ -141,11 +141,21 @@ def test_import_cli_and_mcap(rig, tmp_path, capsys):
             lambda r: r.joinpath("map.toml").write_text(
                 MAP.replace('pos_mm = "mm"', 'pos_mm = "deg"')
             ),
-            "is a length",
+            "(nut_position) is a length, but its unit 'deg' is an angle",
         ),
         (
             lambda r: r.joinpath("map.toml").write_text(MAP.replace("nut_position =", "nut_pos =")),
-            "not a channel",
+            "'nut_pos' is not a channel (did you mean 'nut_position'?)",
+        ),
+        (
+            lambda r: r.joinpath("map.toml").write_text(MAP.replace("lead = 0.005", "lead = 5")),
+            "lead = 5 is invalid: must be ≤ 0.1 m: lengths are in metres",
+        ),
+        (
+            lambda r: r.joinpath("map.toml").write_text(
+                MAP.replace("sample_rate =", "sampl_rate =")
+            ),
+            "unknown key 'sampl_rate' in [map] (did you mean 'sample_rate'?)",
         ),
         (
             lambda r: r.joinpath("map.toml").write_text(
@@ -156,14 +166,6 @@ def test_import_cli_and_mcap(rig, tmp_path, capsys):
         (
             lambda r: r.joinpath("map.toml").write_text(MAP.replace("torque_constant = 0.1", "")),
             "torque_constant",
-        ),
-        (
-            lambda r: (
-                pd.read_csv(r / "labels.csv")
-                .assign(recording=lambda t: t["recording"].where(t.index > 0, "ghost.csv"))
-                .to_csv(r / "labels.csv", index=False)
-            ),
-            "ghost.csv",
         ),
         (
             lambda r: pd.read_csv(r / "labels.csv").iloc[1:].to_csv(r / "labels.csv", index=False),
@@ -186,6 +188,22 @@ def test_bad_input_is_one_line_and_writes_nothing(rig, capsys, change, needle):
     assert needle in err, err
     assert not (root / "ds").exists()
     assert not [p for p in root.iterdir() if p.name.startswith(".ds.importing")]
+
+
+def test_labels_of_recordings_not_given_are_ignored_with_a_warning_naming_them(rig):
+    # a campaign's labels table, some of its recordings imported: the extra rows are named
+    root, files = rig
+    labels = pd.read_csv(root / "labels.csv")
+    extra = labels.iloc[:2].assign(recording=["ghost.csv", "later.csv"])
+    pd.concat([labels, extra]).to_csv(root / "labels.csv", index=False)
+    with pytest.warns(UserWarning) as caught:
+        summary = import_recordings(files, root / "labels.csv", root / "map.toml", root / "ds")
+    messages = [str(w.message) for w in caught if "label row" in str(w.message)]
+    assert len(messages) == 1
+    n = len(labels)
+    assert f"data row {n + 1} (ghost.csv), data row {n + 2} (later.csv)" in messages[0]
+    assert summary["runs"] == len(files)
+    assert sorted(Dataset(root / "ds").runs["recording"]) == sorted(p.name for p in files)
 
 
 def test_existing_output_is_refused_unless_overwrite(rig):

@@ -119,3 +119,12 @@ def test_an_ambiguous_check_names_the_classes_left_and_asks_for_more_checks(chec
     assert d.undecided.kind == AMBIGUOUS
     assert set(d.undecided.candidates) == {"healthy", "preload_loss", "spall"}
     assert "baseline" in d.undecided.next_recording
+
+
+def test_a_baseline_only_class_note_says_how_to_get_the_baseline_reading():
+    # The note once ended mid-sentence ("against this unit's baseline … it is").
+    from prsm_health.diagnostics.check_model import baseline_only_note
+
+    note = baseline_only_note("preload_loss", "one check cannot tell it from the as-built play")
+    assert note.startswith("not observable by one check alone: preload_loss — one check")
+    assert "it is observable" in note and "--asset" in note and "asset_id" in note

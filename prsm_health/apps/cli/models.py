@@ -19,8 +19,8 @@ from prsm_health.training.train import train as train_model
 
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
+from .models_options import DEFAULT_CV
 from .output import print_json, print_table, scaled, share, um
-from .parser import DEFAULT_CV
 from .prognose import check_train_options, train_prognostics
 
 # What each fault macro-F1 counts (prsm_health.training.evaluation.fault_report and

@@ -1,5 +1,6 @@
-"""The parser's parts: the one-line-error parser, the help formatter that writes every default,
-and the argument types (each refuses bad text with a message naming the option).
+"""The parser's parts every command group uses: the one-line-error parser, the help formatter
+that writes every default, the maker of subcommands, the help texts several groups share, and
+the argument types (each refuses bad text with a message naming the option).
 
 Nothing here imports more than the standard library and the light ``core`` and ``actuator``
 modules: building the parser must stay cheap (``prsm-health --help`` loads neither pandas,
@@ -66,6 +67,30 @@ def format_default(value) -> str:
     if isinstance(value, (list, tuple)):
         return ", ".join(format_default(v) for v in value)
     return str(value)
+
+
+def command_maker(parser, dest: str):
+    """A maker of ``parser``'s subcommands (``simulate``, ``design template`` …), each with
+    the same parser class and help formatter."""
+    sub = parser.add_subparsers(dest=dest, required=True, parser_class=Parser)
+
+    def make(name: str, text: str):
+        return sub.add_parser(name, help=text, description=text, formatter_class=HelpFormatter)
+
+    return make
+
+
+def add_json(p, what: str = "the result") -> None:
+    p.add_argument("--json", action="store_true", help=f"print {what} as JSON instead of a table")
+
+
+# ----------------------------------------------------------------------------- shared help texts
+DESIGN_HELP = "preset name (paper01…paper05) or design TOML file"
+PROFILE_HELP = (
+    "instrumentation profile: a built-in name (prsm-health instrumentation list) or a TOML file"
+)
+SHIPPED_MODEL = "the shipped model"
+MODEL_WINDOW = "the model's window"
 
 
 # ----------------------------------------------------------------------------- argument types

@@ -75,13 +75,25 @@ def design_show(args) -> int:
     else:
         ratings = load_ratings(design)
         print_table(
-            design_rows(design)
+            [_in_degrees(row) for row in design_rows(design)]
             + [
+                ("lead (screw and nut, starts × pitch)", design.screw_lead, "m"),
+                ("lead angle λ_s (screw)", math.degrees(design.screw_lead_angle), "°"),
+                ("lead angle λ_n (nut)", math.degrees(design.nut_lead_angle), "°"),
+                ("lead angle λ_r (roller)", math.degrees(design.roller_lead_angle), "°"),
                 ("load rating C_a (dynamic, 1e6 rev, 90 %)", ratings.dynamic / 1e3, "kN"),
                 ("load rating C_0a (static, 4.2 GPa)", ratings.static / 1e3, "kN"),
             ]
         )
     return 0
+
+
+def _in_degrees(row: tuple[str, object, str]) -> tuple[str, object, str]:
+    """An angle row of the design table in degrees, with the radians the file holds."""
+    name, value, unit = row
+    if unit != "rad" or not isinstance(value, float):
+        return row
+    return name, math.degrees(value), f"° ({value:.6g} rad in the file)"
 
 
 def design_check(args) -> int:

@@ -212,3 +212,45 @@ def test_cli_diagnose_json_matches_the_published_schema(doc, recording, tmp_path
     answer = json.loads(capsys.readouterr().out)
     _check(_diagnosis_schema(doc), answer)
     assert set(answer) >= CONTRACT_FIELDS
+
+
+def test_the_docs_json_example_sends_only_measured_channels(tmp_path, monkeypatch, capsys):
+    # docs/service.md's JSON body from a simulated run.parquet (measured and truth columns)
+    # must be a valid request: truth_* channels are 422.
+    import re
+    import runpy
+    from pathlib import Path
+
+    from prsm_health.apps.service.schemas import DiagnoseRequest
+    from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_NAMES
+
+    text = (Path(__file__).resolve().parents[3] / "docs" / "service.md").read_text()
+    script = re.search(r"python - <<'EOF' > body.json\n(.*?)\nEOF", text, re.S).group(1)
+    n, rate = 300, 20_000.0
+    zeros = np.zeros(n)
+    run = Run(
+        np.arange(n) / rate,
+        dict.fromkeys(CHANNEL_NAMES, zeros),
+        rate,
+        truth=dict.fromkeys(TRUTH_NAMES, zeros),
+    )
+    write_run_parquet(run, tmp_path / "run.parquet")
+    (tmp_path / "example.py").write_text(script)
+    monkeypatch.chdir(tmp_path)
+    runpy.run_path("example.py")
+    body = json.loads(capsys.readouterr().out)
+    request = DiagnoseRequest.model_validate(body)
+    assert set(request.channels.model_dump(exclude_none=True)) == set(CHANNEL_NAMES)
+
+
+def test_the_docs_say_whether_the_shipped_model_has_a_check_part():
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[3] / "docs" / "service.md").read_text()
+    text = " ".join(text.split())
+    from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL, check_part_path
+
+    has_check = check_part_path(DEFAULT_MODEL).exists()  # load_bundle loads it when there
+    assert bool(re.search(r"shipped model[^.]*has a health-check part", text)) == has_check
+    assert bool(re.search(r"shipped model[^.]*has no health-check part", text)) == (not has_check)
