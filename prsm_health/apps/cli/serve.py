@@ -6,7 +6,9 @@ from prsm_health.apps import service
 
 
 def serve(args) -> int:
-    overrides = {"max_window_seconds": args.max_window}
+    overrides = {}
+    if args.max_window is not None:  # else ServiceLimits' default: the longest built-in check
+        overrides["max_window_seconds"] = args.max_window
     if args.workers is not None:  # 0 or negative: ServiceLimits refuses it by name
         overrides["workers"] = args.workers
     if args.processes is not None:

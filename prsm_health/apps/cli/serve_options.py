@@ -41,7 +41,11 @@ def add_serve_command(command) -> None:
         help="diagnosis processes, each with the model loaded once, or 0: threads",
     )
     v.add_argument(
-        "--max-window", type=finite_float, default=2.0, help="longest JSON recording [s]"
+        "--max-window",
+        type=finite_float,
+        default=None,
+        help="longest recording of POST /v1/diagnose [s] (default: 2.5, the longest built-in "
+        "health check rounded up to the half second)",
     )
     v.add_argument(
         "--log-level",

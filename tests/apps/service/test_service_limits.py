@@ -101,3 +101,18 @@ def test_upload_sample_rate_outside_the_limits(app, tmp_path):
     assert r.json() == {
         "error": "slow.parquet: sample_rate = 5 Hz is outside the accepted range [10, 100000] Hz"
     }
+
+
+def test_serve_takes_the_limits_default_window_unless_given(monkeypatch):
+    # without --max-window the service's default (the longest built-in check fits); with it,
+    # the value given
+    import prsm_health.apps.service as service
+    from prsm_health.apps.cli import main
+    from prsm_health.apps.service.limits import DEFAULT_MAX_WINDOW_SECONDS
+
+    seen = {}
+    monkeypatch.setattr(service, "serve", lambda *a, **kw: seen.update(kw))
+    assert main(["serve"]) == 0
+    assert seen["limits"].max_window_seconds == DEFAULT_MAX_WINDOW_SECONDS
+    assert main(["serve", "--max-window", "3"]) == 0
+    assert seen["limits"].max_window_seconds == 3.0
