@@ -82,7 +82,7 @@ def plot_check(run: Run, path: str | Path) -> Path:
     present = [c for c in CHECK_CHANNELS if c in run.channels]
     fig, axes = plt.subplots(len(present), 1, figsize=(10, 1.9 * len(present)), sharex=True)
     axes = np.atleast_1d(axes)
-    phases = run.check.get("phases", [])
+    phases = run.check.phases if run.check is not None else ()
     for ax, name in zip(axes, present):
         factor, unit = _SCALE.get(name, (1.0, UNITS[name]))
         ax.plot(run.time, factor * run.channels[name], lw=0.5, color="k")
@@ -90,12 +90,12 @@ def plot_check(run: Run, path: str | Path) -> Path:
         ax.grid(alpha=0.3)
         for k, phase in enumerate(phases):
             colour = PHASE_COLOURS[k % len(PHASE_COLOURS)]
-            ax.axvspan(phase["start"], phase["end"], color=colour, alpha=0.18)
+            ax.axvspan(phase.start, phase.end, color=colour, alpha=0.18)
     for k, phase in enumerate(phases):
         axes[0].text(
-            0.5 * (phase["start"] + phase["end"]),
+            0.5 * (phase.start + phase.end),
             1.02,
-            phase["name"],
+            phase.name,
             transform=axes[0].get_xaxis_transform(),
             ha="center",
             va="bottom",
@@ -104,7 +104,7 @@ def plot_check(run: Run, path: str | Path) -> Path:
         )
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(
-        f"health check '{run.check.get('name', '')}' — {run.labels.get('design', '')}, "
+        f"health check '{run.check.name if run.check else ''}' — {run.operating.design or ''}, "
         f"{run.scenario.get('instrumentation', '')}, seed {run.labels.get('seed', '')}: "
         "phases shaded (ramps between them unshaded)",
         fontsize=10,
