@@ -56,7 +56,7 @@ def plot_run(
             )
     axes[-1][0].set_xlabel("time [s]")
     axes[-1][1].set_xlabel("frequency [Hz] (dashed: gear mesh harmonics)")
-    fig.suptitle(_run_title(run.labels), fontsize=10)
+    fig.suptitle(_run_title(run), fontsize=10)
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110)
@@ -118,19 +118,27 @@ def plot_check(run: Run, path: str | Path) -> Path:
     return path
 
 
-def _run_title(labels: dict) -> str:
-    """Design, clearance, speed, load with its profile, seed — what a reader needs to place it."""
-    load = f"load {labels.get('axial_load', 0):g} N"
-    profile = labels.get("load_profile", "constant")
-    if profile != "constant":
-        load += f" {profile} ±{labels.get('load_amplitude', 0):g} N"
+def _run_title(run: Run) -> str:
+    """Design, speed, load (the operating point) and, of a simulated run, its clearance, motion,
+    load profile and seed (its labels) — what a reader needs to place it."""
+    op, labels = run.operating, run.labels
+    parts = [op.design or ""]
+    if "clearance_screw" in labels:
+        parts.append(f"clearance {1e6 * labels['clearance_screw']:.0f} µm")
     motion = labels.get("motion", "constant")
-    return (
-        f"{labels.get('design', '')}  clearance {1e6 * labels.get('clearance_screw', 0):.0f} µm  "
-        f"speed {labels.get('screw_speed', 0):g} rad/s"
-        + (f" ({motion})" if motion != "constant" else "")
-        + f"  {load}  seed {labels.get('seed', '')}"
-    )
+    if op.screw_speed is not None:
+        parts.append(
+            f"speed {op.screw_speed:g} rad/s" + (f" ({motion})" if motion != "constant" else "")
+        )
+    if op.axial_load is not None:
+        load = f"load {op.axial_load:g} N"
+        profile = labels.get("load_profile", "constant")
+        if profile != "constant":
+            load += f" {profile} ±{op.load_amplitude or 0:g} N"
+        parts.append(load)
+    if "seed" in labels:
+        parts.append(f"seed {labels['seed']}")
+    return "  ".join(parts)
 
 
 def plot_diagnosis(result, path: str | Path) -> Path:
