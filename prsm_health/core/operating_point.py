@@ -23,15 +23,39 @@ from .errors import require
 NO_DESIGN = "none"
 
 
-def _number(value) -> float | None:
-    """``value`` as a finite float, or None (absent, None, NaN read back from a table, text)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        try:
-            value = float(value)  # numpy scalars
-        except (TypeError, ValueError):
-            return None
-    value = float(value)
-    return value if math.isfinite(value) else None
+#: Each number field of :class:`OperatingPoint`: (its lowest value or None for any, whether
+#: that value is allowed, its unit).
+_NUMBERS = {
+    "gear_ratio": (0.0, False, "–"),
+    "lead": (0.0, False, "m"),
+    "screw_speed": (None, True, "rad/s"),
+    "axial_load": (None, True, "N"),
+    "load_amplitude": (0.0, True, "N"),
+    "temperature": (0.0, False, "K"),
+}
+
+
+def _usable(name: str, value) -> float | None:
+    """``value`` as a float when it is a valid ``name`` (a finite number in its range; numpy
+    scalars too), else None (absent, None, NaN read back from a table, text, a bool)."""
+    if value is None or isinstance(value, (bool, str)):
+        return None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    low, inclusive, _ = _NUMBERS[name]
+    if not math.isfinite(number) or (
+        low is not None and not (number >= low if inclusive else number > low)
+    ):
+        return None
+    return number
+
+
+def _allowed(name: str) -> str:
+    low, inclusive, unit = _NUMBERS[name]
+    bound = "" if low is None else f" {'≥' if inclusive else '>'} {low:g}"
+    return f"must be a finite number{bound} [{unit}]"
 
 
 @dataclass(frozen=True)
@@ -91,20 +115,12 @@ class OperatingPoint:
                 value,
                 "must be a string or None",
             )
-        checks = {
-            "gear_ratio": (lambda v: v > 0, "must be a finite number > 0 [–]"),
-            "lead": (lambda v: v > 0, "must be a finite number > 0 [m]"),
-            "screw_speed": (lambda v: True, "must be a finite number [rad/s]"),
-            "axial_load": (lambda v: True, "must be a finite number [N]"),
-            "load_amplitude": (lambda v: v >= 0, "must be a finite number ≥ 0 [N]"),
-            "temperature": (lambda v: v > 0, "must be a finite number > 0 [K]"),
-        }
-        for name, (ok, allowed) in checks.items():
+        for name in _NUMBERS:
             value = getattr(self, name)
-            if value is None and name != "gear_ratio":
+            if value is None and name != "gear_ratio":  # unknown; the gear ratio defaults to 1
                 continue
-            number = _number(value)
-            require(number is not None and ok(number), f"operating.{name}", value, allowed)
+            number = _usable(name, value)
+            require(number is not None, f"operating.{name}", value, _allowed(name))
             object.__setattr__(self, name, number)
 
     def as_dict(self) -> dict:
@@ -127,22 +143,10 @@ class OperatingPoint:
         fingerprint = labels.get("design_fingerprint")
         if isinstance(fingerprint, str):
             out["design_fingerprint"] = fingerprint
-        ratio = _number(labels.get("gear_ratio"))
-        if ratio is not None and ratio > 0:
-            out["gear_ratio"] = ratio
-        lead = _number(labels.get("lead"))
-        if lead is not None and lead > 0:
-            out["lead"] = lead
-        for name in ("screw_speed", "axial_load"):
-            value = _number(labels.get(name))
-            if value is not None:
-                out[name] = value
-        amplitude = _number(labels.get("load_amplitude"))
-        if amplitude is not None and amplitude >= 0:
-            out["load_amplitude"] = amplitude
-        temperature = _number(labels.get("temperature"))
-        if temperature is not None and temperature > 0:
-            out["temperature"] = temperature
+        for name in _NUMBERS:
+            number = _usable(name, labels.get(name))
+            if number is not None:
+                out[name] = number
         return cls(**out)
 
 

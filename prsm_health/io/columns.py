@@ -33,16 +33,15 @@ LABELS_KEY = b"prsm_health.labels"
 SCENARIO_KEY = b"prsm_health.scenario"
 
 
-def run_table(run: Run, dtype=None):
-    """``run`` as a pyarrow Table (``time``, channels, ``check_phase``, ``truth_<name>``) whose
-    schema carries the units and sample rate (:func:`with_units`), the labels, the scenario,
-    the operating point and a health check's phases: what every file of signals the package
-    writes stores (the Parquet and Arrow writers, a dataset's shards).
-
-    ``dtype``: as in :func:`run_columns`."""
+def run_table(run: Run):
+    """``run`` as a pyarrow Table (:func:`run_columns`: ``time``, channels, ``check_phase``,
+    ``truth_<name>``) whose schema carries the units and sample rate (:func:`with_units`), the
+    labels, the scenario, the operating point and a health check's phases (:func:`run_metadata`):
+    what the Parquet and Arrow writers store. A dataset's shard holds the same columns and units
+    for each of its runs, the labels of all in its footer (:mod:`prsm_health.datasets`)."""
     import pyarrow as pa
 
-    table = with_units(pa.table(run_columns(run, dtype)), run.sample_rate)
+    table = with_units(pa.table(run_columns(run)), run.sample_rate)
     return table.replace_schema_metadata({**table.schema.metadata, **run_metadata(run)})
 
 
@@ -70,7 +69,7 @@ def run_metadata(run: Run) -> dict[bytes, bytes]:
     return meta
 
 
-def read_run_metadata(meta: dict, name) -> dict:
+def read_run_metadata(meta: dict, name: str | Path) -> dict:
     """``labels``, ``scenario``, ``operating`` and ``check`` of a run's schema metadata
     (:func:`run_metadata`), as :class:`~prsm_health.core.run.Run` keywords. A file written
     before the operating record has its operating point read from its labels, which carried
@@ -190,7 +189,7 @@ def check_column(table) -> np.ndarray | None:
     return table.column(CHECK_PHASE).to_numpy().astype(np.int16)
 
 
-def run_from_table(table, name) -> Run:
+def run_from_table(table, name: str | Path) -> Run:
     """A run from a table of :func:`run_table`'s layout, or any table with a ``time`` column
     [s] and measured channel columns (the Parquet and Arrow readers): ``truth_<name>``
     columns go to ``Run.truth``; the sample rate is the ``prsm_health.sample_rate`` schema
