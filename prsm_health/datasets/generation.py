@@ -51,7 +51,7 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
         spec = specs[run_id]
         scenario = spec.scenario()
         run = scenario.simulate()
-        label = spec.labels(scenario, run)
+        label = spec.labels(scenario=scenario, run=run)
         run = replace(run, labels=label)  # the dataset's labels, in its MCAP file too
         if formats in ("mcap", "both"):
             from prsm_health.io.mcap import write_mcap

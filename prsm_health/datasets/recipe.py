@@ -665,7 +665,7 @@ class RunSpec:
                 f"recipe (run {self.run_id}, fault case {name}, severity {factor:g}): {exc}"
             ) from None
 
-    def labels(self, scenario: Scenario | None = None, run: Run | None = None) -> dict:
+    def labels(self, *, scenario: Scenario | None = None, run: Run | None = None) -> dict:
         """The run's labels: id, split, fault class, the scenario's labels (nominal values) and,
         given the simulated run, its realised clearances, samples and, for a health check, its
         phases (``check_phases``, JSON of :meth:`CheckPhases.as_record
