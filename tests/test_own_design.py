@@ -17,6 +17,7 @@ import pytest
 from prsm_health.actuator.design import preset
 from prsm_health.actuator.design_files import design_fingerprint, design_to_toml, same_design
 from prsm_health.core.errors import ParameterError, PRSMHealthError
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.datasets import Dataset, generate, load_recipe
 from prsm_health.prognostics import cross_validate_units, fit_prognostics_model, prognose
@@ -115,9 +116,13 @@ def test_a_run_of_ones_own_design_needs_no_design_argument(dataset):
     by_itself = extract_features(run)
     given = extract_features(run, MINE)
     assert by_itself["axial_baseline_frequency"] == given["axial_baseline_frequency"]
-    # a simulated run's scenario holds the design's dict form, its labels the name
+    # a simulated run's scenario holds the design's dict form, its operating point the name
     simulated = Run(
-        run.time, run.channels, run.sample_rate, dict(run.labels), {"design": MINE.to_dict()}
+        run.time,
+        run.channels,
+        run.sample_rate,
+        scenario={"design": MINE.to_dict()},
+        operating=run.operating,
     )
     assert extract_features(simulated)["axial_baseline_frequency"] == pytest.approx(
         given["axial_baseline_frequency"], rel=1e-12
@@ -126,11 +131,13 @@ def test_a_run_of_ones_own_design_needs_no_design_argument(dataset):
 
 def test_a_run_known_only_by_an_unknown_name_says_what_to_pass(dataset, tmp_path):
     run = dataset.run(0, truth=False)
-    bare = Run(run.time, run.channels, run.sample_rate, {"design": "acme-ema-24"})
+    bare = Run(
+        run.time, run.channels, run.sample_rate, operating=OperatingPoint(design="acme-ema-24")
+    )
     with pytest.raises(PRSMHealthError) as info:
         extract_features(bare)
     assert str(info.value) == (
-        "run labelled design 'acme-ema-24' carries no design and it is not a preset: "
+        "run of design 'acme-ema-24' carries no design and it is not a preset: "
         "pass design=<PRSMDesign or design file>"
     )
     # the design file given: works

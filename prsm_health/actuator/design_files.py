@@ -264,26 +264,27 @@ def labelled_same_design(
     return name == other_name
 
 
-def design_of(source, labels: Mapping | None = None) -> PRSMDesign | None:
-    """The design of a run: its scenario's design, else a preset named in its labels, else None.
+def design_of(source, name: str | None = None) -> PRSMDesign | None:
+    """The design of a run: its scenario's design, else the preset its operating point names,
+    else None.
 
     Parameters
     ----------
     source : Run or dict
-        A :class:`~prsm_health.core.run.Run` (its ``scenario`` and ``labels`` are read) or a
-        run's scenario dict. A simulated run's scenario holds ``design`` (a preset name or the
-        full dict form); a dataset's run holds it too, and under ``recipe``.
-    labels : dict, optional
-        The run's labels, when ``source`` is a scenario dict.
+        A :class:`~prsm_health.core.run.Run` (its ``scenario`` and ``operating.design`` are
+        read) or a run's scenario dict. A simulated run's scenario holds ``design`` (a preset
+        name or the full dict form); a dataset's run holds it too, and under ``recipe``.
+    name : str, optional
+        The run's design name, when ``source`` is a scenario dict.
 
     Returns
     -------
     PRSMDesign or None
-        None when the run carries no design and its labels name no preset (an imported rig, a
-        design known only by name): the caller decides what that means.
+        None when the run carries no design and names no preset (an imported rig, a design
+        known only by name): the caller decides what that means.
     """
     if hasattr(source, "scenario"):
-        source, labels = source.scenario, source.labels if labels is None else labels
+        source, name = source.scenario, source.operating.design if name is None else name
     scenario = source if isinstance(source, Mapping) else {}
     recipe = scenario.get("recipe")
     for ref in (
@@ -296,7 +297,6 @@ def design_of(source, labels: Mapping | None = None) -> PRSMDesign | None:
             return ref
         if isinstance(ref, str) and ref in PRESETS:
             return preset(ref)
-    name = (labels or {}).get("design")
     if isinstance(name, str) and name in PRESETS:
         return preset(name)
     return None

@@ -284,19 +284,24 @@ FAULT_CLASSES = (
 )
 
 
+#: The fault taxonomy: how :class:`FaultThresholds` names a run's primary class (stored in
+#: every dataset's manifest, ``fault_taxonomy.rule``; each threshold is named by its field).
+FAULT_RULE = (
+    "A run's class, in this order of precedence: spall when it has a spall longer than spall "
+    "[m]; tooth_damage when a gear tooth has a crack or pit deeper than tooth_damage [m]; "
+    "severe_wear when its largest thread clearance ≥ severe_wear [m]; wear when ≥ wear [m]; "
+    "preload_loss when it has lost a share ≥ preload_loss of a preload; lubrication when its "
+    "friction scale ≥ lubrication [-] or its lubricant degradation or starvation ≥ lubricant "
+    "[-]; else healthy. Localised damage comes first because it grows to the end of the unit "
+    "fastest and has a signature of its own; wear before preload loss and lubricant because "
+    "it is irreversible and what maintenance acts on."
+)
+
+
 @dataclass(frozen=True)
 class FaultThresholds:
-    """Fault taxonomy thresholds (recipe ``[faults]``).
-
-    A run's class, in this order of precedence: ``spall`` when it has a spall longer than
-    ``spall`` [m]; ``tooth_damage`` when a gear tooth has a crack or pit deeper than
-    ``tooth_damage`` [m]; ``severe_wear`` when its largest thread clearance ≥ ``severe_wear`` [m];
-    ``wear`` when ≥ ``wear`` [m]; ``preload_loss`` when it has lost a share ≥ ``preload_loss``
-    of a preload; ``lubrication`` when its friction scale ≥ ``lubrication`` [-] or its
-    lubricant degradation or starvation ≥ ``lubricant`` [-]; else ``healthy``. Localised damage comes first because it grows to the end of the unit fastest
-    and has a signature of its own; wear before preload loss and lubricant because it is
-    irreversible and what maintenance acts on.
-    """
+    """Fault taxonomy thresholds (recipe ``[faults]``): a run's class follows
+    :data:`FAULT_RULE`, each threshold named there by its field (:meth:`classify`)."""
 
     wear: float = 15e-6
     severe_wear: float = 30e-6

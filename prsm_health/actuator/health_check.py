@@ -55,9 +55,9 @@ from pathlib import Path
 
 import numpy as np
 
+from prsm_health.core.check_phases import CheckPhases, PhaseSpan
 from prsm_health.core.errors import ParameterError, require, require_known_keys, require_range
 from prsm_health.core.quantities import ForceSpec, parse_force
-from prsm_health.core.run import phase_of_samples
 from prsm_health.core.tomlfile import read_toml
 
 PHASE_MOTIONS = ("constant", "reversing", "rest")
@@ -228,39 +228,26 @@ class HealthCheck:
             self.phases[-1].ramp_time
         )
 
-    def boundaries(self) -> list[dict]:
-        """Every phase's ``index``, ``name``, ``start`` and ``end`` [s] (the settled part; the
-        ramp before ``start`` belongs to no phase) and its commanded condition: ``motion``,
-        ``speed`` [rad/s] and, once the check is :meth:`resolved`, ``load`` [N] (resisting the
-        motion; None before). The controller commands them, so a hardware recording has them
-        too; the diagnosis reads a phase by its condition, not its name."""
+    def recorded(self) -> CheckPhases:
+        """What a recording of the check carries: its name and every phase's ``index``,
+        ``name``, ``start`` and ``end`` [s] (the settled part; the ramp before ``start`` belongs
+        to no phase) with its commanded condition: ``motion``, ``speed`` [rad/s] and, once the
+        check is :meth:`resolved`, ``load`` [N] (resisting the motion; None before). The
+        controller commands them, so a hardware recording has them too; the diagnosis reads a
+        phase by its condition, not its name."""
         out, t = [], 0.0
         for k, p in enumerate(self.phases):
             start = t + p.ramp_time
             end = start + p.duration
             load = float(p.load) if isinstance(p.load, (int, float)) else None
-            out.append(
-                {
-                    "index": k,
-                    "name": p.name,
-                    "start": start,
-                    "end": end,
-                    "motion": p.motion,
-                    "speed": float(p.speed),
-                    "load": load,
-                }
-            )
+            out.append(PhaseSpan(k, p.name, start, end, p.motion, float(p.speed), load))
             t = end
-        return out
+        return CheckPhases(self.name, tuple(out))
 
     def phase_at(self, times) -> np.ndarray:
         """Phase index of each time [s] (start ≤ t < end), −1 outside any phase (ramps, after
         the end); int16."""
-        return phase_of_samples(times, self.boundaries())
-
-    def as_record(self) -> dict:
-        """Name and boundaries: what a recording stores about its check."""
-        return {"name": self.name, "phases": self.boundaries()}
+        return self.recorded().of_samples(times)
 
     # ------------------------------------------------------------------ knots
     def _speed_knots(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

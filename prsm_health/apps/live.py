@@ -93,7 +93,9 @@ def window_diagnoser(bundle) -> Diagnose:
     from prsm_health.diagnostics.diagnosis import diagnose_window
 
     def diagnose(w: Window) -> dict:
-        return diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
+        return diagnose_window(
+            Run(w.time, w.channels, w.sample_rate, w.labels, operating=w.operating), bundle
+        ).to_json()
 
     return diagnose
 
@@ -202,6 +204,7 @@ def _run_windows(run: Run, window: float) -> Iterator[Window]:
                 time=run.time[a:b],
                 channels={name: v[a:b] for name, v in run.channels.items()},
                 labels=run.labels,
+                operating=run.operating,
                 sample_rate=float(run.sample_rate),
                 truth={name: v[a:b] for name, v in run.truth.items()},
             )

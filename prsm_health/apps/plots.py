@@ -56,7 +56,7 @@ def plot_run(
             )
     axes[-1][0].set_xlabel("time [s]")
     axes[-1][1].set_xlabel("frequency [Hz] (dashed: gear mesh harmonics)")
-    fig.suptitle(_run_title(run.labels), fontsize=10)
+    fig.suptitle(_run_title(run), fontsize=10)
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110)
@@ -82,7 +82,7 @@ def plot_check(run: Run, path: str | Path) -> Path:
     present = [c for c in CHECK_CHANNELS if c in run.channels]
     fig, axes = plt.subplots(len(present), 1, figsize=(10, 1.9 * len(present)), sharex=True)
     axes = np.atleast_1d(axes)
-    phases = run.check.get("phases", [])
+    phases = run.check.phases if run.check is not None else ()
     for ax, name in zip(axes, present):
         factor, unit = _SCALE.get(name, (1.0, UNITS[name]))
         ax.plot(run.time, factor * run.channels[name], lw=0.5, color="k")
@@ -90,12 +90,12 @@ def plot_check(run: Run, path: str | Path) -> Path:
         ax.grid(alpha=0.3)
         for k, phase in enumerate(phases):
             colour = PHASE_COLOURS[k % len(PHASE_COLOURS)]
-            ax.axvspan(phase["start"], phase["end"], color=colour, alpha=0.18)
+            ax.axvspan(phase.start, phase.end, color=colour, alpha=0.18)
     for k, phase in enumerate(phases):
         axes[0].text(
-            0.5 * (phase["start"] + phase["end"]),
+            0.5 * (phase.start + phase.end),
             1.02,
-            phase["name"],
+            phase.name,
             transform=axes[0].get_xaxis_transform(),
             ha="center",
             va="bottom",
@@ -104,7 +104,7 @@ def plot_check(run: Run, path: str | Path) -> Path:
         )
     axes[-1].set_xlabel("time [s]")
     fig.suptitle(
-        f"health check '{run.check.get('name', '')}' — {run.labels.get('design', '')}, "
+        f"health check '{run.check.name if run.check else ''}' — {run.operating.design or ''}, "
         f"{run.scenario.get('instrumentation', '')}, seed {run.labels.get('seed', '')}: "
         "phases shaded (ramps between them unshaded)",
         fontsize=10,
@@ -118,19 +118,27 @@ def plot_check(run: Run, path: str | Path) -> Path:
     return path
 
 
-def _run_title(labels: dict) -> str:
-    """Design, clearance, speed, load with its profile, seed — what a reader needs to place it."""
-    load = f"load {labels.get('axial_load', 0):g} N"
-    profile = labels.get("load_profile", "constant")
-    if profile != "constant":
-        load += f" {profile} ±{labels.get('load_amplitude', 0):g} N"
+def _run_title(run: Run) -> str:
+    """Design, speed, load (the operating point) and, of a simulated run, its clearance, motion,
+    load profile and seed (its labels) — what a reader needs to place it."""
+    op, labels = run.operating, run.labels
+    parts = [op.design or ""]
+    if "clearance_screw" in labels:
+        parts.append(f"clearance {1e6 * labels['clearance_screw']:.0f} µm")
     motion = labels.get("motion", "constant")
-    return (
-        f"{labels.get('design', '')}  clearance {1e6 * labels.get('clearance_screw', 0):.0f} µm  "
-        f"speed {labels.get('screw_speed', 0):g} rad/s"
-        + (f" ({motion})" if motion != "constant" else "")
-        + f"  {load}  seed {labels.get('seed', '')}"
-    )
+    if op.screw_speed is not None:
+        parts.append(
+            f"speed {op.screw_speed:g} rad/s" + (f" ({motion})" if motion != "constant" else "")
+        )
+    if op.axial_load is not None:
+        load = f"load {op.axial_load:g} N"
+        profile = labels.get("load_profile", "constant")
+        if profile != "constant":
+            load += f" {profile} ±{op.load_amplitude or 0:g} N"
+        parts.append(load)
+    if "seed" in labels:
+        parts.append(f"seed {labels['seed']}")
+    return "  ".join(parts)
 
 
 def plot_diagnosis(result, path: str | Path) -> Path:

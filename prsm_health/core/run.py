@@ -1,22 +1,28 @@
-"""A simulated or recorded run: time, measured channels, truth, labels.
+"""A simulated or recorded run: time, measured channels, truth, operating point, labels.
 
 Channel names and units follow the signal-channel contract (:mod:`prsm_health.core.channels`):
 :attr:`Run.channels` holds the measured channels a recording has, :attr:`Run.truth` the
 simulator's truth signals (empty for a recording from hardware); the two never mix. A run as a
 table (:meth:`Run.to_frame`, the single-run Parquet file of :mod:`prsm_health.io.parquet`) has
 the columns ``time``, the measured channels, then ``truth_<name>`` for each truth signal.
+What the run is of and how it ran travels typed: :attr:`Run.operating` (design, reduction,
+nominal conditions) and :attr:`Run.check` (a health check's phases); :attr:`Run.labels` is
+ground truth (a simulated or dataset run's clearances, fault class, seed, …), never read by the
+diagnosis.
 :meth:`Run.validate` is the one place that decides whether a recording can be processed,
 :meth:`Run.windows` the one place recordings are cut into windows.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from .channels import CHANNEL_NAMES, CHECK_PHASE, TRUTH_NAMES, truth_column
+from .check_phases import CheckPhases
 from .errors import PRSMHealthError, RecordingError, RecordingTooLongError
+from .operating_point import OperatingPoint
 
 #: Fewest samples a recording or window needs: below it the spectra have too few bins for the
 #: indicators (a 256-point Welch segment).
@@ -38,7 +44,9 @@ class Run:
         sensors gave. A recording may lack some.
     sample_rate : float [Hz]
     labels : dict
-        Run labels (contract): clearances [m], nominal speed [rad/s] and load [N], seed, …
+        Ground truth (the run-label contract, docs/formats.md): clearances [m], fault class,
+        seed, … of a simulated or dataset run; empty for a recording. Never read by the
+        diagnosis.
     scenario : dict
         Everything needed to re-run it (design, health, profile, sensors, options).
     energy : dict
@@ -49,12 +57,15 @@ class Run:
         the ``truth_`` prefix), SI, on the same time axis, free of sensor errors — empty for
         recordings. Never an input of the diagnosis.
     check_phase : ndarray of int or None
-        Health-check phase of every sample (index into ``check["phases"]``, −1 outside any
+        Health-check phase of every sample (a phase's ``index`` in ``check``, −1 outside any
         phase), None when the run is no check. Known to the controller (it commands the
         phases), so a recording from hardware may have it too.
-    check : dict
-        The check's ``name`` and ``phases`` (each ``index``, ``name``, ``start``, ``end`` [s]);
-        empty when the run is no check.
+    check : CheckPhases or None
+        The check's name and its phases (span [s] and commanded condition); None when the run
+        is no check.
+    operating : OperatingPoint
+        The design the run is of, the reduction, the nominal conditions: what the diagnosis
+        reads about a recording beside its samples (every field may be unknown).
     """
 
     time: np.ndarray
@@ -65,7 +76,8 @@ class Run:
     energy: dict = field(default_factory=dict)
     truth: dict[str, np.ndarray] = field(default_factory=dict)
     check_phase: np.ndarray | None = None
-    check: dict = field(default_factory=dict)
+    check: CheckPhases | None = None
+    operating: OperatingPoint = field(default_factory=OperatingPoint)
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name in self.truth and name not in self.channels:
@@ -164,30 +176,19 @@ class Run:
 
     def without_truth(self) -> Run:
         """The same recording with the measured channels only (arrays shared, not copied)."""
-        return Run(
-            self.time,
-            self.channels,
-            self.sample_rate,
-            self.labels,
-            self.scenario,
-            self.energy,
-            check_phase=self.check_phase,
-            check=self.check,
-        )
+        return replace(self, truth={})
 
     def slice(self, start: int, stop: int) -> Run:
-        """Samples ``[start, stop)`` as a run (views): channels, truth, check phase, labels and
-        scenario; no energy book (it is the whole run's)."""
+        """Samples ``[start, stop)`` as a run (views): channels, truth, check phase, with the
+        labels, scenario, check and operating point; no energy book (it is the whole run's)."""
         sl = slice(start, stop)
-        return Run(
-            self.time[sl],
-            {k: v[sl] for k, v in self.channels.items()},
-            self.sample_rate,
-            self.labels,
-            self.scenario,
+        return replace(
+            self,
+            time=self.time[sl],
+            channels={k: v[sl] for k, v in self.channels.items()},
             truth={k: v[sl] for k, v in self.truth.items()},
             check_phase=None if self.check_phase is None else self.check_phase[sl],
-            check=self.check,
+            energy={},
         )
 
     def windows(
@@ -258,7 +259,7 @@ class Run:
         if self.check_phase is None:
             return {}
         phase = np.asarray(self.check_phase)
-        names = {int(p["index"]): p["name"] for p in self.check.get("phases", [])}
+        names = self.check.names() if self.check is not None else {}
         out = {}
         for index in np.unique(phase[phase >= 0]):
             where = np.flatnonzero(phase == index)
@@ -281,18 +282,6 @@ class Run:
         import pandas as pd
 
         return pd.DataFrame(self.columns())
-
-
-def phase_of_samples(time, phases) -> np.ndarray:
-    """Health-check phase index of each sample time [s]: the ``index`` of the phase whose
-    ``start`` ≤ t < ``end`` (``phases`` as in :attr:`Run.check`), −1 outside any; int16.
-    The one rule that turns phase boundaries into the ``check_phase`` column (the simulator
-    and the file readers use it)."""
-    time = np.asarray(time, dtype=float)
-    out = np.full(time.shape, -1, dtype=np.int16)
-    for p in phases:
-        out[(time >= float(p["start"])) & (time < float(p["end"]))] = int(p["index"])
-    return out
 
 
 def window_span(

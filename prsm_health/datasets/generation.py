@@ -13,16 +13,13 @@ from __future__ import annotations
 import json
 import os
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from prsm_health.actuator.faults import (
-    FAULT_CLASSES,
-    FaultThresholds,
-)
-from prsm_health.core.channels import CHANNEL_NAMES, CHECK_PHASE, TRUTH_PREFIX, UNITS
+from prsm_health.actuator.faults import FAULT_CLASSES, FAULT_RULE
+from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_PREFIX, UNITS
 from prsm_health.core.errors import (
     PRSMHealthError,
     require,
@@ -43,6 +40,8 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
     import pyarrow as pa
     import pyarrow.parquet as pq
 
+    from prsm_health.io.columns import run_columns, units_schema
+
     recipe = Recipe.from_dict(recipe_source)
     store = DatasetStore(out_dir)
     specs = recipe.runs()
@@ -50,43 +49,35 @@ def run_batch(recipe_source: dict, batch: int, out_dir: str, formats: str) -> li
     tables, labels = [], []
     for run_id in recipe.batches()[batch]:
         spec = specs[run_id]
-        run = spec.scenario().simulate()
-        label = spec.labels(run)
-        if run.check:  # a check's phase names and boundaries, one JSON cell per run
-            label["check_phases"] = json.dumps(run.check)
-        run.labels = dict(run.labels, **label)
+        scenario = spec.scenario()
+        run = scenario.simulate()
+        label = spec.labels(scenario=scenario, run=run)
+        run = replace(run, labels=label)  # the dataset's labels, in its MCAP file too
         if formats in ("mcap", "both"):
             from prsm_health.io.mcap import write_mcap
 
             with store.staged(mcap_name(run_id)) as tmp:
                 write_mcap(run, tmp)
-        columns = {"run_id": pa.array(np.full(len(run), run_id, np.int32))}
-        for name, values in run.columns().items():
-            # time stays float64: float32 would round the sample times; the phase stays int16
-            exact = name in ("time", CHECK_PHASE)
-            columns[name] = pa.array(values if exact else values.astype(dtype))
-        tables.append(pa.table(columns))
+        run_id_column = np.full(len(run), run_id, np.int32)
+        tables.append(pa.table({"run_id": run_id_column, **run_columns(run, dtype)}))
         labels.append(label)
-    # One shard per batch, one row group per run; the labels ride in the footer so a shard and
-    # its labels appear together, atomically (staged, see DatasetStore.staged). The runs of a
-    # recipe share their instrumentation, hence their columns.
-    metadata = _schema_metadata(recipe, tables[0].column_names[1:])
-    metadata[b"prsm_health.labels"] = json.dumps(labels).encode()
+    # One shard per batch, one row group per run, the columns and units of a single-run file
+    # (io.columns); the labels ride in the footer so a shard and its labels appear together,
+    # atomically (staged, see DatasetStore.staged). The runs of a recipe share their
+    # instrumentation, hence their columns.
+    schema = units_schema(tables[0].schema, recipe.sample_rate)
+    schema = schema.with_metadata(
+        {
+            **schema.metadata,
+            b"prsm_health.recipe": recipe.name.encode(),
+            b"prsm_health.labels": json.dumps(labels).encode(),
+        }
+    )
     with store.staged(shard_name(batch)) as tmp:
-        with pq.ParquetWriter(
-            tmp, tables[0].schema.with_metadata(metadata), compression="zstd"
-        ) as writer:
+        with pq.ParquetWriter(tmp, schema, compression="zstd") as writer:
             for table in tables:
-                writer.write_table(table, row_group_size=table.num_rows)
+                writer.write_table(table.cast(schema), row_group_size=table.num_rows)
     return labels
-
-
-def _schema_metadata(recipe: Recipe, columns: list[str]) -> dict:
-    return {
-        b"prsm_health.units": json.dumps({k: UNITS[k] for k in columns}).encode(),
-        b"prsm_health.sample_rate": repr(float(recipe.sample_rate)).encode(),
-        b"prsm_health.recipe": recipe.name.encode(),
-    }
 
 
 def _shard_schema(store: DatasetStore, rel: str):
@@ -339,7 +330,7 @@ def _finalise(store: DatasetStore, recipe: Recipe, formats: str) -> None:
         "fault_taxonomy": {
             "classes": list(FAULT_CLASSES),
             "thresholds": recipe.faults.as_dict(),
-            "rule": FaultThresholds.__doc__.split("\n\n")[1].strip().replace("\n    ", " "),
+            "rule": FAULT_RULE,
         },
         "counts": dataset_counts(frame),
     }

@@ -34,7 +34,6 @@ sibling directory renamed at the end: a failed import leaves nothing behind.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import shutil
@@ -50,6 +49,7 @@ from prsm_health.core.jsonable import dumps
 from prsm_health.core.run import MIN_SAMPLES, Run
 from prsm_health.io import ColumnMap, load_column_map, read_with_warnings
 from prsm_health.io.column_map import MIN_RATE as COLUMN_MAP_MIN_RATE
+from prsm_health.io.columns import run_columns, units_schema
 
 #: Lowest sample rate an import accepts [Hz] (a map's ``sample_rate`` is held to it too).
 MIN_RATE = COLUMN_MAP_MIN_RATE
@@ -202,6 +202,7 @@ def import_recordings(
     try:
         rows = []
         channels = [c for c in CHANNEL_NAMES if c in runs[0].channels]
+        operating = spec.operating()
         for run_id, (path, run) in enumerate(zip(paths, runs)):
             row = {k: _plain(v) for k, v in table.loc[path.name].items() if k != "split"}
             if "clearance" in row:
@@ -213,34 +214,24 @@ def import_recordings(
                 "recording": path.name,
                 "source": str(path),
                 # None for a rig that is not a PRSM; else the map's design name, fingerprint
-                "design": None,
-                "design_fingerprint": None,
+                "design": operating.design,
+                "design_fingerprint": operating.design_fingerprint,
                 "lead": spec.lead,
-                **spec.labels(),
                 **row,
                 "n_samples": len(run),
             }
-            columns = {
-                "run_id": pa.array(np.full(len(run), run_id, np.int32)),
-                "time": pa.array(run.time),
-            }
-            for c in channels:
-                columns[c] = pa.array(run.channels[c])
+            # the columns and units of a single-run file, as a generated dataset's shard
+            table_ = pa.table({"run_id": np.full(len(run), run_id, np.int32), **run_columns(run)})
+            schema = units_schema(table_.schema, run.sample_rate)
+            schema = schema.with_metadata(
+                {**schema.metadata, b"prsm_health.labels": dumps([label]).encode()}
+            )
             shard = tmp / "signals" / f"part-{run_id:05d}.parquet"
-            metadata = {
-                b"prsm_health.units": json.dumps(
-                    {"time": "s", **{c: CHANNEL_UNITS[c] for c in channels}}
-                ).encode(),
-                b"prsm_health.sample_rate": repr(float(run.sample_rate)).encode(),
-                b"prsm_health.labels": dumps([label]).encode(),
-            }
-            table_ = pa.table(columns)
-            pq.write_table(table_.replace_schema_metadata(metadata), shard, compression="zstd")
+            pq.write_table(table_.cast(schema), shard, compression="zstd")
             rows.append(dict(label, shard=f"signals/{shard.name}", row_group=0))
         frame = pd.DataFrame(rows)
         pq.write_table(pa.Table.from_pandas(frame, preserve_index=False), tmp / "runs.parquet")
         classes = sorted(set(frame["fault_class"].astype(str))) if "fault_class" in frame else []
-        design = spec.labels()
         manifest = {
             "name": name or out.name,
             "recipe": {
@@ -253,7 +244,7 @@ def import_recordings(
                 "labels": str(labels),
             },
             "design": (
-                {"name": design["design"], "fingerprint": design["design_fingerprint"]}
+                {"name": operating.design, "fingerprint": operating.design_fingerprint}
                 if spec.design is not None
                 else None
             ),

@@ -14,10 +14,12 @@ import numpy as np
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.design_files import load_design
 from prsm_health.core.channels import CHANNEL_NAMES, CHECK_PHASE, TRUTH_PREFIX
+from prsm_health.core.check_phases import CheckPhases
 from prsm_health.core.errors import (
     PRSMHealthError,
     StorageError,
 )
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 
 from .store import DatasetStore
@@ -108,12 +110,10 @@ class Dataset:
             for k, v in row.items()
             if k not in ("shard", "row_group")
         }
-        check = {}
+        phase, check = None, None
         if CHECK_PHASE in names:  # a health-check run: its phases, as the generator stored them
-            check = {
-                "check_phase": table.column(CHECK_PHASE).to_numpy().astype(np.int16),
-                "check": json.loads(labels.get("check_phases") or "{}"),
-            }
+            phase = table.column(CHECK_PHASE).to_numpy().astype(np.int16)
+            check = CheckPhases.from_record(json.loads(labels.get("check_phases") or "{}"))
         return Run(
             table.column("time").to_numpy(),
             channels,
@@ -122,7 +122,10 @@ class Dataset:
             # the design as a simulated run's scenario holds it (a preset name or the dict)
             {"recipe": self.manifest["recipe"], "design": self.manifest["recipe"].get("design")},
             truth=signals,
-            **check,
+            check_phase=phase,
+            check=check,
+            # the design, reduction and nominal conditions are columns of runs.parquet
+            operating=OperatingPoint.from_labels(labels),
         )
 
     def iter_runs(self, run_ids: Iterable[int] | None = None):

@@ -669,10 +669,15 @@ class RunSpec:
                 f"recipe (run {self.run_id}, fault case {name}, severity {factor:g}): {exc}"
             ) from None
 
-    def labels(self, run: Run | None = None) -> dict:
+    def labels(self, *, scenario: Scenario | None = None, run: Run | None = None) -> dict:
         """The run's labels: id, split, fault class, the scenario's labels (nominal values) and,
-        given the simulated run, its realised clearances."""
-        scenario = self.scenario()
+        given the simulated run, its realised clearances, samples and, for a health check, its
+        phases (``check_phases``, JSON of :meth:`CheckPhases.as_record
+        <prsm_health.core.check_phases.CheckPhases.as_record>`).
+
+        ``scenario``: this run's :meth:`scenario`, when the caller has built it already (the
+        generator, which simulates it); default: built here."""
+        scenario = self.scenario() if scenario is None else scenario
         out = {
             "run_id": self.run_id,
             "split": self.split,
@@ -694,6 +699,8 @@ class RunSpec:
         if run is not None:
             out.update({k: v for k, v in run.labels.items() if "_realised_" in k})
             out["n_samples"] = len(run)
+            if run.check is not None:  # one JSON cell per run
+                out["check_phases"] = json.dumps(run.check.as_record())
         return out
 
 

@@ -108,14 +108,14 @@ class CheckModel:
 
 def is_check(run: Run) -> bool:
     """Whether ``run`` is a health-check recording (its phases known)."""
-    return run.check_phase is not None and bool(run.check.get("phases"))
+    return run.check_phase is not None and run.check is not None
 
 
 def check_reading(run: Run, design):
     """The check indicators of ``run`` (:func:`prsm_health.signals.check_indicators.check_indicators`)."""
     from prsm_health.signals.check_indicators import check_indicators
 
-    return check_indicators(run, design, gear_ratio=run.labels.get("gear_ratio"))
+    return check_indicators(run, design)
 
 
 def change_row(row: dict, baseline, names) -> dict:

@@ -51,7 +51,7 @@ def contract_json(value):
     return value
 
 
-class _Part(Mapping):
+class ContractPart(Mapping):
     """A frozen part of the contract, also readable as the mapping of its fields."""
 
     def __getitem__(self, key):
@@ -79,7 +79,7 @@ class _Part(Mapping):
 
 
 @dataclass(frozen=True, eq=False)
-class ClearanceInterval(_Part):
+class ClearanceInterval(ContractPart):
     """The clearance estimate and its interval."""
 
     estimate: float | None = describe("thread half-clearance estimate [m]")
@@ -94,7 +94,7 @@ class ClearanceInterval(_Part):
 
 
 @dataclass(frozen=True, eq=False)
-class Observability(_Part):
+class Observability(ContractPart):
     """Whether the recording lets the model see each target.
 
     Per window a bool; for a recording the fraction of its windows (0 … 1). A target is not
@@ -116,7 +116,7 @@ class Observability(_Part):
 
 
 @dataclass(frozen=True, eq=False)
-class ModelReference(_Part):
+class ModelReference(ContractPart):
     """The model bundle that made the diagnosis."""
 
     name: str = describe("model name")
@@ -129,7 +129,7 @@ class ModelReference(_Part):
 
 
 @dataclass(frozen=True, eq=False)
-class WindowSpan(_Part):
+class WindowSpan(ContractPart):
     """Where a window lies in its recording."""
 
     index: int = describe("window number from 0")
@@ -144,7 +144,7 @@ AMBIGUOUS = "ambiguous"
 
 
 @dataclass(frozen=True, eq=False)
-class Undecided(_Part):
+class Undecided(ContractPart):
     """Why the diagnosis names no class (``fault_class`` is ``cannot_tell``), and what to
     record next to decide."""
 
@@ -166,7 +166,7 @@ class Undecided(_Part):
 
 
 @dataclass(frozen=True, eq=False)
-class BaselineState(_Part):
+class BaselineState(ContractPart):
     """A unit's own baseline and how far this recording lies from it."""
 
     recordings: int = describe("recordings in the unit's baseline")
@@ -184,7 +184,7 @@ class BaselineState(_Part):
 
 
 @dataclass(frozen=True, eq=False)
-class EvidenceState(_Part):
+class EvidenceState(ContractPart):
     """The class evidence accumulated over a unit's recordings."""
 
     recordings: int = describe("recordings whose evidence has accumulated")
@@ -206,7 +206,7 @@ class EvidenceState(_Part):
 
 
 @dataclass(frozen=True, eq=False)
-class AssetState(_Part):
+class AssetState(ContractPart):
     """The unit (asset) a recording belongs to: its baseline and accumulated evidence."""
 
     asset_id: str = describe("the asset's identifier")

@@ -44,10 +44,10 @@ from prsm_health.actuator.design_files import (
 from prsm_health.core.channels import MEASURED_TOPICS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import finite_or_none
+from prsm_health.core.operating_point import NO_DESIGN, OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.signals.features import (
     FEATURES,
-    NO_DESIGN,
     extract_features_batch,
     indicator_groups,
 )
@@ -113,14 +113,14 @@ class ModelBundle:
         """The identity of the design the model was trained on (None: a rig without one)."""
         return None if self.design is None else design_fingerprint(self.design)
 
-    def refuses(self, labels: dict) -> str | None:
-        """Why this model cannot diagnose a recording with these labels — another design —
-        or None. The design itself decides (its fingerprint) where the recording carries it;
-        a recording known only by its design's name is compared by name; one that names no
-        design, or a model trained on a rig without one, is taken as it comes."""
+    def refuses(self, operating: OperatingPoint) -> str | None:
+        """Why this model cannot diagnose a recording of this operating point — another
+        design — or None. The design itself decides (its fingerprint) where the recording
+        carries it; a recording known only by its design's name is compared by name; one that
+        names no design, or a model trained on a rig without one, is taken as it comes."""
         if self.design is None:
             return None
-        fingerprint, name = labels.get("design_fingerprint"), labels.get("design")
+        fingerprint, name = operating.design_fingerprint, operating.design
         if name == NO_DESIGN:
             name = None
         if labelled_same_design(name, fingerprint, self.design.name, self.design_fingerprint) in (
@@ -249,7 +249,7 @@ def diagnose_indicators(
     """One :class:`Diagnosis` per row of indicators (one row per window).
 
     ``channels``: the measured channels of each row's window (default: the model's, i.e. none
-    missing); ``design``: the recording's design label, if it has one.
+    missing); ``design``: the recording's design name, if it has one.
     """
     x = _matrix(rows, bundle.feature_names)
     channels = channels or [bundle.channels or ()] * len(rows)
@@ -509,7 +509,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
 def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:
     """Diagnosis of one window (a :class:`Run` of about the model's window length)."""
     row = bundle.indicators(run)
-    return diagnose_indicators([row], bundle, [tuple(run.channels)], run.labels.get("design"))[0]
+    return diagnose_indicators([row], bundle, [tuple(run.channels)], run.operating.design)[0]
 
 
 def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
@@ -567,7 +567,7 @@ def diagnose_runs(
 
     bundle = bundle or load_bundle()
     for run in runs:
-        reason = bundle.refuses(run.labels)
+        reason = bundle.refuses(run.operating)
         if reason is not None:
             raise PRSMHealthError(reason)
     runs = [run.without_truth().validate() for run in runs]
@@ -604,7 +604,7 @@ def _diagnose_windowed(runs, bundle, *, window, split) -> list[Diagnosis]:
     split = [([part.without_truth() for part in parts], notes) for parts, notes in split]
     rows = bundle.indicators_batch([part for parts, _ in split for part in parts])
     channels = [tuple(run.channels) for run, (parts, _) in zip(runs, split) for _ in parts]
-    designs = [run.labels.get("design") for run, (parts, _) in zip(runs, split) for _ in parts]
+    designs = [run.operating.design for run, (parts, _) in zip(runs, split) for _ in parts]
     per_window = []
     for design in dict.fromkeys(designs):  # one call per design (usually one)
         at = [i for i, d in enumerate(designs) if d == design]
@@ -677,7 +677,8 @@ def replay(
             step = ReplayStep(w.index, w.start, w.end)
             if bundle is not None:
                 step.diagnosis = diagnose_window(
-                    Run(w.time, w.channels, w.sample_rate, w.labels), bundle
+                    Run(w.time, w.channels, w.sample_rate, w.labels, operating=w.operating),
+                    bundle,
                 )
                 if writer is not None:
                     writer.add(w.end_ns, step.diagnosis.to_json())

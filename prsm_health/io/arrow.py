@@ -12,16 +12,14 @@ refuse a small compressed stream that would inflate past its limits (the service
 
 from __future__ import annotations
 
-import json
 import struct
 from dataclasses import dataclass
 from pathlib import Path
 
-from prsm_health.core.channels import UNITS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 
-from .columns import check_columns, contract_channels, rate_from_time, run_table, truth_columns
+from .columns import run_from_table, run_table
 
 #: Media type of an Arrow IPC stream (IANA registration).
 ARROW_STREAM_MEDIA_TYPE = "application/vnd.apache.arrow.stream"
@@ -31,7 +29,8 @@ def write_run_arrow(run: Run, path: str | Path | None = None, *, compression: st
     """``run`` as an Arrow IPC stream: the bytes, or written to ``path`` (returns the path).
 
     Columns and schema metadata are those of :func:`~prsm_health.io.parquet.write_run_parquet`
-    (``time``, channels, ``truth_<name>``; units, sample rate, labels, scenario).
+    (``time``, channels, ``truth_<name>``; units, sample rate, labels, scenario, operating
+    point).
     ``compression``: None, ``"zstd"`` or ``"lz4"`` (Arrow IPC buffer compression).
     """
     import pyarrow as pa
@@ -134,40 +133,7 @@ def read_run_arrow(data, name: str = "recording") -> Run:
             table = reader.read_all()
     except (pa.ArrowException, OSError, ValueError) as exc:
         raise PRSMHealthError(f"{name}: not a readable Arrow IPC stream ({_short(exc)})") from None
-    return _run_from_table(table, name)
-
-
-def _run_from_table(table, name: str) -> Run:
-    import pyarrow as pa
-
-    meta = table.schema.metadata or {}
-    if "time" not in table.column_names:
-        raise PRSMHealthError(f"{name}: no 'time' column")
-    numeric = {"time", *[c for c in table.column_names if c in UNITS]}
-    for column in numeric:
-        kind = table.schema.field(column).type
-        if not (pa.types.is_floating(kind) or pa.types.is_integer(kind)):
-            raise PRSMHealthError(f"{name}: column {column!r} has type {kind}; numbers expected")
-
-    def values(column):
-        return table.column(column).to_numpy()
-
-    channels = contract_channels(name, table.column_names, values)
-    truth = truth_columns(table.column_names, values)
-    time = values("time").astype(float)
-    try:
-        labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
-        scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
-        rate = (
-            float(meta[b"prsm_health.sample_rate"])
-            if b"prsm_health.sample_rate" in meta
-            else rate_from_time(name, time)
-        )
-    except ValueError as exc:
-        raise PRSMHealthError(f"{name}: unreadable prsm_health schema metadata ({exc})") from None
-    if not isinstance(labels, dict) or not isinstance(scenario, dict):
-        raise PRSMHealthError(f"{name}: prsm_health.labels and .scenario must be JSON objects")
-    return Run(time, channels, rate, labels, scenario, truth=truth, **check_columns(table))
+    return run_from_table(table, name)
 
 
 # ----------------------------------------------------------------------------- flatbuffers

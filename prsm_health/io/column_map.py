@@ -26,6 +26,7 @@ from prsm_health.core.errors import (
     nearest_key,
     unknown_key_message,
 )
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml, tomllib
 
@@ -131,17 +132,15 @@ class ColumnMap:
         """The rig's design (None: not a PRSM)."""
         return None if self.design is None else load_design(self.design)
 
-    def labels(self) -> dict:
-        """The run labels the map gives, those it sets: ``design`` (the design's name) and
-        ``design_fingerprint`` for a PRSM, ``lead`` when given."""
-        out = {}
+    def operating(self) -> OperatingPoint:
+        """What a mapped run's operating point holds: the design's name and fingerprint for
+        a PRSM, the ``lead`` when given."""
         design = self.prsm_design
-        if design is not None:
-            out["design"] = design.name
-            out["design_fingerprint"] = design_fingerprint(design)
-        if self.lead is not None:
-            out["lead"] = self.lead
-        return out
+        return OperatingPoint(
+            design=None if design is None else design.name,
+            design_fingerprint=None if design is None else design_fingerprint(design),
+            lead=self.lead,
+        )
 
     def scenario(self) -> dict:
         """What a mapped run's ``scenario`` holds: the design as a simulated run's scenario
@@ -291,8 +290,9 @@ def _map_design(design, where: str, base: Path | None) -> str | dict | None:
 def apply_column_map(frame, spec: ColumnMap, where: str) -> Run:
     """A table (pandas DataFrame of a CSV or Parquet file) through ``spec``, as a Run in SI.
 
-    Time starts at 0 (a logger's clock may be wall time); the run's labels are the map's
-    (:meth:`ColumnMap.labels`), its scenario holds the map's design (:meth:`ColumnMap.scenario`).
+    Time starts at 0 (a logger's clock may be wall time); the run's operating point is the
+    map's (:meth:`ColumnMap.operating`), its scenario holds the map's design
+    (:meth:`ColumnMap.scenario`); no labels (a recording has no ground truth).
     Errors name ``where`` (the file), the column and, for a cell
     that is not a number, its data row.
     """
@@ -323,4 +323,4 @@ def apply_column_map(frame, spec: ColumnMap, where: str) -> Run:
         time = np.arange(n) / rate
     if "motor_current" in values:
         values["drive_torque"] = values.pop("motor_current") * spec.torque_constant
-    return Run(time, values, rate, spec.labels(), spec.scenario())
+    return Run(time, values, rate, scenario=spec.scenario(), operating=spec.operating())

@@ -3,6 +3,8 @@ for every reader (and so for the importer, ``diagnose`` and the service alike)."
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from prsm_health.core.run import Run
@@ -27,7 +29,4 @@ def derive_channels(run: Run) -> tuple[Run, tuple[str, ...]]:
     if not added:
         return run, ()
     channels = {**run.channels, **added}
-    derived = Run(
-        run.time, channels, run.sample_rate, run.labels, run.scenario, run.energy, run.truth
-    )
-    return derived, tuple(added)
+    return replace(run, channels=channels), tuple(added)

@@ -1,19 +1,19 @@
 """One run as a single Parquet file: ``time``, the measured channels, ``check_phase`` (a health
 check's phase of every sample, int16, −1 between phases) then ``truth_<name>`` for each truth
-signal as columns, with the units, sample rate, labels, scenario and the check's phase names and
-boundaries (``prsm_health.health_check``) in the schema metadata (docs/formats.md), so pandas,
+signal as columns, with the units, sample rate, labels, scenario, operating point
+(``prsm_health.operating``) and the check's phases (``prsm_health.health_check``) in the schema
+metadata (docs/formats.md), so pandas,
 pyarrow, polars and duckdb read it as is. Datasets (many runs) are :mod:`prsm_health.datasets`.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 
-from .columns import check_columns, contract_channels, rate_from_time, run_table, truth_columns
+from .columns import run_from_table, run_table
 
 
 def write_run_parquet(run: Run, path: str | Path) -> Path:
@@ -47,16 +47,4 @@ def read_run_parquet(path: str | Path | bytes, *, name: str | None = None) -> Ru
         raise PRSMHealthError(f"{path}: no such file") from None
     except Exception as exc:  # pyarrow raises several types for damaged files
         raise PRSMHealthError(f"{path}: not a readable Parquet file ({exc})") from None
-    meta = table.schema.metadata or {}
-    if "time" not in table.column_names:
-        raise PRSMHealthError(f"{path}: no 'time' column")
-    channels = contract_channels(path, table.column_names, lambda c: table.column(c).to_numpy())
-    truth = truth_columns(table.column_names, lambda c: table.column(c).to_numpy())
-    time = table.column("time").to_numpy().astype(float)
-    if b"prsm_health.sample_rate" in meta:
-        rate = float(meta[b"prsm_health.sample_rate"])
-    else:
-        rate = rate_from_time(path, time)
-    labels = json.loads(meta.get(b"prsm_health.labels", b"{}"))
-    scenario = json.loads(meta.get(b"prsm_health.scenario", b"{}"))
-    return Run(time, channels, rate, labels, scenario, truth=truth, **check_columns(table))
+    return run_from_table(table, path)

@@ -27,7 +27,7 @@ command line of this module.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -233,9 +233,7 @@ def honesty_checks(bundle, reference: Recipe, *, n: int = 6) -> dict:
             if "design" in change:
                 # A recording that says its design is refused (ModelBundle.refuses); what is
                 # checked here is one that does not say it — a rig's file of unknown origin.
-                run.labels = {
-                    k: v for k, v in run.labels.items() if k not in ("design", "design_fingerprint")
-                }
+                run.operating = replace(run.operating, design=None, design_fingerprint=None)
             d = diagnose(run, bundle)
             top = max(d.class_probabilities.values())
             true_class = one.labels()["fault_class"]

@@ -264,13 +264,13 @@ def phase_conditions(run: Run) -> list[PhaseCondition]:
     sign changes of the measured speed, the speed as its mean (its largest magnitude for a
     reversal), the load from a load cell (None without one)."""
     phases = run.phases()
-    records = {str(p.get("name")): p for p in run.check.get("phases", [])}
+    records = {p.name: p for p in run.check.phases} if run.check is not None else {}
     out = []
     for name, part in phases.items():
-        record = records.get(name, {})
+        record = records.get(name)
         speed_signal = _measured_speed(part)
-        motion = record.get("motion") or _measured_motion(speed_signal)
-        speed = record.get("speed")
+        motion = (record and record.motion) or _measured_motion(speed_signal)
+        speed = record.speed if record is not None else None
         if not _is_number(speed):
             if speed_signal is None or len(speed_signal) == 0:
                 speed = math.nan
@@ -278,7 +278,7 @@ def phase_conditions(run: Run) -> list[PhaseCondition]:
                 speed = float(np.percentile(np.abs(speed_signal), 98))
             else:
                 speed = float(np.mean(speed_signal))
-        load = record.get("load")
+        load = record.load if record is not None else None
         if not _is_number(load):
             load = _measured_load(part, motion, speed_signal)
         out.append(PhaseCondition(name, motion, float(speed), load, len(part), part))
@@ -401,7 +401,7 @@ def _reversal(phase: Run, design: PRSMDesign, out: dict) -> None:
     if "nut_position" not in phase.channels:
         wanted.append("nut_axial_accel")  # extract_features needs a position or a vibration
     channels = {k: phase.channels[k] for k in wanted if k in phase.channels}
-    part = Run(phase.time, channels, phase.sample_rate, phase.labels)
+    part = Run(phase.time, channels, phase.sample_rate, operating=phase.operating)
     try:
         values = extract_features(part, design)
     except PRSMHealthError:  # too short for a window, or no position and no vibration
@@ -476,8 +476,8 @@ def check_indicators(
         None: the run's own (:func:`~prsm_health.signals.features.run_design`). Gives C_a
         (the no-load threshold), the PRSM's periods, the position bins.
     gear_ratio : float or None
-        Motor turns per screw turn; None: the run's ``gear_ratio`` label, else 1 (no
-        reduction: nothing is removed before the averages).
+        Motor turns per screw turn; None: the run's ``operating.gear_ratio`` (1 when the
+        recording does not say: no reduction, nothing is removed before the averages).
 
     Returns
     -------
@@ -503,7 +503,7 @@ def check_indicators(
         A run labelled with a design that cannot be resolved, no ``design`` given.
     """
     out = dict.fromkeys(CHECK_INDICATORS, math.nan)
-    if run.check_phase is None or not run.check.get("phases"):
+    if run.check_phase is None or run.check is None:
         reason = "the run is no health check (no check phases)"
         return CheckReading(out, {}, dict.fromkeys(ROLES, reason))
     design = run_design(run) if design is None else load_design(design)
@@ -511,7 +511,7 @@ def check_indicators(
         reason = "no PRSM design (an imported rig): no load rating, no kinematics"
         return CheckReading(out, {}, dict.fromkeys(ROLES, reason))
     if gear_ratio is None:
-        gear_ratio = run.labels.get("gear_ratio", 1.0)
+        gear_ratio = run.operating.gear_ratio
     gear_ratio = float(gear_ratio) if _is_number(gear_ratio) and gear_ratio > 0 else 1.0
     found, missing = find_roles(phase_conditions(run), load_ratings(design).dynamic)
     roles: dict[str, str] = {}

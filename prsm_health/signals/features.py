@@ -45,6 +45,7 @@ from prsm_health.actuator.design import DEFAULT_PRESET, PRSMDesign, preset
 from prsm_health.actuator.design_files import design_of, load_design
 from prsm_health.core.channels import CHANNEL_NAMES, VIBRATION
 from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.operating_point import NO_DESIGN
 from prsm_health.core.run import Run
 from prsm_health.physics.kinematics import defect_frequencies, speed_ratios
 
@@ -83,8 +84,6 @@ ORDER_TRACKING_SPREAD = 0.05
 #: Most windows processed together by :func:`extract_features_batch` (memory: the
 #: mean-removed vibration of a window of 20,000 samples takes 0.64 MB).
 BATCH_WINDOWS = 16
-#: The design of a rig that is not a PRSM (imported recordings): no design-dependent indicators.
-NO_DESIGN = "none"
 
 
 def _feature_table() -> dict[str, str]:
@@ -310,12 +309,12 @@ def extract_features(
         ``run.truth`` is not read unless named in ``truth``.
     design : PRSMDesign, preset name, design TOML file, dict form, :data:`NO_DESIGN` or None
         Default (None): the run's own design (:func:`run_design`: its scenario's, else a
-        preset its labels name, else paper01 for a run with no design label).
-        :data:`NO_DESIGN` (or a run labelled ``design = None``, an imported rig that is not a
-        PRSM): the indicators that need the design's kinematics (mesh, gear, envelope, axial
+        preset its operating point names, else paper01 for a run that names none).
+        :data:`NO_DESIGN` (or a run whose operating point says so, an imported rig that is not
+        a PRSM): the indicators that need the design's kinematics (mesh, gear, envelope, axial
         baseline) are NaN.
     lead : float or None [m per revolution of screw_angle]
-        Without a design, the lead lost motion needs (default the run's ``labels["lead"]``).
+        Without a design, the lead lost motion needs (default the run's ``operating.lead``).
     truth : tuple of str
         Truth signals to use (keys of :data:`TRUTH_FEATURES`), research only: each adds its
         indicators; ``"carrier_speed"`` locates the mesh lines from the true carrier speed.
@@ -331,8 +330,8 @@ def extract_features(
         The measured channels (or the truth signals asked for) cannot be processed.
     PRSMHealthError
         No nut acceleration and no nut position; an unknown or absent truth signal asked for;
-        a run labelled with a design that is not a preset and carries no design, no
-        ``design`` given.
+        a run that names a design that is not a preset and carries no design, no ``design``
+        given.
     ParameterError
         A ``design`` that is not a preset, a design file or a valid dict form.
     """
@@ -354,7 +353,7 @@ def extract_features_batch(
     by row, where a row's frames stay in the cache).
     """
     given = _given_design(design)
-    # windows of one recording share its scenario and labels: resolve its design once
+    # windows of one recording share its scenario and operating point: resolve its design once
     designs: dict[tuple[int, int], PRSMDesign | None] = {}
     prepared = [_prepare(run, given, truth, lead, designs) for run in runs]
     groups: dict[tuple, list[int]] = {}
@@ -389,26 +388,26 @@ def _given_design(design) -> PRSMDesign | None | object:
 def run_design(run: Run) -> PRSMDesign | None:
     """The design a run's indicators are computed for, from the run alone.
 
-    Its scenario's design (a simulated run's, a dataset run's), else a preset its labels name
-    (:func:`~prsm_health.actuator.design_files.design_of`); None for a run labelled
-    ``design = None`` or :data:`NO_DESIGN` (a rig that is not a PRSM); paper01 for a run
-    with no design label at all.
+    Its scenario's design (a simulated run's, a dataset run's), else a preset its operating
+    point names (:func:`~prsm_health.actuator.design_files.design_of`); None for a run whose
+    operating point names :data:`NO_DESIGN` (a rig that is not a PRSM); paper01 for a run that
+    names no design at all.
 
     Raises
     ------
     PRSMHealthError
-        The labels name a design that is not a preset and the run carries no design.
+        The run names a design that is not a preset and carries no design.
     """
     found = design_of(run)
     if found is not None:
         return found
-    if "design" not in run.labels:
+    name = run.operating.design
+    if name is None:
         return preset(DEFAULT_PRESET)
-    name = run.labels["design"]
-    if not isinstance(name, str) or name == NO_DESIGN:  # None, or NaN read back from a table
+    if name == NO_DESIGN:
         return None
     raise PRSMHealthError(
-        f"run labelled design {name!r} carries no design and it is not a preset: "
+        f"run of design {name!r} carries no design and it is not a preset: "
         "pass design=<PRSMDesign or design file>"
     )
 
@@ -419,10 +418,10 @@ def _prepare(
     """(the window with only what is read, checked; its design; the lead without a design).
 
     ``design``: what :func:`_given_design` made of the argument; ``designs`` memoises
-    :func:`run_design` by the identity of the run's scenario and labels."""
+    :func:`run_design` by the identity of the run's scenario and operating point."""
     if design is _FROM_RUN:
         # ids are unique here: every run of the batch is alive while it is prepared
-        key, memo = (id(run.scenario), id(run.labels)), {} if designs is None else designs
+        key, memo = (id(run.scenario), id(run.operating)), {} if designs is None else designs
         if key not in memo:
             memo[key] = run_design(run)
         design = memo[key]
@@ -432,8 +431,8 @@ def _prepare(
         run.time,
         run.channels,
         run.sample_rate,
-        run.labels,
         truth={name: run.truth[name] for name in truth},
+        operating=run.operating,
     ).validate(what="window")
     if not any(name in CHANNEL_NAMES for name in run.channels):
         raise PRSMHealthError(
@@ -441,7 +440,7 @@ def _prepare(
             f"({', '.join(CHANNEL_NAMES)})"
         )
     if design is None:
-        lead = lead if lead is not None else run.labels.get("lead")
+        lead = lead if lead is not None else run.operating.lead
     return run, design, lead
 
 
@@ -594,7 +593,11 @@ def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> Non
             # drive_torque is the motor's, screw_speed the gearbox output's: the input power
             # is T_m·N·ω_s: the efficiency is the drive's from the motor shaft (reduction, screw)
             out["efficiency"] = _window_efficiency(
-                ch["drive_torque"] * _gear_ratio(run), speed, load, ch["nut_position"], run.time
+                ch["drive_torque"] * run.operating.gear_ratio,
+                speed,
+                load,
+                ch["nut_position"],
+                run.time,
             )
 
     # ---- reversals: of the motion, of the load (load cell), or of the drive torque when no
@@ -684,18 +687,6 @@ def _reverses(x: np.ndarray) -> bool:
     # smoothed signal: a steady run's noise around a small mean must not count).
     margin = 0.1 * float(np.ptp(x))
     return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
-
-
-def _gear_ratio(run: Run) -> float:
-    """The reduction N between the motor (whose torque ``drive_torque`` is) and the screw: the
-    run's ``gear_ratio`` label (a simulated run's drive train), else 1 (a recording that gives
-    none: its torque is taken as the screw's)."""
-    ratio = run.labels.get("gear_ratio", 1.0)
-    try:
-        ratio = float(ratio)
-    except (TypeError, ValueError):
-        return 1.0
-    return ratio if np.isfinite(ratio) and ratio > 0 else 1.0
 
 
 def _window_efficiency(torque, speed, load, position, time) -> float:

@@ -48,6 +48,7 @@ from prsm_health.actuator.drive_train import DriveTrain, duty_check, load_drive_
 from prsm_health.actuator.faults import fault_as_dict
 from prsm_health.actuator.states import HealthState, ManufacturingVariation, OperatingProfile
 from prsm_health.core.errors import ParameterError, require, require_known_keys
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.core.tomlfile import read_toml, toml_value
 from prsm_health.physics.load_rating import load_ratings
@@ -269,18 +270,34 @@ class Scenario:
         return "\n".join(lines) + "\n"
 
     # ------------------------------------------------------------------ labels
-    def labels(self) -> dict:
-        """Run labels of the contract: nominal health and operating point (SI)."""
-        h, p = self.health, self.profile
+    def operating_point(self) -> OperatingPoint:
+        """The design, reduction and nominal conditions a run of this scenario carries
+        (:attr:`Run.operating <prsm_health.core.run.Run.operating>`)."""
+        p = self.profile
         # a health check has no one operating point: its top speed and its peak load
         check = getattr(p, "check", None)
-        speed = p.top_speed if check else p.speed
-        load = p.peak_load if check else p.load
+        return OperatingPoint(
+            design=self.design.name,
+            # the name is for people; the fingerprint says which design the run is of
+            design_fingerprint=design_fingerprint(self.design),
+            # the drive torque is the motor's: N between it and the screw (features need it)
+            gear_ratio=self.drive_train.gear_ratio,
+            screw_speed=p.top_speed if check else p.speed,
+            axial_load=p.peak_load if check else p.load,
+            load_amplitude=0.0 if check else p.load_amplitude,
+            temperature=p.temperature,
+        )
+
+    def labels(self) -> dict:
+        """Run labels of the contract: nominal health and operating point (SI) — the operating
+        point's fields (:meth:`operating_point`) under their own names, so a dataset's table
+        holds them beside the health."""
+        h, p = self.health, self.profile
+        check = getattr(p, "check", None)
+        operating = self.operating_point()
         return {
-            "design": self.design.name,
-            # the name is for people; the fingerprint says which design the run is of (as a
-            # dataset run's label does)
-            "design_fingerprint": design_fingerprint(self.design),
+            "design": operating.design,
+            "design_fingerprint": operating.design_fingerprint,
             "clearance_screw": h.clearance_screw,
             "clearance_nut": h.clearance_nut,
             "clearance_gear": h.clearance_gear,
@@ -294,18 +311,17 @@ class Scenario:
             # JSON text, so a dataset's labels table keeps one scalar per cell
             "fault_kinds": "+".join(sorted({f.kind for f in h.faults})),
             "faults": json.dumps([fault_as_dict(f) for f in h.faults]),
-            "screw_speed": speed,
-            "axial_load": load,
-            "load_amplitude": 0.0 if check else p.load_amplitude,
+            "screw_speed": operating.screw_speed,
+            "axial_load": operating.axial_load,
+            "load_amplitude": operating.load_amplitude,
             # the peak load as a share of the design's dynamic rating: how hard the run works
             "load_share": p.peak_load / design_ratings(self.design)["C_a"],
             "motion": "check" if check else p.motion,
             "load_profile": "check" if check else p.load_profile,
             "check": check.name if check else "",
-            # the drive torque is the motor's: N between it and the screw (features need it)
-            "gear_ratio": self.drive_train.gear_ratio,
+            "gear_ratio": operating.gear_ratio,
             "duration": p.duration,
-            "temperature": p.temperature,
+            "temperature": operating.temperature,
             "seed": self.seed,
             "sensor_seed": self.sensors_seed,
         }

@@ -30,6 +30,7 @@ from sklearn.model_selection import GroupKFold, KFold, StratifiedGroupKFold, Str
 from sklearn.utils import check_random_state
 
 from prsm_health.core.errors import PRSMHealthError, require
+from prsm_health.core.operating_point import OperatingPoint
 
 __all__ = [
     "SparseFeatureError",
@@ -428,7 +429,7 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
     # a model of another design reads these indicators wrongly: refused before any work
     identity = [c for c in ("design", "design_fingerprint") if c in runs]
     for labels in runs[identity].drop_duplicates().to_dict("records") if identity else []:
-        reason = bundle.refuses({k: v for k, v in labels.items() if isinstance(v, str)})
+        reason = bundle.refuses(OperatingPoint.from_labels(labels))
         if reason is not None:
             raise PRSMHealthError(f"{dataset.path}: {reason}")
     table = dataset_features(dataset, runs["run_id"], progress=progress)

@@ -16,6 +16,7 @@ from prsm_health.actuator.design_files import (
     same_design,
 )
 from prsm_health.core.errors import ParameterError
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 
 
@@ -62,18 +63,24 @@ def test_integers_for_float_fields_are_the_same_design():
     assert "name" not in canonical_design(data) and "reference" not in canonical_design(data)
 
 
-def test_design_of_a_run_scenario_first_then_a_preset_label():
+def test_design_of_a_run_scenario_first_then_a_preset_name():
     mine = _mine()
-    run = Run([0.0, 1.0], {}, 1.0, {"design": mine.name}, {"design": mine.to_dict()})
+    run = Run(
+        [0.0, 1.0],
+        {},
+        1.0,
+        scenario={"design": mine.to_dict()},
+        operating=OperatingPoint(design=mine.name),
+    )
     assert design_of(run) == mine
     assert design_of({"design": mine.to_dict()}) == mine  # a scenario dict
     # a dataset run: the design inside the recipe
-    assert design_of({"recipe": {"design": mine.to_dict()}}, {"design": mine.name}) == mine
-    assert design_of({"design": "paper02"}, {"design": "paper01"}) == preset("paper02")
-    assert design_of({}, {"design": "paper03"}) == preset("paper03")
+    assert design_of({"recipe": {"design": mine.to_dict()}}, mine.name) == mine
+    assert design_of({"design": "paper02"}, "paper01") == preset("paper02")
+    assert design_of({}, "paper03") == preset("paper03")
     # known by name only, or by nothing: the caller decides
-    assert design_of({}, {"design": "acme-ema-24"}) is None
-    assert design_of({}, {"design": None}) is None
+    assert design_of({}, "acme-ema-24") is None
+    assert design_of({}, None) is None
     assert design_of({}) is None
 
 

@@ -43,21 +43,21 @@ def test_built_in_holds_the_issue_phases_in_order(check):
     assert turns >= 3.0
 
 
-def test_boundaries_and_phase_column(check):
-    b = check.boundaries()
-    assert [x["name"] for x in b] == [p.name for p in check.phases]
+def test_recorded_phases_and_phase_column(check):
+    b = check.recorded().phases
+    assert [x.name for x in b] == [p.name for p in check.phases]
     t = 0.0
     for x, p in zip(b, check.phases):
-        assert x["start"] == pytest.approx(t + p.ramp_time)
-        assert x["end"] - x["start"] == pytest.approx(p.duration)
-        t = x["end"]
+        assert x.start == pytest.approx(t + p.ramp_time)
+        assert x.end - x.start == pytest.approx(p.duration)
+        t = x.end
     assert check.duration == pytest.approx(t + check.phases[-1].ramp_time)
     times = np.arange(0.0, check.duration, 1e-4)
     phase = check.phase_at(times)
     assert phase.dtype == np.int16 and phase[0] == -1  # the first ramp belongs to no phase
     for x in b:  # each phase one contiguous span, −1 between them
-        where = np.flatnonzero(phase == x["index"])
-        assert times[where[0]] >= x["start"] and times[where[-1]] < x["end"]
+        where = np.flatnonzero(phase == x.index)
+        assert times[where[0]] >= x.start and times[where[-1]] < x.end
         assert np.all(np.diff(where) == 1)
     assert set(np.unique(phase)) == {-1, *range(len(b))}
 
@@ -73,8 +73,8 @@ def test_knots_continuous_and_on_the_commanded_speeds(check):
     # the angle is the integral of the piecewise-linear speed (what the kernel follows)
     assert np.allclose(np.diff(angles), 0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times))
     # inside each phase the commanded speed holds (constant) or swings ±speed (reversing)
-    for x, p in zip(check.boundaries(), check.phases):
-        t = np.linspace(x["start"], x["end"], 201)
+    for x, p in zip(check.recorded().phases, check.phases):
+        t = np.linspace(x.start, x.end, 201)
         w = np.interp(t, times, speeds)
         if p.motion == "constant":
             assert np.allclose(w, p.speed)
@@ -88,8 +88,8 @@ def test_loads_resolved_and_resisting_the_motion(check):
     assert amp == freq == 0.0
     times, speeds, _ = check.motion_knots()
     assert np.array_equal(knots[0], times)
-    for x, p in zip(check.boundaries(), check.phases):
-        t = np.linspace(x["start"], x["end"], 101)
+    for x, p in zip(check.recorded().phases, check.phases):
+        t = np.linspace(x.start, x.end, 101)
         load = np.interp(t, knots[0], knots[1])
         w = np.interp(t, times, speeds)
         # kernel sign: positive resists a positive speed; the phase's load resists its motion
@@ -147,7 +147,7 @@ def test_toml_round_trip(tmp_path):
     assert load_check("health-check") is BUILT_IN["health-check"]
     # a linear reversal is a triangle: the speed reaches −5 rad/s at half a period
     t, w, _ = check.resolved(RATINGS).motion_knots()
-    start = check.boundaries()[1]["start"]
+    start = check.recorded().phases[1].start
     assert np.interp(start + 0.05, t, w) == pytest.approx(-5.0)
 
 

@@ -37,7 +37,7 @@ def test_phases_are_read_back_from_the_dataset(tmp_path):
         run = ds.run(int(run_id))
         assert run.check_phase.dtype == np.int16  # not cast to the recipe's float32
         assert set(run.check_phase) == {-1, 0, 1}
-        assert [p["name"] for p in run.check["phases"]] == ["free", "loaded"]
+        assert [p.name for p in run.check.phases] == ["free", "loaded"]
         assert list(run.phases()) == ["free", "loaded"]
     shards = list((tmp_path / "ds" / "signals").glob("*.parquet"))
     assert shards

@@ -182,6 +182,11 @@ def test_workers_1_and_2_identical_and_readers(recipe_path, tmp_path):
     shard = pq.read_table(next((tmp_path / "a" / "signals").glob("*.parquet")))
     assert shard.schema.field("truth_friction_torque").type == "float"  # recipe dtype float32
     assert json.loads(meta[b"prsm_health.units"])["truth_load_force"] == "N"
+    # the units where every reader sees them, as in a single-run file: each field's and pandas'
+    assert shard.schema.field("nut_axial_accel").metadata[b"unit"] == b"m/s^2"
+    assert shard.schema.field("run_id").metadata is None
+    attrs = pd.read_parquet(next((tmp_path / "a" / "signals").glob("*.parquet"))).attrs
+    assert attrs["units"]["time"] == "s" and attrs["sample_rate"] == 20000.0
     counts = duckdb.sql(
         f"select run_id, count(*) n from read_parquet('{tmp_path / 'a' / 'signals' / '*.parquet'}') group by run_id order by run_id"
     ).fetchall()
@@ -210,6 +215,8 @@ def test_dataset_run_equals_simulation(recipe_path, tmp_path):
         expected = direct.truth[name].astype(np.float32).astype(float)
         assert np.array_equal(stored.truth[name], expected), name
     assert stored.labels["clearance_screw"] == scenario.health.clearance_screw
+    # the operating point from its columns in runs.parquet, as the simulation made it
+    assert stored.operating == direct.operating
     assert ds.run(4, truth=False).truth == {}
     assert ds.channels == CHANNEL_NAMES
 

@@ -133,16 +133,16 @@ def test_an_inline_design_table_is_the_same_design(rig, tmp_path):
     spec = load_column_map(tmp_path / "inline.toml")
     assert spec.design == MINE.to_dict()
     # a single recording read through the map (what `diagnose FILE --map` and the service
-    # read) carries the design too: labels name it, the scenario holds it
+    # read) carries the design too: its operating point names it, the scenario holds it
     run = read_recording(files[0], column_map=tmp_path / "inline.toml")
-    assert run.labels["design"] == "rig-7"
-    assert run.labels["design_fingerprint"] == design_fingerprint(MINE)
+    assert run.operating.design == "rig-7"
+    assert run.operating.design_fingerprint == design_fingerprint(MINE)
     assert same_design(design_of(run), MINE)
     # an uploaded map (text: no folder) takes the inline table, and the preset, as they are
     assert column_map_from_text(text, "up.toml").design == MINE.to_dict()
     preset_map = column_map_from_text('design = "paper01"\n' + MAP_BODY)
     assert preset_map.design == "paper01"
-    assert preset_map.labels()["design_fingerprint"] == design_fingerprint("paper01")
+    assert preset_map.operating().design_fingerprint == design_fingerprint("paper01")
     # an inline table that does not name itself is named after the map
     unnamed = text.replace('name = "rig-7"\n', "")
     (tmp_path / "bench.toml").write_text(unnamed)
@@ -152,7 +152,7 @@ def test_an_inline_design_table_is_the_same_design(rig, tmp_path):
 def test_the_design_file_is_read_relative_to_the_map(rig, tmp_path, monkeypatch):
     root, _ = rig
     monkeypatch.chdir(tmp_path)  # not the map's folder
-    assert load_column_map(root / "map.toml").labels()["design"] == "rig-7"
+    assert load_column_map(root / "map.toml").operating().design == "rig-7"
 
 
 @pytest.mark.parametrize(

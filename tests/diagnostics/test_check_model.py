@@ -4,6 +4,8 @@ missing and what to record; an ambiguous answer names the classes left; a class 
 is named with its reason. The estimators are stand-ins with fixed answers (the check model's
 training is measured by tools/release/train_check_model.py, not here)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -58,10 +60,10 @@ def check_run(short_check_run) -> Run:
 
 def without_phase(run: Run, name: str) -> Run:
     """The recording of a check that lacked the phase ``name`` (its samples outside any phase)."""
-    index = next(p["index"] for p in run.check["phases"] if p["name"] == name)
+    index = next(p.index for p in run.check.phases if p.name == name)
     phase = np.where(run.check_phase == index, -1, run.check_phase).astype(np.int16)
-    check = dict(run.check, phases=[p for p in run.check["phases"] if p["index"] != index])
-    return Run(run.time, run.channels, run.sample_rate, run.labels, check_phase=phase, check=check)
+    check = replace(run.check, phases=tuple(p for p in run.check.phases if p.index != index))
+    return replace(run, check_phase=phase, check=check)
 
 
 def test_a_check_is_read_phase_by_phase_and_names_a_class_alone(check_run):

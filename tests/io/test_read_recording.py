@@ -9,6 +9,7 @@ import pytest
 
 from prsm_health.actuator.design_files import design_fingerprint
 from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.io import (
     ColumnMap,
@@ -81,7 +82,10 @@ def test_map_converts_to_si_derives_speed_and_reads_every_table_alike(rig):
         run.channels["screw_speed"], np.gradient(run.channels["screw_angle"], run.time)
     )
     assert np.median(run.channels["screw_speed"]) == pytest.approx(2 * np.pi * 5.0, rel=0.05)
-    assert run.labels == {"design": "paper01", "design_fingerprint": design_fingerprint("paper01")}
+    assert run.operating == OperatingPoint(
+        design="paper01", design_fingerprint=design_fingerprint("paper01")
+    )
+    assert run.labels == {}  # a recording: no ground truth
     assert run.scenario == {"design": "paper01"}
     # the same table as Parquet, and as bytes, read the same through the same map
     spec = load_column_map(root / "map.toml")
@@ -186,11 +190,11 @@ def test_column_map_object_and_its_labels():
         'sample_rate = 50\nlead = 0.004\n[columns]\nnut_position = "p"\n[units]\np = "mm"\n'
     )
     assert isinstance(spec, ColumnMap) and spec.sample_rate == 50.0
-    assert spec.labels() == {"lead": 0.004}
+    assert spec.operating() == OperatingPoint(lead=0.004)
     frame = pd.DataFrame({"p": np.arange(300.0)})
     from prsm_health.io.column_map import apply_column_map
 
     run = apply_column_map(frame, spec, "f.csv")
     assert run.sample_rate == 50.0 and run.time[-1] == pytest.approx(299 / 50)
     assert np.allclose(run.channels["nut_position"], np.arange(300.0) * 1e-3)
-    assert math.isclose(run.labels["lead"], 0.004)
+    assert math.isclose(run.operating.lead, 0.004)

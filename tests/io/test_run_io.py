@@ -127,3 +127,26 @@ def test_damaged_files(tmp_path):
 def test_unknown_channel(run):
     with pytest.raises(PRSMHealthError, match="unknown channel"):
         run["vibration"]
+
+
+def test_the_operating_point_travels_in_every_format(tmp_path, run):
+    from prsm_health.io.arrow import read_run_arrow, write_run_arrow
+    from prsm_health.io.mcap import read_mcap, write_mcap
+
+    assert run.operating.design == "paper01" and run.operating.screw_speed == 100.0
+    parquet = read_run_parquet(write_run_parquet(run, tmp_path / "run.parquet"))
+    arrow = read_run_arrow(write_run_arrow(run))
+    mcap = read_mcap(write_mcap(run, tmp_path / "run.mcap"))
+    for back in (parquet, arrow, mcap):
+        assert back.operating == run.operating
+    meta = pq.read_schema(tmp_path / "run.parquet").metadata
+    assert json.loads(meta[b"prsm_health.operating"]) == run.operating.as_dict()
+
+
+def test_a_file_without_the_operating_record_reads_it_from_its_labels(tmp_path, run):
+    # files written before the record carried the same keys in their labels
+    path = write_run_parquet(run, tmp_path / "run.parquet")
+    table = pq.read_table(path)
+    meta = {k: v for k, v in table.schema.metadata.items() if k != b"prsm_health.operating"}
+    pq.write_table(table.replace_schema_metadata(meta), tmp_path / "old.parquet")
+    assert read_run_parquet(tmp_path / "old.parquet").operating == run.operating

@@ -1,6 +1,7 @@
 """The shipped default model (models/default.skops) on freshly simulated runs it never saw."""
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -113,7 +114,7 @@ def test_no_confident_wrong_class_when_clearance_is_hidden_or_channels_missing(b
 
 
 def test_another_design_or_instrumentation_is_flagged(bundle, reference):
-    # A paper-02 PRSM: refused while its recording says so; without its design labels (a
+    # A paper-02 PRSM: refused while its recording says so; without its design named (a
     # file of unknown origin) and with the lab-rig instrumentation: out of distribution (score
     # above the limit) and warned, no class. The model card's honesty table has six of each.
     from prsm_health.core.errors import PRSMHealthError
@@ -123,7 +124,7 @@ def test_another_design_or_instrumentation_is_flagged(bundle, reference):
     other, _ = _point_run(reference, spec, design="paper02")
     with pytest.raises(PRSMHealthError, match="design 'paper02.*trained on design 'paper01'"):
         diagnose(other, bundle)
-    other.labels = {k: v for k, v in other.labels.items() if not k.startswith("design")}
+    other.operating = replace(other.operating, design=None, design_fingerprint=None)
     lab_rig, _ = _point_run(reference, spec, instrumentation="lab-rig")
     for run in (other, lab_rig):
         d = diagnose(run, bundle)

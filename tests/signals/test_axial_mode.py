@@ -12,6 +12,7 @@ from prsm_health.actuator.design import preset
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.actuator.states import HealthState, OperatingProfile
 from prsm_health.core.errors import ParameterError
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.physics.load_rating import load_ratings
 from prsm_health.signals import axial_mode
@@ -243,7 +244,12 @@ def test_features_carry_the_tracked_frequency(monkeypatch):
     rng = np.random.default_rng(5)
     n = 6000
     x = _resonance(170.0, 0.02, 1.0, n, rng) + _resonance(465.0, 0.05, 3.0, n, rng)
-    run = Run(np.arange(n) / RATE, {"nut_axial_accel": x}, RATE, {"design": "paper01"})
+    run = Run(
+        np.arange(n) / RATE,
+        {"nut_axial_accel": x},
+        RATE,
+        operating=OperatingPoint(design="paper01"),
+    )
     row = extract_features(run)
     assert FEATURES["axial_contact_frequency"] == FEATURES["axial_contact_frequency_shift"] == "Hz"
     assert {"axial_contact_frequency", "axial_contact_frequency_shift"} <= set(

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from prsm_health.actuator.design import preset
-from prsm_health.core.run import Run, phase_of_samples
+from prsm_health.core.check_phases import CheckPhases
+from prsm_health.core.operating_point import OperatingPoint
+from prsm_health.core.run import Run
 from prsm_health.physics.kinematics import speed_ratios
 from prsm_health.signals.angle_domain import prsm_periods
 from prsm_health.signals.check_indicators import (
@@ -50,7 +52,8 @@ def _check_run(phases=PHASES, *, record=True, load_cell=False, drop=(), locked=T
         )
         t0 = start + duration
     time = np.arange(int((t0 + RAMP) * RATE)) / RATE
-    phase = phase_of_samples(time, bounds)
+    check = CheckPhases.from_record({"name": "synthetic", "phases": bounds})
+    phase = check.of_samples(time)
     speed = np.zeros_like(time)
     torque = np.zeros_like(time)
     load = np.zeros_like(time)
@@ -91,14 +94,13 @@ def _check_run(phases=PHASES, *, record=True, load_cell=False, drop=(), locked=T
         channels["axial_load"] = load
     for name in drop:
         channels.pop(name)
-    labels = {"design": "paper01", "gear_ratio": 3.0}
     return Run(
         time,
         channels,
         RATE,
-        labels,
         check_phase=phase,
-        check={"name": "synthetic", "phases": bounds},
+        check=check,
+        operating=OperatingPoint(design="paper01", gear_ratio=3.0),
     )
 
 
@@ -233,7 +235,7 @@ def test_find_roles_picks_the_largest_speed_ratio_and_the_largest_load():
 
 def test_no_check_gives_all_roles_missing():
     run = _check_run()
-    plain = Run(run.time, run.channels, run.sample_rate, run.labels)
+    plain = Run(run.time, run.channels, run.sample_rate, operating=run.operating)
     reading = check_indicators(plain, DESIGN)
     assert reading.roles == {}
     assert set(reading.missing) == set(ROLES)

@@ -8,6 +8,7 @@ import pytest
 from prsm_health import preset, speed_ratios
 from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_NAMES
 from prsm_health.core.errors import PRSMHealthError, RecordingError
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import Run
 from prsm_health.diagnostics.diagnosis import ModelBundle, diagnose
 from prsm_health.signals.features import (
@@ -47,7 +48,7 @@ def synthetic(n=20_000, speed=100.0, extra=None, load=None):
         "carrier_speed": np.full(n, ratios.carrier * speed),
         "friction_torque": 0.03 + 0.001 * np.sin(2 * math.pi * 10 * t),
     }
-    return Run(t, ch, RATE, {"design": "paper01"}, truth=truth), f_mesh
+    return Run(t, ch, RATE, truth=truth, operating=OperatingPoint(design="paper01")), f_mesh
 
 
 def same(a: dict, b: dict) -> bool:

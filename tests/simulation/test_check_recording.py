@@ -46,15 +46,15 @@ def run():
 
 def test_every_sample_has_its_phase(run):
     check = run.scenario["profile"]["check"]
-    assert run.check["name"] == check["name"] == "short-check"
+    assert run.check.name == check["name"] == "short-check"
     phase = run.check_phase
     assert phase.shape == run.time.shape and phase.dtype == np.int16
-    for b in run.check["phases"]:
-        inside = (run.time >= b["start"]) & (run.time < b["end"])
-        assert np.all(phase[inside] == b["index"])
+    for b in run.check.phases:
+        inside = (run.time >= b.start) & (run.time < b.end)
+        assert np.all(phase[inside] == b.index)
         # 0.03 s at the sample rate, ±1 sample at the edges
         assert abs(inside.sum() - 0.03 * run.sample_rate) <= 1
-    assert np.all(phase[run.time < run.check["phases"][0]["start"]] == -1)
+    assert np.all(phase[run.time < run.check.phases[0].start] == -1)
     parts = run.phases()
     assert list(parts) == [p["name"] for p in check["phases"]]
     # the phase's settled speed is what the drive measured there (prescribed drive: the motor
@@ -84,14 +84,14 @@ def test_parquet_column_and_metadata_read_by_pyarrow(run, tmp_path):
     assert str(table.schema.field(CHECK_PHASE).type) == "int16"
     assert np.array_equal(table.column(CHECK_PHASE).to_numpy(), run.check_phase)
     meta = json.loads(table.schema.metadata[f"prsm_health.{CHECK_METADATA}".encode()])
-    assert meta == json.loads(json.dumps(run.check))
+    assert meta == json.loads(json.dumps(run.check.as_record()))
     # the reader can cut by phase from the file alone
     time = table.column("time").to_numpy()
     for b in meta["phases"]:
         at = time[table.column(CHECK_PHASE).to_numpy() == b["index"]]
         assert b["start"] <= at[0] < b["start"] + 1.5 / run.sample_rate and at[-1] < b["end"]
     back = read_run_parquet(path)
-    assert np.array_equal(back.check_phase, run.check_phase) and back.check == meta
+    assert np.array_equal(back.check_phase, run.check_phase) and back.check == run.check
 
 
 def test_mcap_topic_and_metadata_read_by_mcap(run, tmp_path):
@@ -107,13 +107,13 @@ def test_mcap_topic_and_metadata_read_by_mcap(run, tmp_path):
         metadata = {m.name: m.metadata for m in reader.iter_metadata()}
     # one message per change: −1, then each phase and the ramp after it
     assert [m["index"] for _, m in messages] == [-1, 0, -1, 1, -1, 2, -1, 3, -1, 4, -1]
-    names = {b["index"]: b["name"] for b in run.check["phases"]}
+    names = run.check.names()
     for log_time, m in messages:
         assert m["name"] == names.get(m["index"], "")
         k = int(round(log_time * 1e-9 * run.sample_rate))  # the sample it starts at
         assert run.check_phase[k] == m["index"] and (k == 0 or run.check_phase[k - 1] != m["index"])
     record = metadata[CHECK_METADATA]
     assert record["name"] == "short-check"
-    assert json.loads(record["phases"]) == json.loads(json.dumps(run.check["phases"]))
+    assert json.loads(record["phases"]) == run.check.as_record()["phases"]
     back = read_mcap(path)
     assert np.array_equal(back.check_phase, run.check_phase)

@@ -6,6 +6,7 @@ simulated runs last 0.02–0.05 s. Tolerances are stated where they are used.
 """
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -218,12 +219,7 @@ def test_a_recording_with_or_without_the_channel_diagnoses_alike(runs):
     bundle = load_bundle()
     assert "housing_temperature_mean" in bundle.feature_names
     run = runs["flight-ema"]
-    without = type(run)(
-        run.time,
-        {k: v for k, v in run.channels.items() if k != CHANNEL},
-        run.sample_rate,
-        run.labels,
-    )
+    without = replace(run, channels={k: v for k, v in run.channels.items() if k != CHANNEL})
     a, b = diagnose(run, bundle), diagnose(without, bundle)
     assert not any(CHANNEL in w for w in a.warnings)
     assert any(CHANNEL in w and "missing" in w for w in b.warnings)

@@ -53,8 +53,8 @@ def main() -> None:
         f"{e['dissipated']:.4g} J; (drive − output − dissipated)/(energy through) = "
         f"{100 * energy_residual(e):+.3f} %"
     )
-    for p in run.check["phases"]:
-        print(f"phase {p['index']} {p['name']!r}: {p['start']:.3f}–{p['end']:.3f} s")
+    for p in run.check.phases:
+        print(f"phase {p.index} {p.name!r}: {p.start:.3f}–{p.end:.3f} s")
     print("wrote", plot_check(run, args.out))
 
 

@@ -76,7 +76,8 @@ def _parquet_parts(path: Path) -> dict:
     for name in table.column_names:
         columns += [name, table.column(name).combine_chunks().to_numpy(zero_copy_only=False)]
     parts = {"columns": _digest(c.tobytes() if hasattr(c, "tobytes") else c for c in columns)}
-    for key in (b"prsm_health.units", b"prsm_health.labels", b"prsm_health.scenario"):
+    keys = ("units", "labels", "operating", "scenario")
+    for key in (f"prsm_health.{k}".encode() for k in keys):
         parts[key.decode().removeprefix("prsm_health.")] = json.loads(meta.get(key, b"null"))
     return parts
 

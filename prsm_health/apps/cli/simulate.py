@@ -140,7 +140,7 @@ def simulate(args) -> int:
                 "integration_step": run.scenario["integration_step"],
                 "highest_natural_frequency": run.scenario["highest_natural_frequency"],
                 "energy": run.energy,
-                "check": run.check or None,
+                "check": None if run.check is None else run.check.as_record(),
                 "labels": run.labels,
             }
         )
@@ -152,11 +152,11 @@ def simulate(args) -> int:
                 ("channels", ", ".join(run.channels), ""),
                 ("samples", len(run), f"at {run.sample_rate:g} Hz"),
                 # the load as resolved against the design's rating (a share given, or the default)
-                ("axial load", run.labels["axial_load"], "N, peak" if run.check else "N, mean"),
+                ("axial load", run.operating.axial_load, "N, peak" if run.check else "N, mean"),
                 ("peak load", 100.0 * run.labels["load_share"], "% of C_a"),
                 *[
-                    (f"check {run.check['name']}", p["name"], f"{p['start']:.3f}–{p['end']:.3f} s")
-                    for p in run.check.get("phases", [])
+                    (f"check {run.check.name}", p.name, f"{p.start:.3f}–{p.end:.3f} s")
+                    for p in (run.check.phases if run.check is not None else ())
                 ],
                 ("gear mesh frequency", mesh, "Hz"),
                 ("integration step", run.scenario["integration_step"], "s"),

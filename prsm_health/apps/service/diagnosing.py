@@ -26,6 +26,7 @@ from prsm_health.core.channels import CHANNEL_NAMES
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.identifiers import content_id, run_content_id
 from prsm_health.core.jsonable import json_ready
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import MIN_SAMPLES, Run
 from prsm_health.diagnostics.baseline import Baseline
 from prsm_health.diagnostics.check_model import is_check
@@ -220,7 +221,7 @@ def check_design(design: str | None, bundle) -> None:
 
 def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     """The recording a validated request describes (channels of equal length, the model's
-    design); the nominal speed and load become labels."""
+    design); the nominal speed, load and the reduction its operating point."""
     given = {name: getattr(req.channels, name) for name in CHANNEL_NAMES}
     channels = {
         name: np.asarray(values, dtype=float)
@@ -238,16 +239,15 @@ def run_from_request(req: DiagnoseRequest, bundle) -> Run:
     check_design(req.design, bundle)
     n = next(iter(lengths.values()))
     rate = float(req.sample_rate)  # range checked by the request's validation
-    labels = {"design": bundle.design_name}
-    if req.speed is not None:
-        labels["screw_speed"] = float(req.speed)
-    if req.load is not None:
-        labels["axial_load"] = float(req.load)
-    if req.gear_ratio is not None:
-        labels["gear_ratio"] = float(req.gear_ratio)
+    operating = OperatingPoint(
+        design=bundle.design_name,
+        screw_speed=req.speed,
+        axial_load=req.load,
+        gear_ratio=1.0 if req.gear_ratio is None else req.gear_ratio,
+    )
     # the channels a file reader derives (screw speed from the angle), derived here too
     return derive_channels(
-        Run(float(req.time_start) + np.arange(n) / rate, channels, rate, labels)
+        Run(float(req.time_start) + np.arange(n) / rate, channels, rate, operating=operating)
     )[0]
 
 
@@ -341,16 +341,16 @@ def diagnose_body(
         params = params or BodyParams()
         check_design(params.design, bundle)
         run, notes = read_body(body, fmt, limits)
-        labels = dict(run.labels)
-        if params.design is not None:
-            labels["design"] = params.design
-        if params.speed is not None:
-            labels["screw_speed"] = params.speed
-        if params.load is not None:
-            labels["axial_load"] = params.load
-        if params.gear_ratio is not None:
-            labels["gear_ratio"] = params.gear_ratio
-        run = dataclasses.replace(run, labels=labels)  # a check's phases kept
+        given = {
+            "design": params.design,
+            "screw_speed": params.speed,
+            "axial_load": params.load,
+            "gear_ratio": params.gear_ratio,
+        }
+        operating = dataclasses.replace(
+            run.operating, **{k: v for k, v in given.items() if v is not None}
+        )
+        run = dataclasses.replace(run, operating=operating)  # a check's phases kept
         limits.check_sample_rate(run.sample_rate, _what(fmt))  # a JSON body's is validated
     max_samples = limits.max_json_samples(run.sample_rate)
     if len(run) > max_samples:

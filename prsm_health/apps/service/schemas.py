@@ -6,8 +6,9 @@ limits are known: a request body is validated with ``context={"limits": limits}`
 pydantic's own error types and messages, and :func:`document_limits` writes the same bounds
 into the app's OpenAPI document.
 
-The Diagnosis answer is not declared here: :func:`contract_model` generates its models from
-the library's declaration (:mod:`prsm_health.diagnostics.contract`), field by field. The query
+The Diagnosis and Prognosis answers are not declared here: :func:`contract_model` generates
+their models from the library's declarations (:mod:`prsm_health.diagnostics.contract`,
+:mod:`prsm_health.prognostics.prognosis`), field by field. The query
 parameters of a binary body are the JSON body's fields (:class:`DiagnoseParams`), checked by
 the same model (:func:`parse_query_params`).
 """
@@ -33,6 +34,7 @@ from pydantic_core import PydanticKnownError
 from prsm_health.core.channels import CHANNEL_NAMES, CHANNELS, TRUTH_NAMES, TRUTH_PREFIX
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, RECORDING_ID_PATTERN
 from prsm_health.diagnostics import contract
+from prsm_health.prognostics import prognosis
 
 from .limits import MAX_OPERATING_HOURS, ServiceLimits
 from .responses import HTTPError
@@ -140,8 +142,9 @@ class DiagnoseRequest(DiagnoseParams):
 
 
 def contract_model(cls: type, models: dict[str, type[BaseModel]] | None = None):
-    """The pydantic model of a part of the Diagnosis contract, generated from its dataclass
-    declaration (:mod:`prsm_health.diagnostics.contract`): one field per dataclass field, with
+    """The pydantic model of a part of the Diagnosis or Prognosis contract, generated from its
+    dataclass declaration (:mod:`prsm_health.diagnostics.contract`,
+    :mod:`prsm_health.prognostics.prognosis`): one field per dataclass field, with
     its type (parts replaced by their models, recursively) and description; a field the JSON
     leaves out when empty (``omit_empty``) is not required, every other one is; no other key
     is allowed. ``models``: the models made so far, by class name (shared by the recursion)."""
@@ -246,44 +249,11 @@ class History(BaseModel):
     diagnoses: list[HistoryEntry]
 
 
-class RulHours(BaseModel):
-    estimate: float = Field(description="median remaining useful life [h]")
-    lower: float = Field(description="5 % quantile [h] (lower bound of the 90 % interval)")
-    upper: float = Field(description="95 % quantile [h] (upper bound of the 90 % interval)")
-
-
-class HealthIndicator(BaseModel):
-    name: str = Field(description="clearance")
-    unit: str = Field(description="m")
-    threshold: float = Field(description="clearance at which the unit fails [m]")
-    ages_hours: list[float] = Field(description="operating hours of the diagnoses used [h]")
-    values: list[float] = Field(description="their clearance estimates [m]")
-    lower: list[float] = Field(description="their 90 % interval lower bounds [m]")
-    upper: list[float] = Field(description="their 90 % interval upper bounds [m]")
-    current: float = Field(description="the latest clearance estimate [m]")
-
-
-class PrognosisModel(BaseModel):
-    """The prognostics model and, by method, its posterior or similarity details."""
-
-    model_config = ConfigDict(extra="allow")
-    name: str = Field(
-        description="degradation-exponential, degradation-linear or similarity (the method used)"
-    )
-    version: str
-    design: str = Field(description="design the prognostics model is for")
-    units_trained: int
-    threshold: float = Field(description="[m]")
-    horizon_hours: float = Field(description="RUL cap [h]")
-
-
-class Prognosis(BaseModel):
-    """Remaining useful life of an asset (``prsm_health.prognostics.Prognosis.as_dict``)."""
-
-    rul_hours: RulHours
-    health_indicator: HealthIndicator
-    model: PrognosisModel
-    warnings: list[str] = Field(description="what limits the answer")
+#: The Prognosis answer's models, generated once from its declaration
+#: (:mod:`prsm_health.prognostics.prognosis`).
+_PROGNOSIS: dict[str, type[BaseModel]] = {}
+Prognosis = contract_model(prognosis.Prognosis, _PROGNOSIS)
+RulHours = _PROGNOSIS["RulHours"]
 
 
 class LatestDiagnosis(BaseModel):

@@ -22,6 +22,7 @@ import numpy as np
 
 from prsm_health.core.channels import TOPIC_FIELDS
 from prsm_health.core.errors import PRSMHealthError
+from prsm_health.core.operating_point import OPERATING_METADATA, OperatingPoint
 
 from ._framing import (
     _MAGIC,
@@ -414,6 +415,13 @@ class _Source:
         return {
             k: decode_metadata_value(v) for k, v in self.metadata.get(LABELS_METADATA, {}).items()
         }
+
+    def operating(self) -> OperatingPoint:
+        """The ``operating`` record; a file written before it: read from the labels."""
+        if OPERATING_METADATA not in self.metadata:
+            return OperatingPoint.from_labels(self.labels())
+        record = self.metadata[OPERATING_METADATA]
+        return OperatingPoint.from_labels({k: decode_metadata_value(v) for k, v in record.items()})
 
     def info(self) -> dict:
         return self.metadata.get(INFO_METADATA, {})

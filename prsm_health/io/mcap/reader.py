@@ -7,8 +7,9 @@ import os
 import warnings
 
 from prsm_health.core.channels import CHECK_METADATA, TOPIC_FIELDS
+from prsm_health.core.check_phases import CheckPhases
 from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
-from prsm_health.core.run import Run, phase_of_samples
+from prsm_health.core.run import Run
 
 from ._samples import _align, _Batch, _merge_topic, _sample_rate, _start_ns, _times
 from ._scan import _chunk_batches, _Source, _unchunked_batches
@@ -31,12 +32,13 @@ def read_mcap(path: str | os.PathLike) -> Run:
     -------
     Run
         Measured channels of the topics present, truth signals of ``/prsm/truth`` (if any) in
-        ``Run.truth``; labels from the ``labels`` metadata, scenario from its
+        ``Run.truth``; labels from the ``labels`` metadata, the operating point from the
+        ``operating`` metadata (files written before it: from the labels), scenario from its
         attachment, sample rate and energy from the ``prsm_health`` metadata (the sample rate
         is estimated from the log-time spacing when that record is missing); a health check's
         name and boundaries from the ``health_check`` metadata in ``Run.check``, and
         ``Run.check_phase`` rebuilt from those boundaries on the time axis (the rule the
-        writer's phase topic was made with, :func:`~prsm_health.core.run.phase_of_samples`).
+        writer's phase topic was made with, :func:`~prsm_health.core.check_phases.phase_of_samples`).
 
     Warns
     -----
@@ -87,8 +89,9 @@ def read_mcap(path: str | os.PathLike) -> Run:
             source.scenario(),
             energy,
             truth,
-            check_phase=phase_of_samples(time, check["phases"]) if check else None,
+            check_phase=None if check is None else check.of_samples(time),
             check=check,
+            operating=source.operating(),
         )
         if source.damage:
             warnings.warn(
@@ -100,40 +103,19 @@ def read_mcap(path: str | os.PathLike) -> Run:
         return run
 
 
-def _condition(phase: dict) -> dict:
-    """A phase's commanded condition (``motion``, ``speed`` [rad/s], ``load`` [N]) where the
-    recording has it (files written before it was recorded have none)."""
-    out = {}
-    if "motion" in phase:
-        out["motion"] = str(phase["motion"])
-    for key in ("speed", "load"):
-        if phase.get(key) is not None:
-            out[key] = float(phase[key])
-    return out
-
-
-def _check_record(record: dict | None) -> dict:
-    """``{"name", "phases"}`` of the ``health_check`` metadata record; {} when absent or
-    unreadable (a recording without a check)."""
+def _check_record(record: dict | None) -> CheckPhases | None:
+    """The check of the ``health_check`` metadata record (its ``phases`` a JSON text); None
+    when absent or unreadable (a recording without a check)."""
     if not record or "phases" not in record:
-        return {}
+        return None
     try:
-        phases = json.loads(record["phases"])
-        phases = [
-            {
-                "index": int(p["index"]),
-                "name": str(p["name"]),
-                "start": float(p["start"]),
-                "end": float(p["end"]),
-                **_condition(p),
-            }
-            for p in phases
-        ]
+        return CheckPhases.from_record(
+            {"name": record.get("name", ""), "phases": json.loads(record["phases"])}
+        )
     except (ValueError, TypeError, KeyError):
         warnings.warn(
             "health_check metadata is not readable; check phases left out",
             UserWarning,
             stacklevel=3,
         )
-        return {}
-    return {"name": record.get("name", ""), "phases": phases}
+        return None

@@ -24,6 +24,7 @@ import numpy as np
 
 from prsm_health.core.channels import TOPIC_FIELDS
 from prsm_health.core.errors import PRSMHealthError, TruncatedRecordingWarning
+from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import lookup_channel, window_span
 
 from ._samples import _align, _Batch, _merge_topic, _require_positive, _sample_rate, _start_ns
@@ -71,6 +72,8 @@ class Window:
         Measured contract channels, SI; NaN where a topic has no sample at a time another has.
     labels : dict
         Run labels of the recording.
+    operating : OperatingPoint
+        The recording's design, reduction and nominal conditions.
     sample_rate : float [Hz]
     truth : dict of name → ndarray
         Truth signals of ``/prsm/truth``, when replayed (simulated recordings); never an input
@@ -85,6 +88,7 @@ class Window:
     time: np.ndarray
     channels: dict[str, np.ndarray]
     labels: dict = field(default_factory=dict)
+    operating: OperatingPoint = field(default_factory=OperatingPoint)
     sample_rate: float = 0.0
     truth: dict[str, np.ndarray] = field(default_factory=dict)
 
@@ -356,6 +360,7 @@ class WindowStream(Iterator[Window]):
                 time=(grid - self._origin) / 1e9,
                 channels=channels,
                 labels=self._source.labels(),
+                operating=self._source.operating(),
                 sample_rate=rate,
                 truth=truth,
             )

@@ -31,6 +31,7 @@ from prsm_health.core.channels import (
 )
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps
+from prsm_health.core.operating_point import OPERATING_METADATA
 from prsm_health.core.run import Run
 
 from ._container import DEFAULT_CHUNK_SIZE, _AtomicFile, _FileWriter, _library, _MessageBlock
@@ -78,7 +79,7 @@ def _phase_messages(run: Run, n: int) -> tuple[np.ndarray | None, list[bytes]]:
     phase = np.asarray(run.check_phase)
     if phase.shape != (n,):
         raise PRSMHealthError(f"{CHECK_PHASE} has shape {phase.shape}; expected ({n},) like time")
-    names = {int(p["index"]): str(p["name"]) for p in run.check.get("phases", [])}
+    names = run.check.names() if run.check is not None else {}
     changes = np.flatnonzero(np.concatenate(([True], phase[1:] != phase[:-1])))
     payloads = [
         dumps({"index": int(phase[i]), "name": names.get(int(phase[i]), "")}).encode()
@@ -184,9 +185,10 @@ def write_mcap(
         }
         scenario = dumps(run.scenario, indent=1).encode()
         labels = {str(k): encode_metadata_value(v) for k, v in run.labels.items()}
+        operating = {k: encode_metadata_value(v) for k, v in run.operating.as_dict().items()}
         check = (
-            {"name": str(run.check.get("name", "")), "phases": dumps(run.check.get("phases", []))}
-            if run.check
+            {"name": run.check.name, "phases": dumps(run.check.as_record()["phases"])}
+            if run.check is not None
             else None
         )
     except (TypeError, ValueError) as exc:
@@ -209,6 +211,7 @@ def write_mcap(
             schema_id = writer.add_schema(CHECK_PHASE_SCHEMA_NAME, "jsonschema", schema)
             phase_id = writer.add_channel(TOPIC_CHECK_PHASE, "json", schema_id)
         writer.add_metadata(LABELS_METADATA, labels)
+        writer.add_metadata(OPERATING_METADATA, operating)
         writer.add_metadata(INFO_METADATA, info)
         if check is not None:
             writer.add_metadata(CHECK_METADATA, check)

@@ -262,7 +262,8 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         truth=truth,
         # the controller commands the check's phases: which one each sample is in is known
         check_phase=None if profile.check is None else profile.check.phase_at(time),
-        check={} if profile.check is None else profile.check.as_record(),
+        check=None if profile.check is None else profile.check.recorded(),
+        operating=scenario.operating_point(),
     )
 
 

@@ -68,7 +68,7 @@ def _body(run: Run, **extra) -> dict:
     return {
         "sample_rate": run.sample_rate,
         "channels": {k: v.tolist() for k, v in run.channels.items()},
-        "gear_ratio": run.labels.get("gear_ratio", 1.0),
+        "gear_ratio": run.operating.gear_ratio,
         **extra,
     }
 
@@ -443,7 +443,10 @@ def test_upload_with_non_numeric_channel(client, tmp_path):
     pq.write_table(pa.table({"time": [0.0, 1.0], "nut_axial_accel": ["a", "b"]}), path)
     r = client.post("/v1/diagnose/file", files={"file": ("text.parquet", path.read_bytes())})
     assert r.status_code == 422
-    assert r.json()["error"].startswith("text.parquet: not a readable recording")
+    # the Parquet reader checks the column types as the Arrow reader does (io.columns)
+    assert r.json()["error"] == (
+        "text.parquet: column 'nut_axial_accel' has type string; numbers expected"
+    )
 
 
 def test_upload_sample_limit(small_server, recording, tmp_path):

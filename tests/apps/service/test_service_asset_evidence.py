@@ -60,7 +60,7 @@ def _body(run: Run, **extra) -> dict:
     return {
         "sample_rate": run.sample_rate,
         "channels": {k: v.tolist() for k, v in run.channels.items()},
-        "gear_ratio": run.labels.get("gear_ratio", 1.0),
+        "gear_ratio": run.operating.gear_ratio,
         **extra,
     }
 

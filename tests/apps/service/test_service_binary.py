@@ -91,7 +91,7 @@ def _json_body(run) -> bytes:
         {
             "sample_rate": run.sample_rate,
             "channels": {k: v.tolist() for k, v in run.channels.items()},
-            "gear_ratio": run.labels["gear_ratio"],
+            "gear_ratio": run.operating.gear_ratio,
         }
     ).encode()
 

@@ -9,6 +9,7 @@ The main path runs against real uvicorn servers on 127.0.0.1, stopped and restar
 same database file; error answers use in-process ASGI calls.
 """
 
+import dataclasses
 import json
 import math
 import os
@@ -31,6 +32,7 @@ from live_server import LiveServer
 from prsm_health import prognostics
 from prsm_health.apps.cli import main
 from prsm_health.apps.service import HistoryStore, create_app
+from prsm_health.apps.service.schemas import Prognosis as PrognosisSchema
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import load_bundle
 from prsm_health.io.arrow import write_run_arrow
@@ -272,6 +274,9 @@ def test_prognosis_of_30_stored_diagnoses_survives_a_restart(
         physics_first = physics.json()
         assert physics_first["model"]["name"] == "physics"
         assert physics_first == json.loads(json.dumps(prognose(table, model, "physics").as_dict()))
+        # every method's answer is what the schema generated from the declaration says
+        for answer in (first, similarity.json(), physics_first):
+            assert PrognosisSchema.model_validate(answer).model_dump() == answer
 
         # real diagnoses, posted with operating hours as JSON and as binary bodies
         body = {
@@ -459,12 +464,14 @@ def test_openapi_documents_the_route(app):
     ref = op["responses"]["200"]["content"]["application/json"]["schema"]["$ref"]
     assert ref == "#/components/schemas/Prognosis"
     schemas = doc["components"]["schemas"]
-    assert set(schemas["Prognosis"]["properties"]) == {
-        "rul_hours",
-        "health_indicator",
-        "model",
-        "warnings",
-    }
+    # generated from the library's declaration: its fields, with their meanings
+    declared = {f.name: f for f in dataclasses.fields(prognostics.Prognosis)}
+    properties = schemas["Prognosis"]["properties"]
+    assert (
+        set(properties) == set(declared) == {"rul_hours", "health_indicator", "model", "warnings"}
+    )
+    for name, f in declared.items():
+        assert properties[name]["description"] == f.metadata["description"]
     assert "operating_hours" in schemas["DiagnoseRequest"]["properties"]
     assert "operating_hours" in schemas["HistoryEntry"]["properties"]
     diagnose = doc["paths"]["/v1/diagnose"]["post"]

@@ -748,7 +748,7 @@ def test_write_diagnosis_mcap(tmp_path, mcap_file, run):
         assert [t for t, _ in got] == [w.end_ns for w in windows]
         assert got[1][1]["indicators"] == {"rms": None, "kurtosis": 4.0}  # NaN → null
         assert got[1][1]["clearance"]["upper"] == 2e-5
-        assert {m.name for m in reader.iter_metadata()} == {"labels", "prsm_health"}
+        assert {m.name for m in reader.iter_metadata()} == {"labels", "operating", "prsm_health"}
         assert [a.name for a in reader.iter_attachments()] == ["scenario.json"]
         count = sum(1 for _ in reader.iter_messages(topics=[TOPIC_NUT_ACCEL, TOPIC_DRIVE]))
         assert count == 2 * len(run)
