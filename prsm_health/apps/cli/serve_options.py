@@ -44,8 +44,8 @@ def add_serve_command(command) -> None:
         "--max-window",
         type=finite_float,
         default=None,
-        help="longest recording of POST /v1/diagnose [s] (default: 2.5, the longest built-in "
-        "health check rounded up to the half second)",
+        default_text="2.5: the longest built-in health check, rounded up to the half second",
+        help="longest recording of POST /v1/diagnose [s]",
     )
     v.add_argument(
         "--log-level",
