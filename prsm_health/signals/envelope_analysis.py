@@ -121,28 +121,61 @@ def spectral_kurtosis(x: np.ndarray, rate: float) -> dict[int, tuple]:
 
 def _best_band(levels: dict, rate: float, low: float, n: int) -> dict:
     """The (window length, frequency) of largest SK above its noise threshold, of one row."""
-    best = (-math.inf, None, None)
-    threshold = math.inf
+    levels = {n_w: (f, sk[None], frames) for n_w, (f, sk, frames) in levels.items()}
+    best = _best_bands(levels, rate, np.array([low], float), n)[0]
+    if isinstance(best, PRSMHealthError):
+        raise best
+    return best
+
+
+def _best_bands(levels: dict, rate: float, lows: np.ndarray, n: int) -> list:
+    """:func:`_best_band` of every row of the SK arrays (rows, bins) of ``levels``, each above
+    its own lowest edge ``lows`` (rows,): level by level for all rows at once. A row where no
+    band fits gets the :class:`PRSMHealthError` instead."""
+    rows = len(lows)
+    score = np.full(rows, -math.inf)  # the best SK so far, above its threshold
+    sk_best = np.full(rows, -math.inf)
+    threshold = np.full(rows, math.inf)
+    edges = np.full((rows, 2), np.nan)
+    window = np.zeros(rows, int)
+    found = np.zeros(rows, bool)
     for n_w, (f, sk, frames) in levels.items():
         half_width = rate / n_w  # Hann main lobe: ±f_s/N_w
-        usable = (f - half_width >= low) & (f + half_width <= 0.45 * rate)
-        if usable.any():
-            k = np.flatnonzero(usable)[np.argmax(sk[usable])]
-            level_threshold = SK_THRESHOLD_SIGMAS * 2.0 / math.sqrt(frames)
-            if sk[k] - level_threshold > best[0] - threshold:
-                best = (float(sk[k]), (float(f[k] - half_width), float(f[k] + half_width)), n_w)
-                threshold = level_threshold
-    if best[1] is None:
-        raise PRSMHealthError(
-            f"no kurtogram band above {low:g} Hz fits below 0.45 × {rate:g} Hz in {n} samples"
+        usable = ((f - half_width)[None, :] >= lows[:, None]) & (f + half_width <= 0.45 * rate)
+        some = usable.any(axis=1)
+        if not some.any():
+            continue
+        k = np.argmax(np.where(usable, sk, -math.inf), axis=1)
+        level_threshold = SK_THRESHOLD_SIGMAS * 2.0 / math.sqrt(frames)
+        value = sk[np.arange(rows), k]
+        better = some & (value - level_threshold > score)
+        score = np.where(better, value - level_threshold, score)
+        sk_best = np.where(better, value, sk_best)
+        threshold = np.where(better, level_threshold, threshold)
+        edges[better, 0] = f[k[better]] - half_width
+        edges[better, 1] = f[k[better]] + half_width
+        window[better] = n_w
+        found |= better
+    out = []
+    for i in range(rows):
+        if not found[i]:
+            out.append(
+                PRSMHealthError(
+                    f"no kurtogram band above {lows[i]:g} Hz fits below 0.45 × {rate:g} Hz "
+                    f"in {n} samples"
+                )
+            )
+            continue
+        out.append(
+            {
+                "band": (float(edges[i, 0]), float(edges[i, 1])),
+                "sk": float(sk_best[i]),
+                "impulsive": bool(sk_best[i] > threshold[i]),
+                "threshold": float(threshold[i]),
+                "window": int(window[i]),
+            }
         )
-    return {
-        "band": best[1],
-        "sk": best[0],
-        "impulsive": best[0] > threshold,
-        "threshold": threshold,
-        "window": best[2],
-    }
+    return out
 
 
 def envelope_amplitude_spectrum(
@@ -258,20 +291,15 @@ def defect_lines_batch(
     where no kurtogram band fits gets the :class:`PRSMHealthError` instead of a result."""
     results: list = [None] * len(x)
     if bands is None:
-        levels = spectral_kurtosis(x, rate)
-        bands = []
-        for i, row_frequencies in enumerate(frequencies):
+        lows = []
+        for row_frequencies in frequencies:
             finite = [f for f in row_frequencies.values() if math.isfinite(f) and f > 0]
-            low = max(3.0 * max(finite, default=0.0), 0.02 * rate)
-            try:
-                best = _best_band(
-                    {n_w: (f, sk[i], k) for n_w, (f, sk, k) in levels.items()},
-                    rate,
-                    low,
-                    x.shape[-1],
-                )
-            except PRSMHealthError as error:
-                results[i] = error
+            lows.append(max(3.0 * max(finite, default=0.0), 0.02 * rate))
+        found = _best_bands(spectral_kurtosis(x, rate), rate, np.array(lows, float), x.shape[-1])
+        bands = []
+        for i, best in enumerate(found):
+            if isinstance(best, PRSMHealthError):
+                results[i] = best
                 bands.append(None)
                 continue
             results[i] = {"band": best["band"], "sk": best["sk"], "impulsive": best["impulsive"]}

@@ -228,8 +228,9 @@ def axial_baseline_frequency(design: PRSMDesign, load: float) -> float:
     return math.sqrt(k / design.masses.nut_mass) / (2 * math.pi)
 
 
-def _classic(centred: np.ndarray, rate: float) -> dict[str, np.ndarray]:
-    """Classic indicators of mean-removed signals (..., n): name suffix → array (...)."""
+def _classic(centred: np.ndarray, rate: float) -> tuple[dict[str, np.ndarray], tuple]:
+    """Classic indicators of mean-removed signals (..., n): name suffix → array (...), and the
+    Welch spectra their bands integrate: (frequencies, PSD (..., bins), segment length)."""
     # moments about the mean, biased (scipy.stats.kurtosis(fisher=False) and skew): the sums
     # of x², x³, x⁴ and the extremes in one compiled pass (numpy made five over the batch)
     sums = np.empty(centred.shape[:-1] + (5,))
@@ -254,7 +255,7 @@ def _classic(centred: np.ndarray, rate: float) -> dict[str, np.ndarray]:
         out[f"band_{int(lo)}_{int(hi)}"] = (
             np.sum(psd[..., a:b], axis=-1) * df if b > a else np.full(psd.shape[:-1], np.nan)
         )
-    return out
+    return out, (f, psd, nperseg)
 
 
 def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
@@ -462,7 +463,9 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
         stacked = np.stack([[run.channels[name] for run in runs] for name in vibration])
         stacked = stacked - np.mean(stacked, axis=-1, keepdims=True)
         centred = dict(zip(vibration, stacked))
-        for suffix, values in _classic(stacked, rate).items():
+        classic, (f, psd, nperseg) = _classic(stacked, rate)
+        welch = {name: (f, psd[c], nperseg) for c, name in enumerate(vibration)}
+        for suffix, values in classic.items():
             for c, name in enumerate(vibration):
                 for row, value in zip(rows, values[c]):
                     row[f"{SHORT[name]}_{suffix}"] = float(value)
@@ -479,7 +482,7 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
         _envelope(runs, rows, design)
     # ---- shifted axial frequency
     if "nut_axial_accel" in centred:
-        _axial(centred["nut_axial_accel"], rate, design, rows)
+        _axial(centred["nut_axial_accel"], rate, design, rows, welch["nut_axial_accel"])
     # nut travel per screw radian: the design's kinematics, or the rig's lead
     nut_per_rad = ratios.nut if ratios is not None else (lead / (2 * math.pi) if lead else None)
     for run, row in zip(runs, rows):
@@ -554,9 +557,11 @@ def _mesh_lines(freq, amp, base: float, side: float, prefix: str, out: dict) -> 
     )
 
 
-def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
+def _axial(centred: np.ndarray, rate: float, design, rows, welch: tuple) -> None:
     """Dominant nut axial frequency and its shift from the healthy baseline, every window's
-    Welch spectrum in one call; the contact mode (:mod:`prsm_health.signals.axial_mode`)."""
+    Welch spectrum in one call; the contact mode (:mod:`prsm_health.signals.axial_mode`),
+    from the classic indicators' Welch spectra ``welch`` (frequencies, PSD, segment) when its
+    tracking segment is theirs (1024 samples at 20 kHz: the same spectrum, computed once)."""
     nperseg = min(512, centred.shape[-1])
     f, psds = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
     for psd, out in zip(psds, rows):
@@ -573,9 +578,14 @@ def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
             out["axial_frequency_shift"] = f_dom - f0
             out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
     if design is not None and design.gear is not None:  # paper 01's mode, tracked in its band
-        from .axial_mode import contact_indicators
+        from .axial_mode import contact_indicators, tracking_segment
 
-        for out, values in zip(rows, contact_indicators(centred, rate, design, rows)):
+        f_classic, psd_classic, nperseg = welch
+        shared = nperseg == tracking_segment(centred.shape[-1], rate)
+        spectra = (f_classic, psd_classic) if shared else None
+        for out, values in zip(
+            rows, contact_indicators(centred, rate, design, rows, welch=spectra)
+        ):
             out.update(values)
 
 
@@ -601,7 +611,10 @@ def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> Non
     # load cell is fitted (the motor current reverses with the load it carries)
     torque = ch.get("drive_torque")
     # the motor torque averaged over 5 ms: current noise and ripple out, load reversals kept
-    slow_torque = None if torque is None else uniform_filter1d(torque, max(1, int(0.005 * rate)))
+    # (read only without a load cell)
+    slow_torque = None
+    if load is None and torque is not None:
+        slow_torque = uniform_filter1d(torque, max(1, int(0.005 * rate)))
     reversal = (
         (speed is not None and np.min(speed) < 0 < np.max(speed))
         or (load is not None and np.min(load) < 0 < np.max(load))
