@@ -53,6 +53,9 @@ KURTOGRAM_WINDOWS = (16, 32, 64, 128, 256)
 SK_THRESHOLD_SIGMAS = 5.0
 #: Harmonics summed by the ``_sum`` indicators.
 HARMONICS = 3
+#: Rows band-passed, enveloped and transformed per call (8 rows of a 0.5 s window at 20 kHz
+#: are 0.6 MB an array: measured 25–30 % faster than row by row and than 40 rows at once).
+ENVELOPE_ROWS = 8
 
 
 def _check(x: np.ndarray, rate: float) -> np.ndarray:
@@ -198,9 +201,11 @@ def envelope_amplitude_spectra(
             )
     freq = np.fft.rfftfreq(x.shape[-1], 1.0 / rate)
     amp = np.empty((len(x), len(freq)))
-    # row by row: one row's envelope and spectrum stay in the cache, a batch's do not
-    for i, band in enumerate(bands):
-        amp[i] = amplitude_spectrum(band_envelope(x[i : i + 1], rate, [band]), rate)[1]
+    # a few rows per call: their envelopes and spectra stay in the cache, a whole batch's do
+    # not, and row by row the calls cost more than the arithmetic
+    for i in range(0, len(x), ENVELOPE_ROWS):
+        rows = slice(i, i + ENVELOPE_ROWS)
+        amp[rows] = amplitude_spectrum(band_envelope(x[rows], rate, bands[rows]), rate)[1]
     return freq, amp
 
 

@@ -78,8 +78,8 @@ def welch_stacked(parts) -> None:
         signal.welch(stacked, fs=p.sample_rate, nperseg=NPERSEG, noverlap=3 * NPERSEG // 4)
 
 
-def summary(values) -> str:
-    return f"{statistics.median(values):.1f} ({min(values):.1f} – {max(values):.1f})"
+def summary(values, digits: int = 1) -> str:
+    return f"{statistics.median(values):.{digits}f} ({min(values):.{digits}f} – {max(values):.{digits}f})"
 
 
 def main() -> None:
@@ -123,7 +123,7 @@ def main() -> None:
     def rate(name, length=seconds):
         return [length / t for t in times[name]]
 
-    def ratio(name, floor):
+    def ratio(name, floor):  # of the same round
         return [f / t for f, t in zip(times[floor], times[name])]
 
     print(
@@ -145,17 +145,17 @@ def main() -> None:
         ("streaming", "indicators + model window by window (streaming)"),
     ):
         print(
-            f"| {words} | {summary(rate(name))} | {summary(ratio(name, 'welch'))} "
-            f"| {summary(ratio(name, 'welch stacked'))} |"
+            f"| {words} | {summary(rate(name))} | {summary(ratio(name, 'welch'), 2)} "
+            f"| {summary(ratio(name, 'welch stacked'), 2)} |"
         )
     print(
         f"| `diagnose` of the health check (phase by phase) | "
         f"{summary(rate('check diagnose', check_seconds))} | "
-        f"{summary(ratio('check diagnose', 'check welch'))} | "
-        f"{summary(ratio('check diagnose', 'check welch stacked'))} |"
+        f"{summary(ratio('check diagnose', 'check welch'), 2)} | "
+        f"{summary(ratio('check diagnose', 'check welch stacked'), 2)} |"
     )
     ms = [1e3 * t / len(parts) for t in times["model"]]
-    print(f"\nmodel alone: {summary(ms)} ms per window in a batch of {len(parts)}")
+    print(f"\nmodel alone: {summary(ms, 2)} ms per window in a batch of {len(parts)}")
     check_ms = [1e3 * t for t in times["check diagnose"]]
     print(f"health check: {summary(check_ms)} ms per diagnosis")
 
