@@ -258,15 +258,19 @@ def _classic(centred: np.ndarray, rate: float) -> tuple[dict[str, np.ndarray], t
     return out, (f, psd, nperseg)
 
 
-def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
-    # Largest amplitude within ±max(2 bins, 0.5 %) of the target: the line may fall between
-    # bins and the speed estimate carries its own error.
-    if not np.isfinite(target) or target <= 0 or target >= freq[-1]:
-        return np.nan
-    half = max(2 * (freq[1] - freq[0]), 0.005 * target)
+def _lines(freq: np.ndarray, amp: np.ndarray, targets: np.ndarray) -> np.ndarray:
+    """The largest amplitude within ±max(2 bins, 0.5 %) of each target [Hz] (the line may fall
+    between bins and the speed estimate carries its own error): ``amp`` (spectra, bins) and
+    ``targets`` (spectra, lines) → (spectra, lines); NaN for a target outside (0, freq[-1])."""
+    valid = np.isfinite(targets) & (targets > 0) & (targets < freq[-1])
+    target = np.where(valid, targets, 0.0)
+    half = np.maximum(2 * (freq[1] - freq[0]), 0.005 * target)
     a = np.searchsorted(freq, target - half, side="left")
     b = np.searchsorted(freq, target + half, side="right")
-    return float(np.max(amp[a:b])) if b > a else np.nan
+    out = np.full(targets.shape, np.nan)
+    for i, k in zip(*np.nonzero(valid & (b > a))):
+        out[i, k] = amp[i, a[i, k] : b[i, k]].max()
+    return out
 
 
 def _order_resample(x: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, float]:
@@ -539,22 +543,27 @@ def _mesh(runs, rows, design, ratios, centred: dict) -> None:
                     x, d_angle = _order_resample(ch[name], ch["screw_angle"])
                     orders, amp = amplitude_spectrum(x, 1.0 / d_angle)
                     per_rad = abs(ratios.carrier) / (2 * math.pi)
-                    _mesh_lines(orders, amp, z * per_rad, per_rad, SHORT[name], row)
+                    _mesh_lines(orders, amp[None], [z * per_rad], [per_rad], SHORT[name], [row])
         else:
             steady.append((w, f_c))
     for name in MESH_CHANNELS:
         if name in centred and steady:
             freq, amp = amplitude_spectrum(centred[name][[w for w, _ in steady]], rate)
-            for (w, f_c), spectrum in zip(steady, amp):
-                _mesh_lines(freq, spectrum, z * f_c, f_c, SHORT[name], rows[w])
+            f_c = [f for _, f in steady]
+            found = [rows[w] for w, _ in steady]
+            _mesh_lines(freq, amp, [z * f for f in f_c], f_c, SHORT[name], found)
 
 
-def _mesh_lines(freq, amp, base: float, side: float, prefix: str, out: dict) -> None:
-    for k in (1, 2, 3):
-        out[f"{prefix}_mesh_h{k}"] = _line(freq, amp, k * base)
-    out[f"{prefix}_mesh_sidebands"] = np.nansum(
-        [_line(freq, amp, base - side), _line(freq, amp, base + side)]
-    )
+def _mesh_lines(freq, amp, bases, sides, prefix: str, rows: list[dict]) -> None:
+    """The mesh harmonics and sidebands of each spectrum of ``amp`` (spectra, bins) at its
+    mesh frequency ``bases`` and sideband spacing ``sides``, into its row."""
+    base, side = np.asarray(bases, float)[:, None], np.asarray(sides, float)[:, None]
+    lines = _lines(freq, amp, np.hstack([base * np.arange(1, 4), base - side, base + side]))
+    sidebands = np.nansum(lines[:, 3:], axis=1)
+    for out, harmonics, sideband in zip(rows, lines, sidebands):
+        for k in (1, 2, 3):
+            out[f"{prefix}_mesh_h{k}"] = float(harmonics[k - 1])
+        out[f"{prefix}_mesh_sidebands"] = float(sideband)
 
 
 def _axial(centred: np.ndarray, rate: float, design, rows, welch: tuple) -> None:
