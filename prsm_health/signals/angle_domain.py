@@ -226,6 +226,14 @@ class AngleRecord:
             out = _resample(out, 1, m)
         return out.reshape(x.shape[:-1] + (out.shape[-1],)), n_periods
 
+    def synchronous_average(
+        self, period: float, samples_per_period: int, *, antialias: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`time_synchronous_average` of the record over ``period``."""
+        resampled, n = self.resample(period, samples_per_period, antialias=antialias)
+        periods = resampled.reshape(resampled.shape[:-1] + (n, samples_per_period))
+        return (periods.mean(axis=-2) if n else resampled), periods
+
 
 def _resample(x: np.ndarray, up: int, down: int) -> np.ndarray:
     """``scipy.signal.resample_poly(x, up, down, axis=-1, padtype="line")`` with its default
@@ -264,13 +272,7 @@ def time_synchronous_average(
     McFadden 1987; Bechhoefer & Kingsley 2009 (each period resampled to a fixed count).
     """
     record = AngleRecord(x, angle, upsampling)
-    return _time_synchronous_average(record, period, samples_per_period, antialias)
-
-
-def _time_synchronous_average(record: AngleRecord, period, samples_per_period, antialias):
-    resampled, n = record.resample(period, samples_per_period, antialias=antialias)
-    periods = resampled.reshape(resampled.shape[:-1] + (n, samples_per_period))
-    return (periods.mean(axis=-2) if n else resampled), periods
+    return record.synchronous_average(period, samples_per_period, antialias=antialias)
 
 
 def default_samples_per_period(angle: np.ndarray, period: float) -> int:
@@ -445,7 +447,7 @@ def synchronous_average_periods(
         count = samples_per_period
         if count is None:
             count = default_samples_per_period(angle, period)
-        average, rows = _time_synchronous_average(record, period, count, antialias)
+        average, rows = record.synchronous_average(period, count, antialias=antialias)
         if rows.shape[-2] == 0:
             average = np.full(record.x.shape[:-1] + (count,), math.nan)
         out[name] = SynchronousAverage(average, rows, float(period))

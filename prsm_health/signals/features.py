@@ -685,16 +685,16 @@ def _gear(runs, design: PRSMDesign, ratios, rows) -> None:
     present = [name for name in TSA_CHANNELS if name in runs[0].channels]
     if not present:
         return
-    for period, (ratio, teeth) in periods.items():
-        by_count: dict[int, list] = {}  # periods averaged → [(window, TSAs of its channels)]
-        for w, run in enumerate(runs):
-            x = np.stack([run.channels[name] for name in present])
-            averages = synchronous_averages(
-                x, run.channels["screw_angle"], 2 * math.pi / abs(ratio)
-            )
-            if averages is not None:
-                by_count.setdefault(averages[1], []).append((w, averages[0]))
-        for count, found in by_count.items():
+    # periods averaged → [(window, TSAs of its channels)], per period
+    by_count: dict[str, dict[int, list]] = {period: {} for period in periods}
+    angles = [2 * math.pi / abs(ratio) for ratio, _ in periods.values()]
+    for w, run in enumerate(runs):
+        x = np.stack([run.channels[name] for name in present])
+        averages = synchronous_averages(x, run.channels["screw_angle"], angles)
+        for period, (tsa, count) in zip(periods, averages or ()):
+            by_count[period].setdefault(count, []).append((w, tsa))
+    for period, (_, teeth) in periods.items():
+        for count, found in by_count[period].items():
             values = tsa_indicators(np.concatenate([tsa for _, tsa in found]), count, teeth)
             for k, (w, name) in enumerate((w, name) for w, _ in found for name in present):
                 for key in TSA_INDICATORS:
