@@ -72,6 +72,7 @@ from .angle_domain import (
 )
 from .features import extract_features, run_design
 from .lost_motion import lost_motion_step
+from .percentiles import percentiles
 from .spectra import bandpass_rows, hilbert_envelope, welch_psd
 
 #: The roles a check's phases are found for, in order.
@@ -235,7 +236,8 @@ def _measured_motion(speed: np.ndarray | None) -> str | None:
         return "rest"
     # both signs reached by a tenth of the range or more: a reversal, not noise about a mean
     margin = 0.1 * float(np.ptp(speed))
-    if float(np.percentile(speed, 2)) < -margin and float(np.percentile(speed, 98)) > margin:
+    low, high = percentiles(speed, [2, 98])
+    if float(low) < -margin and float(high) > margin:
         return "reversing"
     return "constant"
 

@@ -52,6 +52,7 @@ from .envelope_analysis import defect_lines_batch
 from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
 from .kernels import hysteresis_crossings, moment_sums, screw_power_sums
 from .lost_motion import lost_motion_spread
+from .percentiles import percentiles
 from .spectra import amplitude_spectrum, peak_frequency, welch_psd
 
 SHORT = {
@@ -705,7 +706,8 @@ def _reverses(x: np.ndarray) -> bool:
     # A sign change beyond the noise: both signs reached by a tenth of the range or more (of a
     # smoothed signal: a steady run's noise around a small mean must not count).
     margin = 0.1 * float(np.ptp(x))
-    return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
+    low, high = percentiles(x, [2, 98])
+    return float(low) < -margin and float(high) > margin
 
 
 def _gear_ratio(run: Run) -> float:
@@ -747,7 +749,7 @@ def _rattle_rate(torque: np.ndarray, rate: float) -> float:
     bounce. More clearance, faster impacts, more bounces (docs/validation.md, clearance-
     signature map). The hysteresis (10 % of the 5–95 % range) keeps sensor noise from counting.
     """
-    lo, hi = np.percentile(torque, [5, 95])
+    lo, hi = percentiles(torque, [5, 95])
     mid, band = 0.5 * (lo + hi), 0.1 * (hi - lo)
     crossings = hysteresis_crossings(np.ascontiguousarray(torque, float), mid - band, mid + band)
     return crossings / (len(torque) / rate)
