@@ -466,7 +466,7 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
     centred = {}
     if vibration:
         stacked = np.stack([[run.channels[name] for run in runs] for name in vibration])
-        stacked = stacked - np.mean(stacked, axis=-1, keepdims=True)
+        stacked -= np.mean(stacked, axis=-1, keepdims=True)  # a fresh copy: centred in place
         centred = dict(zip(vibration, stacked))
         classic, (f, psd, nperseg) = _classic(stacked, rate)
         welch = {name: (f, psd[c], nperseg) for c, name in enumerate(vibration)}
