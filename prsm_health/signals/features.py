@@ -208,7 +208,7 @@ def indicator_groups(row: dict, channels) -> dict[str, str]:
     out = {}
     for group, members in GROUPS.items():
         values = [row.get(name) for name in members]
-        if any(v is not None and np.isfinite(v) for v in values):
+        if any(v is not None and math.isfinite(v) for v in values):
             out[group] = "computed"
         elif missing := GROUP_CHANNELS[group].missing(channels):
             out[group] = "missing channel(s) " + ", ".join(missing)
