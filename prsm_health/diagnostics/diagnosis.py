@@ -490,7 +490,7 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         fault_class=fault_class,
         class_probabilities=probs,
         class_set=class_set,
-        indicators={n: median([d.indicators[n] for d in diagnoses]) for n in names},
+        indicators=_median_indicators(diagnoses, list(names)),
         model=bundle.model_reference(),
         windows=list(diagnoses),
         warnings=notes,
@@ -504,6 +504,19 @@ def aggregate(diagnoses: list[Diagnosis], bundle: ModelBundle) -> Diagnosis:
         indicator_groups=groups,
         undecided=_undecided(fault_class, class_set, bool(told), conditions, bundle),
     )
+
+
+def _median_indicators(diagnoses: list[Diagnosis], names: list[str]) -> dict:
+    """Each indicator's median over the windows that have it (None where none has), as
+    ``np.median`` of those values gives it, all indicators at once: sorted per column, the
+    middle value or the mean of the two middle ones."""
+    table = np.array([[d.indicators[n] for n in names] for d in diagnoses], dtype=float)
+    count = np.sum(~np.isnan(table), axis=0)  # None became NaN; a value is never NaN
+    ordered = np.sort(table, axis=0)  # NaN last
+    columns = np.arange(len(names))
+    upper, lower = ordered[count // 2, columns], ordered[np.maximum(count - 1, 0) // 2, columns]
+    middle = np.where(count % 2 == 1, upper, (lower + upper) / 2.0)
+    return {n: (float(m) if k else None) for n, m, k in zip(names, middle, count)}
 
 
 def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:

@@ -843,26 +843,20 @@ class DistributionGuard(BaseEstimator):
     def _scaled(self, X) -> np.ndarray:
         return ((X - self.center_) / self.scale_).astype(np.float32)
 
-    def _raw(self, Z: np.ndarray, leave_out_self: bool = False, chunk: int = 64) -> np.ndarray:
-        ref = self.reference_
-        ref_ok = np.isfinite(ref)
-        ref0 = np.where(ref_ok, ref, 0.0)
+    def _raw(self, Z: np.ndarray, leave_out_self: bool = False) -> np.ndarray:
+        """Mean distance of each row of Z (scaled) to its ``n_neighbors`` nearest training
+        rows (itself left out with ``leave_out_self``: Z is then the training rows)."""
+        from ._kernels import neighbour_distances
+
         out = np.empty(len(Z))
-        for start in range(0, len(Z), chunk):
-            z = Z[start : start + chunk]
-            ok = np.isfinite(z)
-            z0 = np.where(ok, z, 0.0)
-            both = ok[:, None, :] & ref_ok[None, :, :]
-            one = ok[:, None, :] ^ ref_ok[None, :, :]
-            diff = np.where(both, z0[:, None, :] - ref0[None, :, :], 0.0)
-            sq = np.sum(diff**2, axis=2) + self.missing_penalty**2 * np.sum(one, axis=2)
-            used = np.maximum(np.sum(both | one, axis=2), 1)
-            d = np.sqrt(sq / used)
-            if leave_out_self:
-                rows = np.arange(start, start + len(z))
-                d[np.arange(len(z)), rows] = np.inf
-            d.sort(axis=1)
-            out[start : start + len(z)] = d[:, : self.n_neighbors].mean(axis=1)
+        neighbour_distances(
+            np.ascontiguousarray(Z, np.float32),
+            np.ascontiguousarray(self.reference_, np.float32),
+            float(self.missing_penalty**2),
+            int(self.n_neighbors),
+            0 if leave_out_self else -1,
+            out,
+        )
         return out
 
     def score(self, X) -> np.ndarray:

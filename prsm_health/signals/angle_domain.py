@@ -62,9 +62,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
-from scipy.signal import resample_poly
+from scipy.signal import firwin, resample_poly
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.physics.kinematics import speed_ratios
@@ -143,49 +144,112 @@ def angle_resample(
     Fyfe & Munck 1997 (resampling at constant angle increments); Bonnardot et al. 2005 §2
     (low-pass in the angle domain).
     """
-    x, angle = np.asarray(x, float), np.asarray(angle, float)
-    if x.shape[-1:] != angle.shape or angle.ndim != 1:
-        raise PRSMHealthError(
-            f"x and angle must be 1-D of one length, got {x.shape}, {angle.shape}"
-        )
-    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(angle))):
-        raise PRSMHealthError("x and angle must be finite")
-    if not (math.isfinite(period) and period > 0):
-        raise PRSMHealthError(f"period = {period!r} must be a positive angle [rad]")
-    if not (isinstance(samples_per_period, (int, np.integer)) and samples_per_period >= 8):
-        raise PRSMHealthError(f"samples_per_period = {samples_per_period!r} must be an integer ≥ 8")
-    if not (isinstance(upsampling, (int, np.integer)) and 1 <= upsampling <= 64):
-        raise PRSMHealthError(f"upsampling = {upsampling!r} must be an integer in 1…64")
-    step = np.diff(angle)
-    direction = np.sign(angle[-1] - angle[0])
-    if direction == 0 or np.any(step * direction <= 0):
-        raise PRSMHealthError("angle must be strictly monotonic (no stop or reversal in a window)")
-    angle = angle * direction
-    n_periods = int((angle[-1] - angle[0]) // period)
-    if n_periods < 1:
-        return np.empty(x.shape[:-1] + (0,)), 0
-    spacing = period / samples_per_period
-    # oversampling that makes the grid at least as fine as the time samples everywhere (the
-    # recorded ones: up-sampling adds no content above their Nyquist)
-    m = 1
-    if antialias:
-        finest = float(np.min(step * direction))
-        m = min(MAX_OVERSAMPLING, max(1, math.ceil(spacing / finest - 1e-9)))
-    if upsampling > 1:
-        # the k-th up-sampled point is at k/upsampling samples; the last ones, past the last
-        # sample, have no angle and are dropped
-        kept = (len(angle) - 1) * upsampling + 1
-        x = resample_poly(x, upsampling, 1, axis=-1, padtype="line")[..., :kept]
-        angle = np.interp(np.arange(kept) / upsampling, np.arange(len(angle)), angle)
-    grid = angle[0] + np.arange(n_periods * samples_per_period * m) * (spacing / m)
-    rows = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
-    out = np.empty((len(rows), len(grid)))
-    interp_rows(grid, angle, rows, out)  # np.interp of every row, bitwise, one walk for all
-    if m > 1:
-        # the anti-alias low-pass at the output grid's Nyquist order, then every m-th point;
-        # "line" padding: the ends see the signal's trend, not a step to zero
-        out = resample_poly(out, 1, m, axis=-1, padtype="line")
-    return out.reshape(x.shape[:-1] + (out.shape[-1],)), n_periods
+    record = AngleRecord(x, angle, upsampling)
+    return record.resample(period, samples_per_period, antialias=antialias)
+
+
+class AngleRecord:
+    """A record on its measured angle, checked once and up-sampled at most once, to be
+    resampled over one period or several (:meth:`resample`, :func:`angle_resample`'s steps):
+    the periods of one signal share its up-sampling, the costliest step.
+
+    Raises
+    ------
+    PRSMHealthError
+        ``x`` and ``angle`` of different lengths or not finite, a bad ``upsampling``, an angle
+        that stops or turns back.
+    """
+
+    def __init__(self, x: np.ndarray, angle: np.ndarray, upsampling: int = 1):
+        x, angle = np.asarray(x, float), np.asarray(angle, float)
+        if x.shape[-1:] != angle.shape or angle.ndim != 1:
+            raise PRSMHealthError(
+                f"x and angle must be 1-D of one length, got {x.shape}, {angle.shape}"
+            )
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(angle))):
+            raise PRSMHealthError("x and angle must be finite")
+        if not (isinstance(upsampling, (int, np.integer)) and 1 <= upsampling <= 64):
+            raise PRSMHealthError(f"upsampling = {upsampling!r} must be an integer in 1…64")
+        step = np.diff(angle)
+        direction = np.sign(angle[-1] - angle[0])
+        if direction == 0 or np.any(step * direction <= 0):
+            raise PRSMHealthError(
+                "angle must be strictly monotonic (no stop or reversal in a window)"
+            )
+        self.x, self.upsampling = x, int(upsampling)
+        self.angle = angle * direction  # increasing
+        self.finest = float(np.min(step * direction))  # the smallest recorded angle step
+        self._fine: tuple[np.ndarray, np.ndarray] | None = None
+
+    def _upsampled(self) -> tuple[np.ndarray, np.ndarray]:
+        """(signal, angle) up-sampled by ``upsampling``, made at the first call."""
+        if self.upsampling == 1:
+            return self.x, self.angle
+        if self._fine is None:
+            # the k-th up-sampled point is at k/upsampling samples; the last ones, past the
+            # last sample, have no angle and are dropped
+            n, up = len(self.angle), self.upsampling
+            kept = (n - 1) * up + 1
+            self._fine = (
+                _resample(self.x, up, 1)[..., :kept],
+                np.interp(np.arange(kept) / up, np.arange(n), self.angle),
+            )
+        return self._fine
+
+    def resample(
+        self, period: float, samples_per_period: int, *, antialias: bool = False
+    ) -> tuple[np.ndarray, int]:
+        """:func:`angle_resample` of the record over ``period``."""
+        if not (math.isfinite(period) and period > 0):
+            raise PRSMHealthError(f"period = {period!r} must be a positive angle [rad]")
+        if not (isinstance(samples_per_period, (int, np.integer)) and samples_per_period >= 8):
+            raise PRSMHealthError(
+                f"samples_per_period = {samples_per_period!r} must be an integer ≥ 8"
+            )
+        n_periods = int((self.angle[-1] - self.angle[0]) // period)
+        if n_periods < 1:
+            return np.empty(self.x.shape[:-1] + (0,)), 0
+        spacing = period / samples_per_period
+        # oversampling that makes the grid at least as fine as the time samples everywhere
+        # (the recorded ones: up-sampling adds no content above their Nyquist)
+        m = 1
+        if antialias:
+            m = min(MAX_OVERSAMPLING, max(1, math.ceil(spacing / self.finest - 1e-9)))
+        x, angle = self._upsampled()
+        grid = angle[0] + np.arange(n_periods * samples_per_period * m) * (spacing / m)
+        rows = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
+        out = np.empty((len(rows), len(grid)))
+        interp_rows(grid, angle, rows, out)  # np.interp of every row, bitwise, one walk for all
+        if m > 1:
+            # the anti-alias low-pass at the output grid's Nyquist order, then every m-th
+            # point; "line" padding: the ends see the signal's trend, not a step to zero
+            out = _resample(out, 1, m)
+        return out.reshape(x.shape[:-1] + (out.shape[-1],)), n_periods
+
+    def synchronous_average(
+        self, period: float, samples_per_period: int, *, antialias: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`time_synchronous_average` of the record over ``period``."""
+        resampled, n = self.resample(period, samples_per_period, antialias=antialias)
+        periods = resampled.reshape(resampled.shape[:-1] + (n, samples_per_period))
+        return (periods.mean(axis=-2) if n else resampled), periods
+
+
+def _resample(x: np.ndarray, up: int, down: int) -> np.ndarray:
+    """``scipy.signal.resample_poly(x, up, down, axis=-1, padtype="line")`` with its default
+    low-pass (Kaiser β = 5) designed once (:func:`_resample_filter`): the same filter and
+    result, without ``firwin`` on every call (it cost more than the filtering)."""
+    return resample_poly(x, up, down, axis=-1, padtype="line", window=_resample_filter(up, down))
+
+
+@lru_cache(maxsize=32)
+def _resample_filter(up: int, down: int) -> np.ndarray:
+    # resample_poly's own design for coprime up, down: 20·max + 1 taps, cut-off at 1/max of
+    # Nyquist (it copies the array it is given)
+    rate = max(up, down)
+    taps = firwin(2 * 10 * rate + 1, 1.0 / rate, window=("kaiser", 5.0))
+    taps.flags.writeable = False
+    return taps
 
 
 def time_synchronous_average(
@@ -207,11 +271,8 @@ def time_synchronous_average(
     ----------
     McFadden 1987; Bechhoefer & Kingsley 2009 (each period resampled to a fixed count).
     """
-    resampled, n = angle_resample(
-        x, angle, period, samples_per_period, antialias=antialias, upsampling=upsampling
-    )
-    periods = resampled.reshape(resampled.shape[:-1] + (n, samples_per_period))
-    return (periods.mean(axis=-2) if n else resampled), periods
+    record = AngleRecord(x, angle, upsampling)
+    return record.synchronous_average(period, samples_per_period, antialias=antialias)
 
 
 def default_samples_per_period(angle: np.ndarray, period: float) -> int:
@@ -357,16 +418,40 @@ def synchronous_average(
     ----------
     McFadden 1987; Bechhoefer & Kingsley 2009; Fyfe & Munck 1997.
     """
-    count = samples_per_period
-    if count is None:
-        count = default_samples_per_period(angle, period)
-    upsampling = UPSAMPLING if upsampling is None else upsampling
-    average, periods = time_synchronous_average(
-        x, angle, period, count, antialias=antialias, upsampling=upsampling
+    found = synchronous_average_periods(
+        x,
+        angle,
+        {"period": period},
+        samples_per_period,
+        antialias=antialias,
+        upsampling=upsampling,
     )
-    if periods.shape[-2] == 0:
-        average = np.full(np.shape(x)[:-1] + (count,), math.nan)
-    return SynchronousAverage(average, periods, float(period))
+    return found["period"]
+
+
+def synchronous_average_periods(
+    x: np.ndarray,
+    angle: np.ndarray,
+    periods: dict[str, float],
+    samples_per_period: int | None = None,
+    *,
+    antialias: bool = True,
+    upsampling: int | None = None,
+) -> dict[str, SynchronousAverage]:
+    """:func:`synchronous_average` of one signal over each of several periods (name → period
+    [rad]): the record checked and up-sampled once for all of them."""
+    upsampling = UPSAMPLING if upsampling is None else upsampling
+    record = AngleRecord(x, angle, upsampling)
+    out = {}
+    for name, period in periods.items():
+        count = samples_per_period
+        if count is None:
+            count = default_samples_per_period(angle, period)
+        average, rows = record.synchronous_average(period, count, antialias=antialias)
+        if rows.shape[-2] == 0:
+            average = np.full(record.x.shape[:-1] + (count,), math.nan)
+        out[name] = SynchronousAverage(average, rows, float(period))
+    return out
 
 
 def evaluate_periodic(average: np.ndarray, angle: np.ndarray, period: float) -> np.ndarray:

@@ -96,6 +96,7 @@ SMOOTHING = 80.0
 PEAK_SHARE = 0.05
 
 
+@lru_cache(maxsize=64)  # every window's reference asks for it; a DriveTrain checks 19 fields
 def _loaded_drive_train(drive_train: DriveTrain | None) -> DriveTrain:
     # Linearised on loaded flanks: the reduction's backlash and the thrust bearing's play closed,
     # as the threads' clearances are. Left open, a light load leaves the reduction inside its
@@ -430,6 +431,12 @@ def duty_band(design: PRSMDesign, drive_train: DriveTrain | None = None) -> tupl
     """
     if drive_train is not None:
         return _duty_band(design, drive_train)
+    return _unknown_duty_band(design)
+
+
+@lru_cache(maxsize=32)
+def _unknown_duty_band(design: PRSMDesign) -> tuple[float, float]:
+    # once per design: its five drive trains cost more than tracking the mode in a window
     default = DriveTrain()
     bands = [
         _duty_band(design, replace(default, payload_mass=m, linkage_stiffness=k))
@@ -525,6 +532,8 @@ def contact_indicators(
     design: PRSMDesign,
     windows: list[dict],
     drive_train: DriveTrain | None = None,
+    *,
+    welch: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> list[dict[str, float]]:
     """The contact-mode indicators of windows of nut axial acceleration.
 
@@ -545,6 +554,10 @@ def contact_indicators(
         (NaN without a load cell).
     drive_train : DriveTrain or None
         The unit's, when known (None: the band covers the drive trains of :func:`duty_band`).
+    welch : (frequencies [Hz], PSD (windows, bins)) or None
+        The Welch spectra of ``x`` at the tracking segment (:func:`tracking_segment`, Hann,
+        75 % overlap, as :func:`prsm_health.signals.spectra.welch_psd` gives them), when the
+        caller has them; None: computed here.
 
     Returns
     -------
@@ -557,7 +570,11 @@ def contact_indicators(
     names = ("axial_contact_frequency", "axial_contact_frequency_shift")
     if design.gear is None or design.variant == "recirculating":
         return [dict.fromkeys(names, np.nan) for _ in windows]
-    tracked = np.atleast_1d(contact_frequency(x, sample_rate, duty_band(design, drive_train)))
+    band = duty_band(design, drive_train)
+    if welch is None:
+        tracked = np.atleast_1d(contact_frequency(x, sample_rate, band))
+    else:
+        tracked = np.atleast_1d(band_mean_frequency(*welch, band))
     out = []
     for value, window in zip(tracked, windows):
         peak = abs(window.get("load_mean", np.nan)) + 0.5 * window.get("load_range", np.nan)

@@ -53,10 +53,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
-from scipy import signal
 
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.design_files import load_design
@@ -69,11 +67,12 @@ from .angle_domain import (
     position_profile,
     prsm_periods,
     subtract_synchronous,
-    synchronous_average,
+    synchronous_average_periods,
 )
 from .features import extract_features, run_design
 from .lost_motion import lost_motion_step
-from .spectra import hilbert_envelope, welch_psd
+from .percentiles import percentiles
+from .spectra import bandpass_rows, hilbert_envelope, welch_psd
 
 #: The roles a check's phases are found for, in order.
 ROLES = ("no_load", "torque_pair", "reversal", "high_load")
@@ -236,7 +235,8 @@ def _measured_motion(speed: np.ndarray | None) -> str | None:
         return "rest"
     # both signs reached by a tenth of the range or more: a reversal, not noise about a mean
     margin = 0.1 * float(np.ptp(speed))
-    if float(np.percentile(speed, 2)) < -margin and float(np.percentile(speed, 98)) > margin:
+    low, high = percentiles(speed, [2, 98])
+    if float(low) < -margin and float(high) > margin:
         return "reversing"
     return "constant"
 
@@ -368,12 +368,6 @@ def spectral_centroid(x: np.ndarray, sample_rate: float, band=CENTROID_BAND) -> 
     return float(np.sum(f[inside] * p[inside]) / total) if total > 0 else math.nan
 
 
-@lru_cache(maxsize=16)
-def _band_sos(low: float, high: float, sample_rate: float) -> np.ndarray:
-    # designed once per band and rate: the design costs more than filtering a phase
-    return signal.butter(4, (low, high), btype="bandpass", fs=sample_rate, output="sos")
-
-
 def impact_band(sample_rate: float) -> tuple[float, float] | None:
     """:data:`IMPACT_BAND` at a sampling rate, its top at most 0.4 of the rate; None when
     less than an octave is left."""
@@ -430,16 +424,18 @@ def _high_load(phase: Run, design: PRSMDesign, gear_ratio: float, out: dict) -> 
     # band first, then the reduction's orders: resampling the broadband signal on the measured
     # angle turns the resolver's angle noise into phase noise of the strong mesh line, which
     # leaks into the band (measured: carrier SNR 0.27 against 0.08 band-first)
-    y = signal.sosfiltfilt(_band_sos(*band, phase.sample_rate), x - np.mean(x))
+    y = bandpass_rows(x[None], phase.sample_rate, [band])[0]  # zero phase, 4th order
     try:
         if gear_ratio > 1:
             y, _ = subtract_synchronous(y, angle, periods["motor"])
-        for name in SNR_PERIODS:
-            out[f"check_highload_snr_{name}"] = synchronous_average(y, angle, periods[name]).snr
+        # each signal up-sampled once for all its periods
+        averages = synchronous_average_periods(y, angle, {k: periods[k] for k in SNR_PERIODS})
+        for name, average in averages.items():
+            out[f"check_highload_snr_{name}"] = average.snr
         envelope = hilbert_envelope(y) ** 2
         envelope -= np.mean(envelope)  # its mean is no periodic content
-        for name in ENVELOPE_PERIODS:
-            average = synchronous_average(envelope, angle, periods[name])
+        wanted = {k: periods[k] for k in ENVELOPE_PERIODS}
+        for name, average in synchronous_average_periods(envelope, angle, wanted).items():
             out[f"check_highload_envelope_snr_{name}"] = average.snr
     except PRSMHealthError as exc:  # the angle stopped or turned back, too short
         return f"no angle domain in the phase: {exc}"

@@ -53,6 +53,9 @@ KURTOGRAM_WINDOWS = (16, 32, 64, 128, 256)
 SK_THRESHOLD_SIGMAS = 5.0
 #: Harmonics summed by the ``_sum`` indicators.
 HARMONICS = 3
+#: Rows band-passed, enveloped and transformed per call (8 rows of a 0.5 s window at 20 kHz
+#: are 0.6 MB an array: measured 25–30 % faster than row by row and than 40 rows at once).
+ENVELOPE_ROWS = 8
 
 
 def _check(x: np.ndarray, rate: float) -> np.ndarray:
@@ -121,28 +124,61 @@ def spectral_kurtosis(x: np.ndarray, rate: float) -> dict[int, tuple]:
 
 def _best_band(levels: dict, rate: float, low: float, n: int) -> dict:
     """The (window length, frequency) of largest SK above its noise threshold, of one row."""
-    best = (-math.inf, None, None)
-    threshold = math.inf
+    levels = {n_w: (f, sk[None], frames) for n_w, (f, sk, frames) in levels.items()}
+    best = _best_bands(levels, rate, np.array([low], float), n)[0]
+    if isinstance(best, PRSMHealthError):
+        raise best
+    return best
+
+
+def _best_bands(levels: dict, rate: float, lows: np.ndarray, n: int) -> list:
+    """:func:`_best_band` of every row of the SK arrays (rows, bins) of ``levels``, each above
+    its own lowest edge ``lows`` (rows,): level by level for all rows at once. A row where no
+    band fits gets the :class:`PRSMHealthError` instead."""
+    rows = len(lows)
+    score = np.full(rows, -math.inf)  # the best SK so far, above its threshold
+    sk_best = np.full(rows, -math.inf)
+    threshold = np.full(rows, math.inf)
+    edges = np.full((rows, 2), np.nan)
+    window = np.zeros(rows, int)
+    found = np.zeros(rows, bool)
     for n_w, (f, sk, frames) in levels.items():
         half_width = rate / n_w  # Hann main lobe: ±f_s/N_w
-        usable = (f - half_width >= low) & (f + half_width <= 0.45 * rate)
-        if usable.any():
-            k = np.flatnonzero(usable)[np.argmax(sk[usable])]
-            level_threshold = SK_THRESHOLD_SIGMAS * 2.0 / math.sqrt(frames)
-            if sk[k] - level_threshold > best[0] - threshold:
-                best = (float(sk[k]), (float(f[k] - half_width), float(f[k] + half_width)), n_w)
-                threshold = level_threshold
-    if best[1] is None:
-        raise PRSMHealthError(
-            f"no kurtogram band above {low:g} Hz fits below 0.45 × {rate:g} Hz in {n} samples"
+        usable = ((f - half_width)[None, :] >= lows[:, None]) & (f + half_width <= 0.45 * rate)
+        some = usable.any(axis=1)
+        if not some.any():
+            continue
+        k = np.argmax(np.where(usable, sk, -math.inf), axis=1)
+        level_threshold = SK_THRESHOLD_SIGMAS * 2.0 / math.sqrt(frames)
+        value = sk[np.arange(rows), k]
+        better = some & (value - level_threshold > score)
+        score = np.where(better, value - level_threshold, score)
+        sk_best = np.where(better, value, sk_best)
+        threshold = np.where(better, level_threshold, threshold)
+        edges[better, 0] = f[k[better]] - half_width
+        edges[better, 1] = f[k[better]] + half_width
+        window[better] = n_w
+        found |= better
+    out = []
+    for i in range(rows):
+        if not found[i]:
+            out.append(
+                PRSMHealthError(
+                    f"no kurtogram band above {lows[i]:g} Hz fits below 0.45 × {rate:g} Hz "
+                    f"in {n} samples"
+                )
+            )
+            continue
+        out.append(
+            {
+                "band": (float(edges[i, 0]), float(edges[i, 1])),
+                "sk": float(sk_best[i]),
+                "impulsive": bool(sk_best[i] > threshold[i]),
+                "threshold": float(threshold[i]),
+                "window": int(window[i]),
+            }
         )
-    return {
-        "band": best[1],
-        "sk": best[0],
-        "impulsive": best[0] > threshold,
-        "threshold": threshold,
-        "window": best[2],
-    }
+    return out
 
 
 def envelope_amplitude_spectrum(
@@ -165,9 +201,11 @@ def envelope_amplitude_spectra(
             )
     freq = np.fft.rfftfreq(x.shape[-1], 1.0 / rate)
     amp = np.empty((len(x), len(freq)))
-    # row by row: one row's envelope and spectrum stay in the cache, a batch's do not
-    for i, band in enumerate(bands):
-        amp[i] = amplitude_spectrum(band_envelope(x[i : i + 1], rate, [band]), rate)[1]
+    # a few rows per call: their envelopes and spectra stay in the cache, a whole batch's do
+    # not, and row by row the calls cost more than the arithmetic
+    for i in range(0, len(x), ENVELOPE_ROWS):
+        rows = slice(i, i + ENVELOPE_ROWS)
+        amp[rows] = amplitude_spectrum(band_envelope(x[rows], rate, bands[rows]), rate)[1]
     return freq, amp
 
 
@@ -258,20 +296,15 @@ def defect_lines_batch(
     where no kurtogram band fits gets the :class:`PRSMHealthError` instead of a result."""
     results: list = [None] * len(x)
     if bands is None:
-        levels = spectral_kurtosis(x, rate)
-        bands = []
-        for i, row_frequencies in enumerate(frequencies):
+        lows = []
+        for row_frequencies in frequencies:
             finite = [f for f in row_frequencies.values() if math.isfinite(f) and f > 0]
-            low = max(3.0 * max(finite, default=0.0), 0.02 * rate)
-            try:
-                best = _best_band(
-                    {n_w: (f, sk[i], k) for n_w, (f, sk, k) in levels.items()},
-                    rate,
-                    low,
-                    x.shape[-1],
-                )
-            except PRSMHealthError as error:
-                results[i] = error
+            lows.append(max(3.0 * max(finite, default=0.0), 0.02 * rate))
+        found = _best_bands(spectral_kurtosis(x, rate), rate, np.array(lows, float), x.shape[-1])
+        bands = []
+        for i, best in enumerate(found):
+            if isinstance(best, PRSMHealthError):
+                results[i] = best
                 bands.append(None)
                 continue
             results[i] = {"band": best["band"], "sk": best["sk"], "impulsive": best["impulsive"]}

@@ -53,6 +53,7 @@ from .envelope_analysis import defect_lines_batch
 from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
 from .kernels import hysteresis_crossings, moment_sums, screw_power_sums
 from .lost_motion import lost_motion_spread
+from .percentiles import percentiles
 from .spectra import amplitude_spectrum, peak_frequency, welch_psd
 
 SHORT = {
@@ -206,7 +207,7 @@ def indicator_groups(row: dict, channels) -> dict[str, str]:
     out = {}
     for group, members in GROUPS.items():
         values = [row.get(name) for name in members]
-        if any(v is not None and np.isfinite(v) for v in values):
+        if any(v is not None and math.isfinite(v) for v in values):
             out[group] = "computed"
         elif missing := GROUP_CHANNELS[group].missing(channels):
             out[group] = "missing channel(s) " + ", ".join(missing)
@@ -227,8 +228,9 @@ def axial_baseline_frequency(design: PRSMDesign, load: float) -> float:
     return math.sqrt(k / design.masses.nut_mass) / (2 * math.pi)
 
 
-def _classic(centred: np.ndarray, rate: float) -> dict[str, np.ndarray]:
-    """Classic indicators of mean-removed signals (..., n): name suffix → array (...)."""
+def _classic(centred: np.ndarray, rate: float) -> tuple[dict[str, np.ndarray], tuple]:
+    """Classic indicators of mean-removed signals (..., n): name suffix → array (...), and the
+    Welch spectra their bands integrate: (frequencies, PSD (..., bins), segment length)."""
     # moments about the mean, biased (scipy.stats.kurtosis(fisher=False) and skew): the sums
     # of x², x³, x⁴ and the extremes in one compiled pass (numpy made five over the batch)
     sums = np.empty(centred.shape[:-1] + (5,))
@@ -253,18 +255,22 @@ def _classic(centred: np.ndarray, rate: float) -> dict[str, np.ndarray]:
         out[f"band_{int(lo)}_{int(hi)}"] = (
             np.sum(psd[..., a:b], axis=-1) * df if b > a else np.full(psd.shape[:-1], np.nan)
         )
-    return out
+    return out, (f, psd, nperseg)
 
 
-def _line(freq: np.ndarray, amp: np.ndarray, target: float) -> float:
-    # Largest amplitude within ±max(2 bins, 0.5 %) of the target: the line may fall between
-    # bins and the speed estimate carries its own error.
-    if not np.isfinite(target) or target <= 0 or target >= freq[-1]:
-        return np.nan
-    half = max(2 * (freq[1] - freq[0]), 0.005 * target)
+def _lines(freq: np.ndarray, amp: np.ndarray, targets: np.ndarray) -> np.ndarray:
+    """The largest amplitude within ±max(2 bins, 0.5 %) of each target [Hz] (the line may fall
+    between bins and the speed estimate carries its own error): ``amp`` (spectra, bins) and
+    ``targets`` (spectra, lines) → (spectra, lines); NaN for a target outside (0, freq[-1])."""
+    valid = np.isfinite(targets) & (targets > 0) & (targets < freq[-1])
+    target = np.where(valid, targets, 0.0)
+    half = np.maximum(2 * (freq[1] - freq[0]), 0.005 * target)
     a = np.searchsorted(freq, target - half, side="left")
     b = np.searchsorted(freq, target + half, side="right")
-    return float(np.max(amp[a:b])) if b > a else np.nan
+    out = np.full(targets.shape, np.nan)
+    for i, k in zip(*np.nonzero(valid & (b > a))):
+        out[i, k] = amp[i, a[i, k] : b[i, k]].max()
+    return out
 
 
 def _order_resample(x: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, float]:
@@ -459,9 +465,11 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
     centred = {}
     if vibration:
         stacked = np.stack([[run.channels[name] for run in runs] for name in vibration])
-        stacked = stacked - np.mean(stacked, axis=-1, keepdims=True)
+        stacked -= np.mean(stacked, axis=-1, keepdims=True)  # a fresh copy: centred in place
         centred = dict(zip(vibration, stacked))
-        for suffix, values in _classic(stacked, rate).items():
+        classic, (f, psd, nperseg) = _classic(stacked, rate)
+        welch = {name: (f, psd[c], nperseg) for c, name in enumerate(vibration)}
+        for suffix, values in classic.items():
             for c, name in enumerate(vibration):
                 for row, value in zip(rows, values[c]):
                     row[f"{SHORT[name]}_{suffix}"] = float(value)
@@ -478,7 +486,7 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
         _envelope(runs, rows, design)
     # ---- shifted axial frequency
     if "nut_axial_accel" in centred:
-        _axial(centred["nut_axial_accel"], rate, design, rows)
+        _axial(centred["nut_axial_accel"], rate, design, rows, welch["nut_axial_accel"])
     # nut travel per screw radian: the design's kinematics, or the rig's lead
     nut_per_rad = ratios.nut if ratios is not None else (lead / (2 * math.pi) if lead else None)
     for run, row in zip(runs, rows):
@@ -535,27 +543,34 @@ def _mesh(runs, rows, design, ratios, centred: dict) -> None:
                     x, d_angle = _order_resample(ch[name], ch["screw_angle"])
                     orders, amp = amplitude_spectrum(x, 1.0 / d_angle)
                     per_rad = abs(ratios.carrier) / (2 * math.pi)
-                    _mesh_lines(orders, amp, z * per_rad, per_rad, SHORT[name], row)
+                    _mesh_lines(orders, amp[None], [z * per_rad], [per_rad], SHORT[name], [row])
         else:
             steady.append((w, f_c))
     for name in MESH_CHANNELS:
         if name in centred and steady:
             freq, amp = amplitude_spectrum(centred[name][[w for w, _ in steady]], rate)
-            for (w, f_c), spectrum in zip(steady, amp):
-                _mesh_lines(freq, spectrum, z * f_c, f_c, SHORT[name], rows[w])
+            f_c = [f for _, f in steady]
+            found = [rows[w] for w, _ in steady]
+            _mesh_lines(freq, amp, [z * f for f in f_c], f_c, SHORT[name], found)
 
 
-def _mesh_lines(freq, amp, base: float, side: float, prefix: str, out: dict) -> None:
-    for k in (1, 2, 3):
-        out[f"{prefix}_mesh_h{k}"] = _line(freq, amp, k * base)
-    out[f"{prefix}_mesh_sidebands"] = np.nansum(
-        [_line(freq, amp, base - side), _line(freq, amp, base + side)]
-    )
+def _mesh_lines(freq, amp, bases, sides, prefix: str, rows: list[dict]) -> None:
+    """The mesh harmonics and sidebands of each spectrum of ``amp`` (spectra, bins) at its
+    mesh frequency ``bases`` and sideband spacing ``sides``, into its row."""
+    base, side = np.asarray(bases, float)[:, None], np.asarray(sides, float)[:, None]
+    lines = _lines(freq, amp, np.hstack([base * np.arange(1, 4), base - side, base + side]))
+    sidebands = np.nansum(lines[:, 3:], axis=1)
+    for out, harmonics, sideband in zip(rows, lines, sidebands):
+        for k in (1, 2, 3):
+            out[f"{prefix}_mesh_h{k}"] = float(harmonics[k - 1])
+        out[f"{prefix}_mesh_sidebands"] = float(sideband)
 
 
-def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
+def _axial(centred: np.ndarray, rate: float, design, rows, welch: tuple) -> None:
     """Dominant nut axial frequency and its shift from the healthy baseline, every window's
-    Welch spectrum in one call; the contact mode (:mod:`prsm_health.signals.axial_mode`)."""
+    Welch spectrum in one call; the contact mode (:mod:`prsm_health.signals.axial_mode`),
+    from the classic indicators' Welch spectra ``welch`` (frequencies, PSD, segment) when its
+    tracking segment is theirs (1024 samples at 20 kHz: the same spectrum, computed once)."""
     nperseg = min(512, centred.shape[-1])
     f, psds = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
     for psd, out in zip(psds, rows):
@@ -572,9 +587,14 @@ def _axial(centred: np.ndarray, rate: float, design, rows) -> None:
             out["axial_frequency_shift"] = f_dom - f0
             out["axial_frequency_shift_relative"] = (f_dom - f0) / f0
     if design is not None and design.gear is not None:  # paper 01's mode, tracked in its band
-        from .axial_mode import contact_indicators
+        from .axial_mode import contact_indicators, tracking_segment
 
-        for out, values in zip(rows, contact_indicators(centred, rate, design, rows)):
+        f_classic, psd_classic, nperseg = welch
+        shared = nperseg == tracking_segment(centred.shape[-1], rate)
+        spectra = (f_classic, psd_classic) if shared else None
+        for out, values in zip(
+            rows, contact_indicators(centred, rate, design, rows, welch=spectra)
+        ):
             out.update(values)
 
 
@@ -604,7 +624,10 @@ def _torque_and_reversals(run: Run, nut_per_rad: float | None, out: dict) -> Non
     # load cell is fitted (the motor current reverses with the load it carries)
     torque = ch.get("drive_torque")
     # the motor torque averaged over 5 ms: current noise and ripple out, load reversals kept
-    slow_torque = None if torque is None else uniform_filter1d(torque, max(1, int(0.005 * rate)))
+    # (read only without a load cell)
+    slow_torque = None
+    if load is None and torque is not None:
+        slow_torque = uniform_filter1d(torque, max(1, int(0.005 * rate)))
     reversal = (
         (speed is not None and np.min(speed) < 0 < np.max(speed))
         or (load is not None and np.min(load) < 0 < np.max(load))
@@ -666,16 +689,16 @@ def _gear(runs, design: PRSMDesign, ratios, rows) -> None:
     present = [name for name in TSA_CHANNELS if name in runs[0].channels]
     if not present:
         return
-    for period, (ratio, teeth) in periods.items():
-        by_count: dict[int, list] = {}  # periods averaged → [(window, TSAs of its channels)]
-        for w, run in enumerate(runs):
-            x = np.stack([run.channels[name] for name in present])
-            averages = synchronous_averages(
-                x, run.channels["screw_angle"], 2 * math.pi / abs(ratio)
-            )
-            if averages is not None:
-                by_count.setdefault(averages[1], []).append((w, averages[0]))
-        for count, found in by_count.items():
+    # periods averaged → [(window, TSAs of its channels)], per period
+    by_count: dict[str, dict[int, list]] = {period: {} for period in periods}
+    angles = [2 * math.pi / abs(ratio) for ratio, _ in periods.values()]
+    for w, run in enumerate(runs):
+        x = np.stack([run.channels[name] for name in present])
+        averages = synchronous_averages(x, run.channels["screw_angle"], angles)
+        for period, (tsa, count) in zip(periods, averages or ()):
+            by_count[period].setdefault(count, []).append((w, tsa))
+    for period, (_, teeth) in periods.items():
+        for count, found in by_count[period].items():
             values = tsa_indicators(np.concatenate([tsa for _, tsa in found]), count, teeth)
             for k, (w, name) in enumerate((w, name) for w, _ in found for name in present):
                 for key in TSA_INDICATORS:
@@ -686,7 +709,8 @@ def _reverses(x: np.ndarray) -> bool:
     # A sign change beyond the noise: both signs reached by a tenth of the range or more (of a
     # smoothed signal: a steady run's noise around a small mean must not count).
     margin = 0.1 * float(np.ptp(x))
-    return float(np.percentile(x, 2)) < -margin and float(np.percentile(x, 98)) > margin
+    low, high = percentiles(x, [2, 98])
+    return float(low) < -margin and float(high) > margin
 
 
 def _window_efficiency(torque, speed, load, position, time) -> float:
@@ -716,7 +740,7 @@ def _rattle_rate(torque: np.ndarray, rate: float) -> float:
     bounce. More clearance, faster impacts, more bounces (docs/validation.md, clearance-
     signature map). The hysteresis (10 % of the 5–95 % range) keeps sensor noise from counting.
     """
-    lo, hi = np.percentile(torque, [5, 95])
+    lo, hi = percentiles(torque, [5, 95])
     mid, band = 0.5 * (lo + hi), 0.1 * (hi - lo)
     crossings = hysteresis_crossings(np.ascontiguousarray(torque, float), mid - band, mid + band)
     return crossings / (len(torque) / rate)

@@ -54,6 +54,7 @@ from prsm_health.core.errors import PRSMHealthError
 
 # order tracking and the TSA live in angle_domain (one implementation); re-exported here,
 # where they were first public
+from .angle_domain import AngleRecord
 from .angle_domain import angle_resample as angle_resample
 from .angle_domain import time_synchronous_average as time_synchronous_average
 from .spectra import hilbert_envelope
@@ -245,19 +246,20 @@ def gear_indicators(
     what came before it. ``mesh_order`` None (a period without a gear mesh): only the TSA's RMS
     and the period count.
     """
-    averages = synchronous_averages(x, angle, period, samples_per_period)
+    averages = synchronous_averages(x, angle, [period], samples_per_period)
     if averages is None:
         return dict.fromkeys(GEAR_INDICATORS, math.nan)
-    tsa, n_periods = averages
+    tsa, n_periods = averages[0]
     values = tsa_indicators(tsa[None], n_periods, mesh_order, ensemble)
     return {name: float(values[name][0]) for name in GEAR_INDICATORS}
 
 
 def synchronous_averages(
-    x: np.ndarray, angle: np.ndarray, period: float, samples_per_period: int = 1024
-) -> tuple[np.ndarray, int] | None:
+    x: np.ndarray, angle: np.ndarray, periods, samples_per_period: int = 1024
+) -> list[tuple[np.ndarray, int]] | None:
     """(TSA (..., samples_per_period), periods averaged) of the signals ``x`` (..., n) over
-    ``angle``, or None when the shaft stopped or turned back in the window (no angle domain).
+    ``angle`` for each of ``periods`` [rad] (the record checked once for all), or None when
+    the shaft stopped or turned back in the window (no angle domain).
 
     Raises
     ------
@@ -265,12 +267,13 @@ def synchronous_averages(
         Non-finite input, a bad period.
     """
     try:
-        tsa, periods = time_synchronous_average(x, angle, period, samples_per_period)
+        record = AngleRecord(x, angle)
+        found = [record.synchronous_average(p, samples_per_period) for p in periods]
     except PRSMHealthError:
         if np.all(np.isfinite(angle)) and np.all(np.isfinite(x)):
             return None
         raise
-    return tsa, periods.shape[-2]
+    return [(tsa, rows.shape[-2]) for tsa, rows in found]
 
 
 def tsa_indicators(

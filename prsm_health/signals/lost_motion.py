@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from .kernels import step_polynomial_normal_equations, subtract_polynomial
+from .percentiles import percentiles
 
 
 def lost_motion_spread(
@@ -19,7 +20,7 @@ def lost_motion_spread(
     """Spread (1st–99th percentile) of the nut's lag behind the rigid kinematics [m]
     (:func:`_lag_fit`: the lag with the sensor's nonlinearity and the lead error removed)."""
     residual, _ = _lag_fit(position, angle, lead, side)
-    low, high = np.percentile(residual, [1, 99])
+    low, high = percentiles(residual, [1, 99])
     return float(high - low)
 
 

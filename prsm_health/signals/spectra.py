@@ -55,13 +55,9 @@ def band_envelope(
     x: np.ndarray, sample_rate: float, bands: list[tuple[float, float]], order: int = 4
 ) -> np.ndarray:
     """Envelope of each row of ``x`` in its frequency band: the magnitude of the analytic
-    signal (Hilbert) of the mean-removed row, band-passed by a zero-phase Butterworth.
-
-    The band-pass is ``scipy.signal.sosfiltfilt(sos, row)`` (odd extension of 3·(2·sections
-    + 1) samples, steady-state initial conditions), equal bitwise, by a compiled kernel
-    (:func:`prsm_health.signals.kernels.sosfiltfilt_rows`) with each band's filter and initial
-    conditions designed once; the envelope is ``abs(scipy.signal.hilbert(row))`` from one
-    real FFT pair (:func:`hilbert_envelope`, equal to rounding).
+    signal (Hilbert) of the mean-removed row, band-passed by a zero-phase Butterworth
+    (:func:`bandpass_rows`); the envelope is ``abs(scipy.signal.hilbert(row))`` from one real
+    FFT pair (:func:`hilbert_envelope`, equal to rounding).
 
     Parameters
     ----------
@@ -70,6 +66,30 @@ def band_envelope(
     bands : list of (low, high) [Hz], one per row
     order : int
         Butterworth order of the band-pass.
+
+    Returns
+    -------
+    ndarray (rows, n)
+    """
+    return hilbert_envelope(bandpass_rows(x, sample_rate, bands, order))
+
+
+def bandpass_rows(
+    x: np.ndarray, sample_rate: float, bands: list[tuple[float, float]], order: int = 4
+) -> np.ndarray:
+    """Each row of ``x`` with its mean removed, band-passed in its band by a zero-phase
+    Butterworth of ``order``: ``scipy.signal.sosfiltfilt(butter(order, band, "bandpass",
+    output="sos"), row)`` (odd extension of 3·(2·sections + 1) samples, steady-state initial
+    conditions), equal bitwise, by a compiled kernel
+    (:func:`prsm_health.signals.kernels.sosfiltfilt_rows`) with each band's filter and initial
+    conditions designed once.
+
+    Parameters
+    ----------
+    x : ndarray (rows, n)
+    sample_rate : float [Hz]
+    bands : list of (low, high) [Hz], one per row
+    order : int
 
     Returns
     -------
@@ -87,7 +107,7 @@ def band_envelope(
         )
     filtered = np.empty_like(x)
     sosfiltfilt_rows(x, sos, zi, edge, filtered)
-    return hilbert_envelope(filtered)
+    return filtered
 
 
 def hilbert_envelope(x: np.ndarray, spectrum: np.ndarray | None = None) -> np.ndarray:

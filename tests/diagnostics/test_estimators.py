@@ -557,6 +557,38 @@ def test_distribution_guard_scores_unlike_rows_high():
     assert np.mean(DistributionGuard().fit(with_nan).score(rows) > 1.0) < 0.05
 
 
+def _guard_distances_numpy(guard, z, leave_out_self=False):
+    """The guard's mean neighbour distance as numpy broadcasting computes it (the kernel's
+    oracle): RMS of the differences over the indicators either row has, the penalty for one
+    only one row has, the mean of the n_neighbors smallest."""
+    ref = guard.reference_.astype(np.float64)
+    z = z.astype(np.float64)
+    ok, ref_ok = np.isfinite(z)[:, None, :], np.isfinite(ref)[None, :, :]
+    diff = np.where(ok & ref_ok, np.nan_to_num(z)[:, None, :] - np.nan_to_num(ref)[None], 0.0)
+    sq = np.sum(diff**2, axis=2) + guard.missing_penalty**2 * np.sum(ok ^ ref_ok, axis=2)
+    d = np.sqrt(sq / np.maximum(np.sum(ok | ref_ok, axis=2), 1))
+    if leave_out_self:
+        np.fill_diagonal(d, np.inf)
+    return np.sort(d, axis=1)[:, : guard.n_neighbors].mean(axis=1)
+
+
+@pytest.mark.parametrize("neighbours", [1, 5, 9])
+def test_distribution_guard_kernel_is_the_numpy_distance(neighbours):
+    # float32 differences summed in float32 in the kernel: equal to the float64 formula to the
+    # rounding of a float32 sum of ≤ 12 squares (≈ 1e-7 relative; 1e-5 leaves room)
+    rng = np.random.default_rng(8)
+    train = rng.normal(size=(200, 12))
+    train[rng.random(train.shape) < 0.2] = np.nan
+    train[:, 3] = np.nan
+    guard = DistributionGuard(n_neighbors=neighbours).fit(train)
+    rows = rng.normal(size=(40, 12)) * 3.0
+    rows[rng.random(rows.shape) < 0.3] = np.nan
+    z = guard._scaled(rows)
+    assert guard._raw(z) == pytest.approx(_guard_distances_numpy(guard, z), rel=1e-5)
+    left_out = _guard_distances_numpy(guard, guard.reference_, leave_out_self=True)
+    assert guard._raw(guard.reference_, leave_out_self=True) == pytest.approx(left_out, rel=1e-5)
+
+
 def test_distribution_guard_bad_parameters():
     x = np.zeros((10, 2))
     for params, field in [

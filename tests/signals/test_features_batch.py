@@ -59,7 +59,7 @@ def test_tsa_indicators_of_rows_equal_gear_indicators():
     rng = np.random.default_rng(4)
     angle = np.linspace(0.0, 12 * np.pi, 12_000)
     x = np.sin(20 * angle) * (1 + 0.3 * np.cos(angle)) + 0.1 * rng.standard_normal((2, 12_000))
-    tsa, n_periods = synchronous_averages(x, angle, 2 * np.pi)
+    [(tsa, n_periods)] = synchronous_averages(x, angle, [2 * np.pi])
     rows = tsa_indicators(tsa, n_periods, 20)
     for k in range(2):
         one = gear_indicators(x[k], angle, 2 * np.pi, 20)
