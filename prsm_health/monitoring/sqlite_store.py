@@ -19,8 +19,10 @@ from typing import NamedTuple
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps, json_ready
+from prsm_health.diagnostics.check_verdicts import check_verdicts
 
 from .sqlite_assets import ASSET_SCHEMA, AssetTables, HistoryCache, insert_statement, named_rows
+from .status import asset_status
 
 #: Environment variable overriding the default history database path.
 DB_ENV = "PRSM_HEALTH_DB"
@@ -384,9 +386,11 @@ class HistoryStore(AssetTables):
         (how many of them have operating hours), ``operating_hours`` (the largest sent [h] or
         None), ``first_received_at``, ``last_received_at``, ``latest`` (the latest stored
         diagnosis in brief: receive time, source, file name, window, operating hours,
-        clearance, fault class, class probabilities, warnings, model) and
-        ``spectra_received_at`` (when its stored spectra came, or None); None when nothing
-        is stored for it."""
+        clearance, fault class, class probabilities, warnings, model and, of a health check,
+        ``check``: its phases' verdicts, :func:`~prsm_health.diagnostics.check_verdicts.check_verdicts`),
+        ``spectra_received_at`` (when its stored spectra came, or None), ``baseline``,
+        ``evidence`` and ``status`` (:func:`~.status.asset_status`); None when nothing is
+        stored for it."""
         with self._lock:
             row = self._conn.execute(
                 "SELECT asset_id, COUNT(*), MIN(received_at), MAX(received_at) FROM diagnoses"
@@ -403,7 +407,10 @@ class HistoryStore(AssetTables):
                 " operating_hours, clearance_estimate, clearance_lower, clearance_upper,"
                 " fault_class, class_probabilities,"
                 " json_extract(diagnosis, '$.warnings') AS warnings,"
-                " json_extract(diagnosis, '$.model') AS model FROM diagnoses WHERE asset_id = ?"
+                " json_extract(diagnosis, '$.model') AS model,"
+                # the whole diagnosis of a check only: its phases' verdicts are read from it
+                " CASE WHEN json_extract(diagnosis, '$.check_phases') IS NOT NULL"
+                " THEN diagnosis END AS check_diagnosis FROM diagnoses WHERE asset_id = ?"
                 " ORDER BY received_at DESC, id DESC LIMIT 1",
                 (asset_id,),
             )
@@ -417,6 +424,7 @@ class HistoryStore(AssetTables):
         ).fetchone()
         baseline, evidence = self._asset_state(asset_id)
         warnings, model = latest["warnings"], latest["model"]
+        check = latest["check_diagnosis"]
         return {
             "asset_id": asset_id,
             "diagnoses": count,
@@ -436,10 +444,12 @@ class HistoryStore(AssetTables):
                 "class_probabilities": json.loads(latest["class_probabilities"]),
                 "warnings": json.loads(warnings) if warnings else [],
                 "model": json.loads(model) if model else None,
+                "check": check_verdicts(json.loads(check)) if check else None,
             },
             "spectra_received_at": None if spectra is None else spectra[0],
             "baseline": baseline,
             "evidence": evidence,
+            "status": asset_status(evidence, baseline, latest["fault_class"]),
         }
 
     def has_asset(self, asset_id: str) -> bool:

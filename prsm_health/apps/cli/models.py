@@ -17,6 +17,7 @@ from prsm_health.monitoring import FileAssetStore, diagnose_asset
 from prsm_health.training.evaluation import evaluate_model
 from prsm_health.training.train import train as train_model
 
+from ..check_plot import plot_check_result
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
 from .models_options import DEFAULT_CV
@@ -130,7 +131,9 @@ def diagnose(args) -> int:
             source="file",
             filename=Path(args.file).name,
         )
-    if args.plot:
+    if args.plot and result.check_phases:  # a check read phase by phase: no windows to draw
+        plot_check_result(run, result, args.plot, design=bundle.design)
+    elif args.plot:
         plot_diagnosis(result, args.plot)
     if args.json:
         print_json(result.to_json())

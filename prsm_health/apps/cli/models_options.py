@@ -100,7 +100,8 @@ def add_model_commands(command) -> None:
         "--plot",
         default=None,
         default_text="no plot",
-        help="write a PNG of the per-window estimates",
+        help="write a PNG of the per-window estimates (a health check: of each phase with its "
+        "reading and verdict)",
     )
     d.add_argument(
         "--asset",

@@ -256,6 +256,42 @@ Prognosis = contract_model(prognosis.Prognosis, _PROGNOSIS)
 RulHours = _PROGNOSIS["RulHours"]
 
 
+class CheckReading(BaseModel):
+    """One indicator a health-check phase was read for."""
+
+    name: str
+    value: float | None = Field(description="in its unit (null: not read)")
+    unit: str
+    z: float | None = Field(
+        description="its robust z-score against the asset's baseline (null: no complete baseline)"
+    )
+
+
+class CheckVerdict(BaseModel):
+    """One role a health check is read for, with the phase it was read in and its verdict
+    (``prsm_health.diagnostics.check_verdicts.check_verdicts``)."""
+
+    role: str = Field(description="'no_load', 'torque_pair', 'reversal' or 'high_load'")
+    condition: str = Field(description="the condition the role needs")
+    phase: str | None = Field(description="the phase(s) it was read in (null: the check lacks it)")
+    read: bool = Field(description="whether any of its indicators has a value")
+    readings: list[CheckReading]
+    classes: dict[str, float] = Field(
+        description="class → probability of the classes this role's phase shows"
+    )
+    clearance: ClearanceInterval | None = Field(  # type: ignore[valid-type]
+        description="the reversal: the clearance interval when observable"
+    )
+
+
+class AssetStatus(BaseModel):
+    """The asset at a glance (``prsm_health.monitoring.status.asset_status``; docs/service.md,
+    Dashboard)."""
+
+    level: str = Field(description="'healthy', 'watch' or 'alarm'")
+    reasons: list[str] = Field(description="why, worst first, and what it cannot tell yet")
+
+
 class LatestDiagnosis(BaseModel):
     """The latest stored diagnosis of an asset, in brief."""
 
@@ -269,6 +305,9 @@ class LatestDiagnosis(BaseModel):
     class_probabilities: dict[str, float]
     warnings: list[str]
     model: dict | None = Field(description="name, version, design of the diagnosing model")
+    check: list[CheckVerdict] | None = Field(
+        None, description="a health check: each role's phase, readings and verdict"
+    )
 
 
 class PrognosisBrief(BaseModel):
@@ -380,6 +419,7 @@ class AssetSummary(BaseModel):
     evidence: AssetEvidence | None = Field(
         description="its accumulated evidence after its latest recording (null: none recorded)"
     )
+    status: AssetStatus = Field(description="healthy, watch or alarm, and why")
     prognosis: PrognosisBrief | None = Field(
         None, description="with `prognosis=true`: the RUL in brief, or why there is none"
     )

@@ -251,10 +251,25 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
     press1 = page.locator("#fleet tbody tr", has_text="press-1")
     cells = press1.locator("td").all_text_contents()
     brief = next(a for a in assets if a["asset_id"] == "press-1")["prognosis"]
-    assert cells[2].startswith(f"{brief['rul_hours']['estimate']:.0f} (")  # RUL [h]
-    assert "µ" not in cells[1] and "(" in cells[1] and cells[3] == "3"
+    assert cells[3].startswith(f"{brief['rul_hours']['estimate']:.0f} (")  # RUL [h]
+    assert "µ" not in cells[2] and "(" in cells[2] and cells[4] == "3"
     press2 = page.locator("#fleet tbody tr", has_text="press-2").locator("td").all_text_contents()
-    assert press2[2].startswith("–") and "at least 2" in press2[2]  # no RUL, and why
+    assert press2[3].startswith("–") and "at least 2" in press2[3]  # no RUL, and why
+    # the status column: each asset's level as the service's rule gave it, in word and colour
+    colours: dict[str, set] = {}
+    for asset in assets:
+        link = page.locator(f"a:text-is('{asset['asset_id']}')")
+        word = page.locator("#fleet tbody tr", has=link).locator("td").first.locator(".status-word")
+        level = asset["status"]["level"]
+        assert level in ("healthy", "watch", "alarm")
+        assert word.text_content() == level
+        assert f"status-{level}" in word.get_attribute("class").split()
+        colour = word.evaluate("(e) => getComputedStyle(e).backgroundColor")
+        assert colour not in ("", "rgba(0, 0, 0, 0)", "transparent"), (level, colour)
+        colours.setdefault(level, set()).add(colour)
+    # one colour per level, a different one for each level shown
+    assert all(len(c) == 1 for c in colours.values())
+    assert len(set().union(*colours.values())) == len(colours)
     assert watch.errors == [] and watch.dialogs == []
     page.screenshot(path=tmp_path / "overview.png", full_page=True)
 
@@ -279,9 +294,30 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
     defects = page.locator("#defects tbody th").all_text_contents()
     assert {"screw_flank", "nut_flank", "roller_flank", "gear_mesh"} <= set(defects)
     assert page.locator("#rul").text_content().endswith(" h")
+    assert page.locator("#check").is_hidden()  # its recordings are no health check
     assert "Over operating hours" in page.locator("#trend-note").text_content()
     assert watch.errors == [] and watch.dialogs == []
     page.screenshot(path=tmp_path / "asset.png", full_page=True)
+
+    # ---- a health check's asset: its phases, each with its reading and verdict
+    watch.reset()
+    page.goto(service.url + "/assets/check-4")
+    _loaded(page)
+    summary = watch.received()["v1/assets/check-4?prognosis=true"]
+    check = summary["latest"]["check"]
+    assert page.locator("#check").is_visible()
+    rows = page.locator("#check-phases tbody tr")
+    assert rows.count() == len(check) == 4
+    for k, verdict in enumerate(check):
+        cells = rows.nth(k).locator("td").all_text_contents()
+        assert rows.nth(k).locator("th").text_content() == verdict["role"].replace("_", " ")
+        assert cells[0] == (verdict["phase"] or "–")
+        assert cells[1] == "read" if verdict["read"] else cells[1].startswith("not read")
+        shown = [r for r in verdict["readings"] if r["value"] is not None]
+        assert len(shown) > 0 and all(r["name"][len("check_") :] in cells[2] for r in shown)
+    assert summary["status"]["level"] in page.locator("#check-note").text_content()
+    assert watch.errors == [] and watch.dialogs == []
+    page.screenshot(path=tmp_path / "check.png", full_page=True)
 
     # ---- an asset without the accelerometer channel: no spectra, said so
     watch.reset()

@@ -337,4 +337,10 @@ def test_asset_page_shows_baseline_and_evidence(bundle, runs, tmp_path):
             cell = page.locator("#fleet tbody tr", has_text="unit-3").locator("td").last
             assert f"{leading} " in cell.text_content() and "after 3" in cell.text_content()
             assert "alarm" in cell.text_content() and watch.errors == []
+            # its status: alarm (the change alarm), in word and in the alarm's colour
+            word = page.locator("#fleet tbody tr", has_text="unit-3").locator(".status-word")
+            assert word.text_content() == "alarm"
+            assert "status-alarm" in word.get_attribute("class").split()
+            colour = word.evaluate("(e) => getComputedStyle(e).backgroundColor")
+            assert colour == "rgb(179, 38, 30)"  # .status-alarm in dashboard.css: #b3261e
             browser.close()

@@ -2,7 +2,8 @@
 // /v1/assets/{asset_id}?prognosis=true), the evidence after each recording (GET
 // /v1/assets/{asset_id}/evidence), the clearance and class probabilities over time or
 // operating hours (GET /v1/assets/{asset_id}/history) and the spectra of its latest window
-// (GET /v1/assets/{asset_id}/spectra), with the defect frequencies marked.
+// (GET /v1/assets/{asset_id}/spectra), with the defect frequencies marked; when the latest
+// recording is a health check, its phases with their readings and verdicts (latest.check).
 "use strict";
 
 PH.ready(async () => {
@@ -17,6 +18,7 @@ PH.ready(async () => {
       PH.getJSON(base + "/evidence?limit=1000"),
     ]);
     showLatest(summary.latest);
+    showCheck(summary.latest.check, summary.status);
     showPrognosis(summary.prognosis);
     showEvidence(summary, evidence);
     const axis = xAxis(history.diagnoses);
@@ -59,6 +61,39 @@ function showLatest(latest) {
     ["Model", model],
   ]);
   PH.fill(document.getElementById("warnings"), latest.warnings || []);
+}
+
+// ---------------------------------------------------------------- the latest health check
+function readingText(r) {
+  const name = r.name.replace(/^check_/, "");
+  if (!PH.finite(r.value)) return `${name}: not read`;
+  const [factor, unit] = r.unit === "m" ? [1e6, "µm"] : [1, r.unit === "-" ? "" : r.unit];
+  const z = PH.finite(r.z) ? ` (z ${r.z >= 0 ? "+" : ""}${r.z.toFixed(1)})` : "";
+  return `${name} = ${(factor * r.value).toPrecision(4)} ${unit}`.trimEnd() + z;
+}
+
+function showCheck(check, status) {
+  if (!check) return;  // the latest recording is no health check
+  document.getElementById("check").hidden = false;
+  document.getElementById("check-note").textContent = "Each role of the check read in the " +
+    "phase whose commanded condition brings it out (found by its condition, not its name); " +
+    "the z-scores are against the asset's own baseline once it is complete. Asset status: " +
+    `${status ? status.level : "–"}.`;
+  const rows = check.map((v) => {
+    const row = PH.el("tr");
+    const verdict = v.phase === null ? `not read: the check has no ${v.condition}`
+      : v.read ? "read" : "not read (see the warnings)";
+    const readings = PH.el("td");
+    for (const r of v.readings) readings.append(PH.el("span", readingText(r), {class: "reading"}));
+    const shows = [];
+    if (v.clearance && PH.finite(v.clearance.estimate)) shows.push(`clearance ${PH.clearanceText(v.clearance)} µm`);
+    for (const [name, p] of Object.entries(v.classes)) shows.push(`P(${name}) ${p.toFixed(2)}`);
+    row.append(PH.el("th", v.role.replace("_", " "), {scope: "row"}), PH.el("td", v.phase ?? "–"),
+      PH.el("td", verdict, {class: v.read ? "" : "not-read"}), readings,
+      PH.el("td", shows.join(", ") || "–"));
+    return row;
+  });
+  document.querySelector("#check-phases tbody").replaceChildren(...rows);
 }
 
 function showPrognosis(prognosis) {

@@ -12,6 +12,7 @@ PH.ready(async () => {
       const row = PH.el("tr");
       row.append(
         name,
+        statusCell(asset.status),
         PH.el("td", PH.classText(asset.latest)),
         PH.el("td", PH.clearanceText(asset.latest.clearance), {class: "num"}),
         rulCell(asset.prognosis),
@@ -34,6 +35,19 @@ PH.ready(async () => {
     status.classList.add("error");
   }
 });
+
+// healthy / watch / alarm, as the service's rule gives it (GET /v1/assets: status), in word
+// and colour, with its reasons below
+function statusCell(status) {
+  const cell = PH.el("td");
+  if (!status) {
+    cell.textContent = "–";
+    return cell;
+  }
+  cell.append(PH.el("span", status.level, {class: `status-word status-${status.level}`}));
+  for (const reason of status.reasons) cell.append(PH.el("span", reason, {class: "why"}));
+  return cell;
+}
 
 function rulCell(prognosis) {
   const cell = PH.el("td", null, {class: "num"});
