@@ -150,6 +150,23 @@ def baseline_only_note(cls: str, reason: str) -> str:
     )
 
 
+def cut_note(cut: dict[str, str], classes) -> str:
+    """The one line of a check whose phases are cut short or too short to read (``cut``: role
+    → its shortfall, :attr:`CheckReading.cut
+    <prsm_health.signals.check_indicators.CheckReading.cut>`): which phases, how long against
+    what they need, what that hides (the clearance, and those of ``classes`` whose role is
+    cut), what to do."""
+    hidden = (
+        ["the clearance (its interval is the whole trained range)"] if "reversal" in cut else []
+    )
+    hidden += [c for c, r in ROLE_OF_CLASS.items() if r in cut and c in classes]
+    shortfalls = "; ".join(dict.fromkeys(cut.values()))
+    return (
+        f"check cut short — not read: {shortfalls}; so not observable: "
+        f"{', '.join(hidden) or 'nothing the model reads'}; record the whole check"
+    )
+
+
 def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
     """Diagnosis of one health-check recording by the bundle's check model.
 
@@ -174,7 +191,8 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
             f"with them; their indicators are NaN"
         )
     for role, reason in reading.missing.items():
-        notes.append(f"check phase missing ({ROLE_CONDITION.get(role, role)}): {reason}")
+        if role not in reading.cut:  # a cut phase has its own line
+            notes.append(f"check phase missing ({ROLE_CONDITION.get(role, role)}): {reason}")
     # clearance: the reversal shows it
     sees_clearance = "reversal" in reading.roles and "nut_position" not in missing_channels
     x = _matrix([row], names)
@@ -182,10 +200,11 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
     lower, upper = (float(a[0]) for a in model.clearance.predict_interval(x))
     if not sees_clearance:
         lower, upper = model.clearance_range
-        notes.append(
-            "no slow reversal under load in this check: clearance is not observable; the "
-            "interval is the whole trained range"
-        )
+        if "reversal" not in reading.cut:
+            notes.append(
+                "no slow reversal under load in this check: clearance is not observable; the "
+                "interval is the whole trained range"
+            )
     relative = baseline is not None and model.fault_relative is not None
     if relative:
         classifier = model.fault_relative
@@ -194,6 +213,8 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
         classifier = model.fault
         x_fault = x
     classes = [str(c) for c in classifier.classes_]
+    if reading.cut:  # the first line: what to fix first
+        notes.insert(0, cut_note(reading.cut, classes))
     probabilities = {
         c: float(p) for c, p in zip(classes, np.asarray(classifier.predict_proba(x_fault))[0])
     }

@@ -30,6 +30,14 @@ so a user-defined check is read the same way. Four roles:
 :func:`check_indicators` returns every indicator of :data:`CHECK_INDICATORS`, NaN where the
 check lacks the phase or the recording the channel, with the reason.
 
+**Cut phases.** A recording can end early (a truncated file, a logger stopped): the check's
+record says how long each phase was commanded, the samples how long it was recorded. A phase
+with fewer samples than its settled part (:data:`BOUNDARY_SAMPLES` aside) is **cut** and not
+read — the models were trained on whole phases, and a part of one reads differently (the lost
+motion of one reversal instead of four; an average over fewer turns) — nor is a whole phase
+shorter than its role needs (:func:`role_shortfall`). Its role is then in
+:attr:`CheckReading.cut`, never in :attr:`CheckReading.roles`.
+
 Measured on simulated checks (paper01, flight-ema, built-in ``health-check``, seeds 1–3;
 :func:`measure_classes` prints the table, docs/angle-domain.md keeps it) — a summary:
 the nut-pass SNR separates a nut spall, the roller-spin SNR a roller spall, the kurtosis (with
@@ -115,6 +123,24 @@ ENVELOPE_PERIODS = ("nut_pass", "roller_spin", "carrier")
 #: Position bins of the stroke profile, as a share of the engaged length (threads × pitch): a
 #: screw spall is met while the nut is within ± half of it, so it spans ≈ 4 bins.
 POSITION_BIN_SHARE = 0.25
+#: Samples a whole phase may lack against its record's span: ``start ≤ t < end`` rounds to a
+#: sample at each end (:func:`~prsm_health.core.check_phases.phase_of_samples`).
+BOUNDARY_SAMPLES = 2
+#: Reversals a reversal phase needs: the lost-motion loop's two branches and back — the play
+#: crossed onto the other flanks and back onto the first, so both flank changes (both signs
+#: of the speed and of the load) are in the lag's step fit and the percentile spread.
+MIN_REVERSALS = 2
+#: A reversal counts when the speed goes from beyond this share of its amplitude on one side
+#: to beyond it on the other: the play crossed with a settled length of each branch recorded.
+REVERSAL_LEVEL = 0.5
+#: Periods each synchronous average of the high-load phase needs: the fewest its SNR is defined
+#: from (:func:`~prsm_health.signals.angle_domain.periodic_snr`: the spread between replicas)
+#: and the motor orders' subtraction needs.
+MIN_PERIODS = 2
+#: The periods the high-load phase must hold :data:`MIN_PERIODS` of: the spall classes'
+#: indicators (nut pass: a nut spall; roller spin: a roller spall) — the carrier and screw SNRs
+#: are NaN in a shorter phase, as in the built-in check's design they are not needed for.
+NEEDED_PERIODS = ("nut_pass", "roller_spin")
 #: The reversal indicators of :func:`~prsm_health.signals.features.extract_features` kept
 #: (module docstring of :func:`check_indicators`).
 REVERSAL_FEATURES = ("lost_motion", "torque_rattle_rate", "drive_torque_ripple", "efficiency")
@@ -187,12 +213,17 @@ class CheckReading:
     missing : dict of role → reason
         Why a role's indicators are NaN, or some of them: the condition the check lacks
         ("no constant phase without load …"), or the channels the recording lacks (then the
-        role is in ``roles`` too).
+        role is in ``roles`` too), or the phase cut short (then in ``cut``).
+    cut : dict of role → shortfall
+        The roles whose phase the recording has, but cut short or too short to read
+        (:func:`role_shortfall`): ``'"<phase>" 0.09 s of the 0.25 s it needs'``; not read,
+        not in ``roles``.
     """
 
     indicators: dict[str, float]
     roles: dict[str, str] = field(default_factory=dict)
     missing: dict[str, str] = field(default_factory=dict)
+    cut: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -208,7 +239,9 @@ class PhaseCondition:
     load : float [N] or None (resisting the motion; the amplitude of a reversing phase)
     samples : int
     run : Run
-        The phase's settled samples.
+        The phase's settled samples (none when the recording ends before the phase).
+    declared : float or None [s]
+        Its settled part as the check's record gives it (``end − start``); None without one.
     """
 
     name: str
@@ -217,6 +250,19 @@ class PhaseCondition:
     load: float | None
     samples: int
     run: Run
+    declared: float | None = None
+
+    @property
+    def recorded(self) -> float:
+        """Its recorded length [s]."""
+        return self.samples / self.run.sample_rate
+
+    @property
+    def is_cut(self) -> bool:
+        """Recorded shorter than its record's span (:data:`BOUNDARY_SAMPLES` aside)."""
+        if self.declared is None:
+            return False
+        return self.samples < self.declared * self.run.sample_rate - BOUNDARY_SAMPLES
 
 
 # ---------------------------------------------------------------------------- conditions
@@ -262,11 +308,16 @@ def phase_conditions(run: Run) -> list[PhaseCondition]:
     that is no check): motion, speed and load as the check's record gives them, each that it
     lacks (older files, a load left as a share of a rating) as measured — the motion from the
     sign changes of the measured speed, the speed as its mean (its largest magnitude for a
-    reversal), the load from a load cell (None without one)."""
+    reversal), the load from a load cell (None without one). A phase of the record the
+    recording ends before (or starts after) is listed too, with no samples."""
     phases = run.phases()
     records = {p.name: p for p in run.check.phases} if run.check is not None else {}
+    for name in records:
+        if name not in phases:
+            phases[name] = run.slice(0, 0)
+    order = {name: k for k, name in enumerate(records)}
     out = []
-    for name, part in phases.items():
+    for name, part in sorted(phases.items(), key=lambda item: order.get(item[0], len(order))):
         record = records.get(name)
         speed_signal = _measured_speed(part)
         motion = (record and record.motion) or _measured_motion(speed_signal)
@@ -281,7 +332,8 @@ def phase_conditions(run: Run) -> list[PhaseCondition]:
         load = record.load if record is not None else None
         if not _is_number(load):
             load = _measured_load(part, motion, speed_signal)
-        out.append(PhaseCondition(name, motion, float(speed), load, len(part), part))
+        declared = None if record is None else float(record.end - record.start)
+        out.append(PhaseCondition(name, motion, float(speed), load, len(part), part, declared))
     return out
 
 
@@ -352,6 +404,88 @@ def find_roles(
     else:
         missing["high_load"] = "no constant-speed phase"
     return found, missing
+
+
+# ---------------------------------------------------------------------------- lengths
+def count_reversals(speed) -> int:
+    """Reversals of a measured speed: changes of side between beyond ±:data:`REVERSAL_LEVEL`
+    of its amplitude (98th percentile of |speed|), so noise about zero counts none."""
+    speed = np.asarray(speed, float)
+    if len(speed) == 0:
+        return 0
+    level = REVERSAL_LEVEL * float(np.percentile(np.abs(speed), 98))
+    side = np.sign(speed) * (np.abs(speed) > level)
+    side = side[side != 0]
+    return int(np.count_nonzero(np.diff(side)))
+
+
+def role_shortfall(
+    role: str, phase: PhaseCondition, design: PRSMDesign, gear_ratio: float = 1.0
+) -> str | None:
+    """Why ``phase`` cannot be read for ``role``, as ``'"<phase>" <has> of the <need> it
+    needs'`` (or ``'"<phase>" not recorded (its <span>)'``); None when it can.
+
+    Every role needs the phase's whole settled part (:attr:`PhaseCondition.is_cut`: the models
+    were trained on whole phases); a whole phase needs besides, per role:
+
+    * ``no_load`` — one Welch segment of the centroid (:data:`CENTROID_SEGMENT` samples; below
+      it :func:`spectral_centroid` has no spectrum);
+    * ``torque_pair`` — nothing more: the mean |torque| of whatever its settled part is;
+    * ``reversal`` — :data:`MIN_REVERSALS` reversals of the measured speed;
+    * ``high_load`` — :data:`MIN_PERIODS` of each of :data:`NEEDED_PERIODS` and of the motor
+      turn (its orders are removed first) in the measured screw angle.
+    """
+    name, part = phase.name, phase.run
+    if phase.is_cut and phase.samples == 0:
+        return f'"{name}" not recorded (its {phase.declared:.2g} s)'
+    if phase.is_cut:
+        return f'"{name}" {phase.recorded:.2g} s recorded of the {phase.declared:.2g} s it needs'
+    if role == "no_load" and phase.samples < CENTROID_SEGMENT:
+        return (
+            f'"{name}" {phase.recorded:.2g} s of the {CENTROID_SEGMENT / part.sample_rate:.2g} s '
+            "it needs (one spectrum segment)"
+        )
+    if role == "reversal":
+        speed = _measured_speed(part)
+        count = None if speed is None else count_reversals(speed)
+        if count is not None and count < MIN_REVERSALS:
+            return f'"{name}" {count} reversal(s) of the {MIN_REVERSALS} it needs (a closed loop)'
+    if role == "high_load" and "screw_angle" in part.channels and len(part) > 1:
+        periods = prsm_periods(design, gear_ratio)
+        longest = max(
+            [periods[k] for k in NEEDED_PERIODS] + ([periods["motor"]] if gear_ratio > 1 else [])
+        )
+        angle = np.asarray(part.channels["screw_angle"], float)
+        travel = abs(float(angle[-1] - angle[0]))
+        if travel < MIN_PERIODS * longest:
+            return (
+                f'"{name}" {travel / (2 * math.pi):.2g} screw turn(s) of the '
+                f"{MIN_PERIODS * longest / (2 * math.pi):.2g} it needs ({MIN_PERIODS} periods "
+                "of each synchronous average)"
+            )
+    return None
+
+
+def _read_roles(
+    conditions: list[PhaseCondition], design: PRSMDesign, gear_ratio: float
+) -> tuple[dict[str, object], dict[str, str], dict[str, str]]:
+    """(found, missing, cut): :func:`find_roles` on the whole phases, then the roles whose
+    phase is cut or too short (:func:`role_shortfall`) moved from ``found`` to ``cut`` — a
+    role only a cut phase would fill is named cut, not absent."""
+    rating = load_ratings(design).dynamic
+    found, missing = find_roles([c for c in conditions if not c.is_cut], rating)
+    if any(c.is_cut for c in conditions):
+        with_cut, _ = find_roles(conditions, rating)
+        found |= {r: p for r, p in with_cut.items() if r not in found}
+    cut: dict[str, str] = {}
+    for role in list(found):
+        phases = found[role] if role == "torque_pair" else (found[role],)
+        short = [s for c in phases if (s := role_shortfall(role, c, design, gear_ratio))]
+        if short:
+            cut[role] = "; ".join(short)
+            missing[role] = f"cut short or too short to read: {cut[role]}"
+            del found[role]
+    return found, missing, cut
 
 
 # ---------------------------------------------------------------------------- indicators
@@ -482,7 +616,8 @@ def check_indicators(
         with |load| ≤ 2 % C_a; ``torque_pair`` the two constant phases under one load
         (within 5 %) with the largest speed ratio (≥ 1.5); ``reversal`` the reversing phase
         under the largest load (a load the record does not give counts as a load);
-        ``high_load`` the constant phase with the largest |load|.
+        ``high_load`` the constant phase with the largest |load|. A role whose phase is
+        cut short or too short (:func:`role_shortfall`) is not read: it is in ``cut``.
 
         The reversal indicators kept from :func:`~prsm_health.signals.features.extract_features`
         are those about the play and the friction across it: ``lost_motion`` (the play
@@ -509,7 +644,7 @@ def check_indicators(
     if gear_ratio is None:
         gear_ratio = run.operating.gear_ratio
     gear_ratio = float(gear_ratio) if _is_number(gear_ratio) and gear_ratio > 0 else 1.0
-    found, missing = find_roles(phase_conditions(run), load_ratings(design).dynamic)
+    found, missing, cut = _read_roles(phase_conditions(run), design, gear_ratio)
     roles: dict[str, str] = {}
     if "housing_temperature" in run.channels:
         out["check_temperature"] = float(np.mean(run.channels["housing_temperature"]))
@@ -537,7 +672,7 @@ def check_indicators(
             reason = _high_load(phase.run, design, gear_ratio, out)
             if reason:
                 missing[role] = reason
-    return CheckReading(out, roles, missing)
+    return CheckReading(out, roles, missing, cut)
 
 
 # ---------------------------------------------------------------------------- measurement
