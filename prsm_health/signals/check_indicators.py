@@ -547,21 +547,41 @@ def _reversal(phase: Run, design: PRSMDesign, out: dict) -> None:
         )
 
 
+def impact_residual(phase: Run, design: PRSMDesign, gear_ratio: float) -> np.ndarray:
+    """The high-load phase's nut axial acceleration in the impact band, the motor's orders
+    removed (``gear_ratio`` > 1) [m/s²]: what the high-load indicators average
+    (:func:`check_indicators`) and a reader draws (:mod:`prsm_health.signals.check_averages`).
+
+    Raises
+    ------
+    PRSMHealthError
+        The sampling rate leaves no impact band; the angle stops or turns back.
+    """
+    band = impact_band(phase.sample_rate)
+    if band is None:
+        raise PRSMHealthError(
+            f"sample rate {phase.sample_rate:g} Hz too low for the {IMPACT_BAND} Hz band"
+        )
+    x = np.asarray(phase.channels["nut_axial_accel"], float)
+    # band first, then the reduction's orders: resampling the broadband signal on the measured
+    # angle turns the resolver's angle noise into phase noise of the strong mesh line, which
+    # leaks into the band (measured: carrier SNR 0.27 against 0.08 band-first)
+    y = bandpass_rows(x[None], phase.sample_rate, [band])[0]  # zero phase, 4th order
+    if gear_ratio > 1:
+        angle = np.asarray(phase.channels["screw_angle"], float)
+        y, _ = subtract_synchronous(y, angle, prsm_periods(design, gear_ratio)["motor"])
+    return y
+
+
 def _high_load(phase: Run, design: PRSMDesign, gear_ratio: float, out: dict) -> str | None:
     """The spall indicators of the high-load phase; a reason when they cannot be read."""
     band = impact_band(phase.sample_rate)
     if band is None:
         return f"sample rate {phase.sample_rate:g} Hz too low for the {IMPACT_BAND} Hz band"
-    x = np.asarray(phase.channels["nut_axial_accel"], float)
     angle = np.asarray(phase.channels["screw_angle"], float)
     periods = prsm_periods(design, gear_ratio)
-    # band first, then the reduction's orders: resampling the broadband signal on the measured
-    # angle turns the resolver's angle noise into phase noise of the strong mesh line, which
-    # leaks into the band (measured: carrier SNR 0.27 against 0.08 band-first)
-    y = bandpass_rows(x[None], phase.sample_rate, [band])[0]  # zero phase, 4th order
     try:
-        if gear_ratio > 1:
-            y, _ = subtract_synchronous(y, angle, periods["motor"])
+        y = impact_residual(phase, design, gear_ratio)
         # each signal up-sampled once for all its periods
         averages = synchronous_average_periods(y, angle, {k: periods[k] for k in SNR_PERIODS})
         for name, average in averages.items():
