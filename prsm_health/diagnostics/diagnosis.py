@@ -597,6 +597,10 @@ def diagnose_runs(
         window=window,
         split=None if split is None else [split[i] for i in rest],
     )
+    if bundle.check is None:  # one line on why a check reads out of distribution
+        for i, d in zip(rest, windowed):
+            if is_check(runs[i]):
+                d.warnings.append(NO_CHECK_PART.format(name=bundle.name))
     if baseline is not None and bundle.check is not None:
         for d in windowed:
             d.warnings.append(
@@ -605,6 +609,15 @@ def diagnose_runs(
             )
     out = dict(checks) | dict(zip(rest, windowed))
     return [out[i] for i in range(len(runs))]
+
+
+#: The warning of a health-check recording diagnosed by a bundle without a check part.
+NO_CHECK_PART = (
+    "model {name!r} has no health-check part: this check is read window by window across its "
+    "phases, where out of distribution is expected; to read it phase by phase, train one with "
+    '`prsm-health train` on a dataset of check recordings (docs/diagnostics.md, "A health '
+    'check for your own actuator")'
+)
 
 
 def _diagnose_windowed(runs, bundle, *, window, split) -> list[Diagnosis]:
