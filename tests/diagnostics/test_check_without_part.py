@@ -32,3 +32,13 @@ def test_a_recording_that_is_no_check_gets_no_such_line(reversing_run, windows_o
 def test_with_its_check_part_the_check_is_read_phase_by_phase(short_check_run):
     d = diagnose(short_check_run(), load_bundle())
     assert d.check_phases and not _no_part_lines(d)
+
+
+def test_a_bundle_with_a_check_part_only_refuses_a_recording_that_is_no_check(reversing_run):
+    from prsm_health.core.errors import PRSMHealthError
+    from prsm_health.diagnostics.diagnosis import ModelBundle
+
+    check_only = ModelBundle(None, None, [], {"design": "paper01", "name": "own"}, None, {})
+    assert check_only.check_only
+    with pytest.raises(PRSMHealthError, match="health-check part only"):
+        diagnose(reversing_run(10e-6), check_only)
