@@ -622,7 +622,8 @@ def diagnose_runs(
 #: The warning of a health-check recording diagnosed by a bundle without a check part.
 NO_CHECK_PART = (
     "model {name!r} has no health-check part: this check is read window by window across its "
-    "phases, where out of distribution is expected; to read it phase by phase, train one with "
+    "phases, which no window of its training mixed (expect out-of-distribution windows or "
+    "cannot_tell); to read it phase by phase, train one with "
     '`prsm-health train` on a dataset of check recordings (docs/diagnostics.md, "A health '
     'check for your own actuator")'
 )

@@ -20,7 +20,7 @@ def _no_part_lines(diagnosis) -> list[str]:
 def test_a_check_without_a_check_part_says_so_in_one_line(short_check_run, windows_only):
     d = diagnose(short_check_run(), windows_only)
     (line,) = _no_part_lines(d)
-    assert "window by window" in line and "out of distribution" in line
+    assert "window by window" in line and "out-of-distribution" in line
     assert "prsm-health train" in line and "docs/diagnostics.md" in line
     assert not d.check_phases and d.windows  # read across its phases, not phase by phase
 
