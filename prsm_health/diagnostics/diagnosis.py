@@ -105,6 +105,12 @@ class ModelBundle:
         self.design = None if design is None else load_design(design)
 
     @property
+    def check_only(self) -> bool:
+        """A bundle with a health-check part and no window model (``prsm-health train`` on
+        checks alone): it reads health-check recordings only."""
+        return self.check is not None and self.clearance is None and self.fault is None
+
+    @property
     def design_name(self) -> str:
         return self.design.name if self.design is not None else NO_DESIGN
 
@@ -584,6 +590,8 @@ def diagnose_runs(
         if reason is not None:
             raise PRSMHealthError(reason)
     runs = [run.without_truth().validate() for run in runs]
+    if bundle.check_only and not all(is_check(run) for run in runs):
+        raise PRSMHealthError(CHECK_ONLY.format(name=bundle.name))
     # a check recording is read phase by phase when the model can (and was not cut already)
     checks = {
         i: diagnose_check(run, bundle, baseline)
@@ -597,6 +605,10 @@ def diagnose_runs(
         window=window,
         split=None if split is None else [split[i] for i in rest],
     )
+    if bundle.check is None:  # one line on why a check reads out of distribution
+        for i, d in zip(rest, windowed):
+            if is_check(runs[i]):
+                d.warnings.append(NO_CHECK_PART.format(name=bundle.name))
     if baseline is not None and bundle.check is not None:
         for d in windowed:
             d.warnings.append(
@@ -605,6 +617,23 @@ def diagnose_runs(
             )
     out = dict(checks) | dict(zip(rest, windowed))
     return [out[i] for i in range(len(runs))]
+
+
+#: The warning of a health-check recording diagnosed by a bundle without a check part.
+NO_CHECK_PART = (
+    "model {name!r} has no health-check part: this check is read window by window across its "
+    "phases, which no window of its training mixed (expect out-of-distribution windows or "
+    "cannot_tell); to read it phase by phase, train one with "
+    '`prsm-health train` on a dataset of check recordings (docs/diagnostics.md, "A health '
+    'check for your own actuator")'
+)
+
+#: The refusal of a recording that is no health check by a bundle with a check part only.
+CHECK_ONLY = (
+    "model {name!r} has a health-check part only: it reads health-check recordings (their "
+    "phases known) and this recording is none; diagnose it with a window model, or train one "
+    "and add the check part to it (prsm-health train CHECKS --window-model MODEL)"
+)
 
 
 def _diagnose_windowed(runs, bundle, *, window, split) -> list[Diagnosis]:

@@ -163,6 +163,7 @@ def train_check_model(
     baseline_only: dict | None = None,
     baseline_only_cases: tuple[str, ...] = (),
     random_state: int = 0,
+    cv: int = CHECK_CV,
     progress: bool = False,
 ) -> tuple[dict, dict]:
     """Train the check part of a model bundle.
@@ -185,6 +186,8 @@ def train_check_model(
     baseline_only_cases : tuple of str
         Fault cases of those classes, left out of the alone classifier's training only.
     random_state : int
+    cv : int
+        Cross-validation folds (by unit: at most the training units).
 
     Returns
     -------
@@ -205,6 +208,7 @@ def train_check_model(
             baseline_only=baseline_only,
             baseline_only_cases=baseline_only_cases,
             random_state=random_state,
+            cv=cv,
             progress=progress,
         )
 
@@ -218,6 +222,7 @@ def _train_check_model(
     baseline_only,
     baseline_only_cases,
     random_state,
+    cv,
     progress,
 ) -> tuple[dict, dict]:
     import pandas as pd
@@ -274,15 +279,15 @@ def _train_check_model(
 
     x_train = table.loc[train, names]
     metrics["clearance_cv"] = cross_validated_metrics(
-        clearance_model, x_train, y_clearance, groups=table.loc[train, "unit_id"], cv=CHECK_CV
+        clearance_model, x_train, y_clearance, groups=table.loc[train, "unit_id"], cv=cv
     )
     clearance = clearance_model().fit(x_train, y_clearance, groups=table.loc[train, "unit_id"])
     metrics["fault_cv"] = cross_validated_metrics(
-        classifier, table.loc[alone_rows, names], y_alone, groups=alone_units, cv=CHECK_CV
+        classifier, table.loc[alone_rows, names], y_alone, groups=alone_units, cv=cv
     )
     fault = classifier().fit(table.loc[alone_rows, names], y_alone, groups=alone_units)
     metrics["fault_relative_cv"] = cross_validated_metrics(
-        classifier, changes.loc[fit_rows, relative_names], y_class, groups=units, cv=CHECK_CV
+        classifier, changes.loc[fit_rows, relative_names], y_class, groups=units, cv=cv
     )
     fault_relative = classifier().fit(changes.loc[fit_rows, relative_names], y_class, groups=units)
     part = {

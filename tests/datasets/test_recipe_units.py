@@ -80,10 +80,17 @@ def test_bad_units_are_recipe_errors_naming_the_key(units, needle):
         Recipe.from_dict(dict(BASE, units=units, sweep={"clearance": [1e-6]}))
 
 
-@pytest.mark.parametrize("other", ["flight-ema-check-baseline"])
-def test_the_shipped_check_recipes_share_their_units(other):
-    check = load_recipe(ROOT / "datasets" / "flight-ema-check.toml")
+@pytest.mark.parametrize(
+    "name, other",
+    [
+        ("flight-ema-check", "flight-ema-check-baseline"),
+        ("own-design-check", "own-design-check-baseline"),  # the docs' own-design example
+    ],
+)
+def test_the_shipped_check_recipes_share_their_units(name, other):
+    check = load_recipe(ROOT / "datasets" / f"{name}.toml")
     twin = load_recipe(ROOT / "datasets" / f"{other}.toml")
+    assert check.design == twin.design
     assert check.units["seed"] == twin.units["seed"] and check.units["count"] == twin.units["count"]
     for unit in (0, 17):
         built, twin_built = check.unit_build(unit), twin.unit_build(unit)

@@ -14,6 +14,8 @@ from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
 from prsm_health.io import read_recording
 from prsm_health.monitoring import FileAssetStore, diagnose_asset
+from prsm_health.training.check_part import is_check_dataset, train_check_part
+from prsm_health.training.check_training import CHECK_CV
 from prsm_health.training.evaluation import evaluate_model
 from prsm_health.training.train import train as train_model
 
@@ -36,6 +38,13 @@ def train(args) -> int:
     check_train_options(args)
     if args.target == "rul":
         return train_prognostics(args)
+    if is_check_dataset(Dataset(args.dataset)):
+        return train_check(args)
+    for option, value in (("--baseline", args.baseline), ("--window-model", args.window_model)):
+        if value is not None:
+            raise PRSMHealthError(
+                f"{option} is for a dataset of health checks; the runs of {args.dataset} are none"
+            )
     cv = DEFAULT_CV if args.cv is None else args.cv
     metrics = train_model(args.dataset, args.out, target=args.target, cv=cv, progress=not args.json)
     if args.json:
@@ -45,6 +54,63 @@ def train(args) -> int:
     for text in metrics.get("warnings", []):
         print(f"warning: {text}", file=sys.stderr)
     return 0
+
+
+def train_check(args) -> int:
+    """``train CHECKS --baseline BASELINE``: the check part of a bundle for the checks' design."""
+    if args.target in ("clearance", "fault"):
+        raise PRSMHealthError(
+            f"--target {args.target}: a dataset of health checks trains the check part, "
+            "clearance and class together: leave --target out"
+        )
+    result = train_check_part(
+        args.dataset,
+        args.baseline,
+        args.out,
+        window_model=args.window_model,
+        cv=CHECK_CV if args.cv is None else args.cv,
+        progress=not args.json,
+    )
+    if args.json:
+        print_json(result)
+        return 0
+    print_table(check_training_rows(result))
+    for text in result["warnings"]:
+        print(f"warning: {text}", file=sys.stderr)
+    return 0
+
+
+def check_training_rows(result: dict) -> list:
+    """The table of ``train`` on health checks: where the bundle and its check part went, the
+    cross-validated (by unit) and held-out metrics."""
+    model, m = result["model"], result["check"]
+    rows = [
+        ("model", model["path"], f"({model['kind']})"),
+        ("check part", model["check_part"], ""),
+        ("metrics", result["metrics_path"], ""),
+        ("design", model["design"], ""),
+        ("checks", f"{m['runs']['train']} train, {m['runs']['test']} held out", ""),
+        ("baseline checks", m["baseline_runs"], ""),
+    ]
+    cv = m.get("clearance_cv") or {}
+    rows.append(("clearance CV MAE (by unit)", scaled(cv.get("mae"), 1e6), "µm"))
+    rows.append(
+        ("clearance CV 90 % interval coverage", share(cv.get("interval_coverage"), "checks"), "")
+    )
+    for key, label in (("fault_cv", "alone"), ("fault_relative_cv", "against the baseline")):
+        rows.append((f"class CV macro-F1, {label}", scaled((m.get(key) or {}).get("macro_f1")), ""))
+    held = m.get("held_out") or {}
+    if held:
+        rows.append(("held-out clearance MAE", scaled(held["clearance_mae"], 1e6), "µm"))
+        rows.append(("held-out macro-F1, alone", scaled(held["macro_f1_alone"]), ""))
+        rows.append(
+            (
+                "held-out macro-F1, against the baseline",
+                scaled(held["macro_f1_against_baseline"]),
+                "",
+            )
+        )
+    return rows
 
 
 def training_rows(metrics: dict) -> list:

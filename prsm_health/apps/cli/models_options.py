@@ -18,10 +18,15 @@ DEFAULT_CV = 5
 def add_model_commands(command) -> None:
     t = command(
         "train",
-        "train the clearance estimator and fault classifier on a dataset, or a prognostics "
-        "model on a fleet dataset (--target rul)",
+        "train the clearance estimator and fault classifier on a dataset, a model's health-check "
+        "part on a dataset of health checks, or a prognostics model on a fleet dataset "
+        "(--target rul)",
     )
-    t.add_argument("dataset", help="dataset directory or URL (prsm-health generate)")
+    t.add_argument(
+        "dataset",
+        help="dataset directory or URL (prsm-health generate); of health checks (a recipe with "
+        "[units] and [profile] check): the check part, clearance and class together",
+    )
     t.add_argument(
         "--out",
         required=True,
@@ -38,7 +43,7 @@ def add_model_commands(command) -> None:
         "--cv",
         type=int,
         default=None,
-        default_text=str(DEFAULT_CV),
+        default_text=f"{DEFAULT_CV}; health checks: the check part's, by unit",
         help="cross-validation folds on the train split (not with --target rul)",
     )
     t.add_argument(
@@ -56,6 +61,22 @@ def add_model_commands(command) -> None:
         metavar="M",
         default_text="learnt from the training units",
         help="--target rul: failure threshold on the diagnosed clearance [m]",
+    )
+    t.add_argument(
+        "--baseline",
+        default=None,
+        metavar="DATASET",
+        default_text="required with a dataset of health checks",
+        help="a dataset of health checks: the same units' checks when new and healthy (the same "
+        "[units]), what each check is read against (docs/diagnostics.md)",
+    )
+    t.add_argument(
+        "--window-model",
+        default=None,
+        metavar="BUNDLE",
+        default_text="a bundle with the check part only",
+        help="a dataset of health checks: the window model (.skops) of the same design that --out "
+        "becomes a copy of, with the check part beside it (--out BUNDLE itself: added in place)",
     )
     add_json(t, "the metrics")
     t.set_defaults(handler="models:train")

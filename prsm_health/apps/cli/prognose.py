@@ -103,7 +103,7 @@ def _prognosis_rows(args, prognosis, history, true_rul) -> list:
 # ----------------------------------------------------------------------------- train --target rul
 #: The options of ``train`` that only ``--target rul`` takes, and those it does not.
 RUL_OPTIONS = (("--model", "model"), ("--threshold", "threshold"))
-DIAGNOSIS_OPTIONS = (("--cv", "cv"),)
+DIAGNOSIS_OPTIONS = (("--cv", "cv"), ("--baseline", "baseline"), ("--window-model", "window_model"))
 
 
 def check_train_options(args) -> None:
