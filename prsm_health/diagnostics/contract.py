@@ -24,6 +24,11 @@ from typing import ClassVar
 #: The class of a window whose class the model cannot see (clearance hidden, channels missing,
 #: indicators unlike the training set, or no class probable enough).
 CANNOT_TELL = "cannot_tell"
+#: Out-of-distribution score above which a window is unlike the training set
+#: (``Diagnosis.ood_score``). The score is 1 at the 99th percentile of the training windows' own
+#: scores; 1.5 leaves room for the held-out windows of the same recipe (models/MODEL_CARD.md:
+#: the share of them above it).
+OOD_LIMIT = 1.5
 
 
 def describe(description: str, *, omit_empty: bool = False, **kwargs):
@@ -247,7 +252,7 @@ class Diagnosis:
     )
     ood_score: float | None = describe(
         "out-of-distribution score of the indicators (1 = the training windows' 99th "
-        "percentile; above 1.5 unlike the training set); a recording's is the median of its "
+        f"percentile; above {OOD_LIMIT:g} unlike the training set); a recording's is the median of its "
         "windows'",
         default=None,
     )

@@ -53,8 +53,9 @@ from prsm_health.signals.features import (
 )
 
 from .answer import NAME_PROBABILITY, SET_NOTE, ambiguous, fault_answer, not_observable  # noqa: F401 (NAME_PROBABILITY: public here)
-from .contract import (
+from .contract import (  # OOD_LIMIT: public here too, where it was defined before
     CANNOT_TELL,
+    OOD_LIMIT,
     ClearanceInterval,
     Diagnosis,
     ModelReference,
@@ -68,10 +69,6 @@ DEFAULT_MODEL = Path(__file__).resolve().parents[2] / "models" / "default.skops"
 #: least this fraction of a window (indicators over less are biased: fewer reversals, wider
 #: spectral bins), and reported as dropped otherwise.
 MIN_TAIL_FRACTION = 0.5
-#: Out-of-distribution score above which a window is unlike the training set. The score is 1 at
-#: the 99th percentile of the training windows' own scores; 1.5 leaves room for the held-out
-#: windows of the same recipe (models/MODEL_CARD.md: the share of them above it).
-OOD_LIMIT = 1.5
 #: How the warning of windows unlike the training set begins.
 _OOD_NOTE = "indicators unlike the training windows"
 #: A clearance interval at least this share of the trained range wide says nothing: the

@@ -11,7 +11,9 @@ diagnosed recording and attaches the asset's state to the diagnosis (``Diagnosis
   names a fault with confidence (:func:`names_a_fault`); a recording labelled healthy joins
   it at any time;
 * every recording not put in the baseline adds its class probabilities to the evidence and,
-  once the baseline is complete, its distance from the baseline to the CUSUM;
+  once the baseline is complete, its distance from the baseline to the CUSUM — unless the
+  model could not see its fault class (:func:`unobservable`): then it adds neither, and its
+  diagnosis says so; its distance and changes are shown all the same;
 * recording the same ``recording_id`` again changes nothing: the diagnosis comes back with
   the state stored the first time (an interrupted or repeated run counts each recording once).
 
@@ -34,6 +36,7 @@ from prsm_health.core.jsonable import finite_or_none
 from prsm_health.diagnostics.baseline import Baseline
 from prsm_health.diagnostics.contract import (
     CANNOT_TELL,
+    OOD_LIMIT,
     AssetState,
     BaselineState,
     Diagnosis,
@@ -50,6 +53,13 @@ from .evidence import EVIDENCE_NAME_PROBABILITY, Cusum, Evidence
 BASELINE_RECORDINGS = 3
 #: The class of a healthy unit.
 HEALTHY = "healthy"
+#: The share of a recording's windows in which its fault class must have been observable
+#: (``Diagnosis.observability["fault"]``) for the recording to add class evidence and a CUSUM
+#: step. A recording's indicators are the medians of all its windows and its class
+#: probabilities the mean of the windows that saw the class: below one half, its indicators
+#: (hence its distance) are mostly those of windows that did not show the class, and a few
+#: windows would speak for the whole recording.
+OBSERVABLE_SHARE = 0.5
 #: Version of the history's JSON form.
 FORMAT = 1
 
@@ -74,14 +84,73 @@ def names_a_fault(diagnosis: Diagnosis) -> bool:
     return named and HEALTHY not in (diagnosis.class_set or [])
 
 
+def unobservable(diagnosis: Diagnosis) -> str | None:
+    """Why ``diagnosis`` adds nothing to a unit's class evidence and change statistic, or None
+    when it does. It adds nothing when the model could not see its fault class:
+
+    * its out-of-distribution score is above :data:`~prsm_health.diagnostics.contract.OOD_LIMIT`
+      (its indicators are unlike the training set: their change from the baseline and the
+      class probabilities say what the recording was, not how the unit is), or
+    * its fault class was observable (``observability["fault"]``) in fewer than
+      :data:`OBSERVABLE_SHARE` of its windows; a window's or a check's observability is a
+      bool, False counting as none.
+
+    A check read by a model's check part has no OOD score; a check lacking a phase that a
+    class needs is not observable (``observability["fault"]`` False)."""
+    ood = finite_or_none(diagnosis.ood_score)
+    if ood is not None and ood > OOD_LIMIT:
+        return (
+            f"its indicators are unlike the model's training set (out-of-distribution score "
+            f"{ood:.3g} > {OOD_LIMIT:g})"
+        )
+    seen = diagnosis.observability.get("fault")
+    share = 0.0 if seen is None else float(seen)
+    if share >= OBSERVABLE_SHARE:
+        return None
+    if isinstance(seen, float):  # a recording's: the share of its windows
+        return (
+            f"its fault class was observable in {100 * share:.0f} % of its windows (at least "
+            f"{100 * OBSERVABLE_SHARE:.0f} % needed)"
+        )
+    missing = diagnosis.undecided.missing if diagnosis.undecided is not None else []
+    return "the recording could not show its fault class" + (
+        f" (it lacked {', '.join(missing)})" if missing else ""
+    )
+
+
+def training_spread(bundle) -> dict[str, float] | None:
+    """Indicator → the robust spread (IQR/1.349) of the window model's training windows, as
+    its out-of-distribution guard stored it
+    (:class:`~prsm_health.diagnostics.estimators.DistributionGuard` ``scale_``); None without
+    a guard. The spread is between all the training windows — units, operating points and
+    health states — so it is an upper bound of the within-unit repeatability."""
+    guard = getattr(bundle, "guard", None)
+    scale = getattr(guard, "scale_", None)
+    names = getattr(guard, "feature_names_in_", None)
+    if names is None:
+        names = getattr(bundle, "feature_names", None)
+    if scale is None or names is None or len(names) != len(scale):
+        return None
+    spread = {str(n): finite_or_none(s) for n, s in zip(names, scale)}
+    return {n: s for n, s in spread.items() if s is not None and s > 0} or None
+
+
 def bundle_priors(bundle, check: bool = True) -> tuple[dict | None, dict | None, list[str] | None]:
     """What a model bundle tells a unit's history about one kind of recording: (prior scale per
-    indicator — the within-unit repeatability, training prior per class, the indicators a
-    baseline of that kind is of). A health check (``check``) and a bundle with a check part
-    (:class:`~prsm_health.diagnostics.check_model.CheckModel`): the check model's; otherwise the window model's
-    indicators, no prior scale and no training prior (the defaults of
-    :meth:`AssetHistory.record`). A unit's check recordings and its in-service windows have
-    baselines of their own: their indicators differ."""
+    indicator, training prior per class, the indicators a baseline of that kind is of).
+
+    A health check (``check``) and a bundle with a check part
+    (:class:`~prsm_health.diagnostics.check_model.CheckModel`): the check model's — the prior
+    scale is its within-unit repeatability, measured on its training units' repeat checks.
+    Otherwise (in-service windows, or a check read window by window by a bundle without a
+    check part) the window model's indicators, with the spread of its training windows as prior
+    scale (:func:`training_spread`) and no training prior (uniform, the default of
+    :meth:`AssetHistory.record`). That spread is between units, operating points and health
+    states, an upper bound of the within-unit repeatability: three baseline recordings that
+    happen to agree closely never give near-zero scales (a healthy unit read against them
+    cannot raise the alarm), and the change statistic sees only changes of about the training
+    set's spread. A unit's check recordings and its in-service windows have baselines of their
+    own: their indicators differ."""
     part = getattr(bundle, "check", None) or {}
     if check and part:
         scale, prior = part.get("repeatability"), part.get("training_prior")
@@ -92,7 +161,7 @@ def bundle_priors(bundle, check: bool = True) -> tuple[dict | None, dict | None,
             list(names) if names else None,
         )
     names = getattr(bundle, "feature_names", None)
-    return None, None, (list(names) if names else None)
+    return training_spread(bundle), None, (list(names) if names else None)
 
 
 def _by_size(changes: Mapping[str, float]) -> dict[str, float]:
@@ -251,7 +320,11 @@ class AssetHistory:
         healthy : bool or None
             A label: True puts the recording in the baseline (at any time), False keeps it
             out; None lets the rule decide (it joins an incomplete baseline unless
-            :func:`names_a_fault`).
+            :func:`names_a_fault`). A recording not put in the baseline adds its class
+            probabilities to the evidence and its distance to the CUSUM, unless its fault
+            class was not observable (:func:`unobservable`: an OOD score above the limit, or
+            observable in fewer than half its windows): then it adds neither, a warning says
+            why, and it is recorded with its distance and changes all the same.
         operating_hours : float or None [h]
             The asset's operating hours at the recording, ≥ 0.
         time : str
@@ -319,7 +392,13 @@ class AssetHistory:
 
         evidence, cusum = self.evidence, self.cusum
         probabilities = {str(k): float(v) for k, v in diagnosis.class_probabilities.items()}
-        if not in_baseline:
+        blind = None if in_baseline else unobservable(diagnosis)
+        if blind is not None and (probabilities or baseline is not None):
+            notes.append(
+                f"added no class evidence and no change-statistic step to asset "
+                f"{self.asset_id}: {blind}"
+            )
+        if not in_baseline and blind is None:
             if probabilities:
                 if evidence is not None and set(evidence.classes) != set(probabilities):
                     notes.append(
@@ -482,9 +561,12 @@ __all__ = [
     "ASSET_ID_PATTERN",
     "BASELINE_RECORDINGS",
     "HEALTHY",
+    "OBSERVABLE_SHARE",
     "AssetEntry",
     "AssetHistory",
     "bundle_priors",
     "names_a_fault",
+    "training_spread",
+    "unobservable",
     "validate_asset_id",
 ]

@@ -20,8 +20,8 @@ from .store import AssetStore
 
 def asset_baseline(store: AssetStore, bundle, asset_id: str) -> Baseline | None:
     """The asset's baseline a recording is diagnosed against: that of its health checks,
-    fitted with the model's within-unit repeatability as prior scale
-    (:func:`~.asset.bundle_priors`); None until it has enough recordings. Only a health
+    fitted with the model's prior scale (its within-unit repeatability, or the spread of its
+    training windows: :func:`~.asset.bundle_priors`); None until it has enough recordings. Only a health
     check is read against a baseline (:func:`~prsm_health.diagnostics.diagnosis.diagnose`)."""
     prior_scale, _, names = bundle_priors(bundle, check=True)
     return store.load(asset_id).history.baseline(prior_scale, names)

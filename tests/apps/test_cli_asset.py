@@ -17,7 +17,8 @@ from prsm_health.monitoring import FileAssetStore
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     """A tiny model (prior class probabilities, no clearance model, no design) and five 0.2 s
-    CSV recordings with their own noise."""
+    CSV recordings with their own noise, the screw reversing in each (a window without a
+    reversal cannot show the class: its answer would add no evidence)."""
     root = tmp_path_factory.mktemp("asset")
     x = pd.DataFrame({"ax_rms": np.linspace(0.0, 1.0, 12)})
     y = np.array(["healthy", "healthy", "wear", "lubrication"] * 3)
@@ -30,12 +31,15 @@ def files(tmp_path_factory):
     t = np.arange(n) / fs
     for k in range(5):
         rng = np.random.default_rng(k)
-        table = np.column_stack([t, (1 + 0.1 * k) * rng.standard_normal(n), 100.0 * t])
+        speed = 100.0 * np.cos(2 * np.pi * 5.0 * t)  # [rad/s]: one reversal in 0.2 s
+        angle = 100.0 / (2 * np.pi * 5.0) * np.sin(2 * np.pi * 5.0 * t)
+        accel = (1 + 0.1 * k) * rng.standard_normal(n)
+        table = np.column_stack([t, accel, angle, speed])
         np.savetxt(
             root / f"rec{k}.csv",
             table,
             delimiter=",",
-            header="time,nut_axial_accel,screw_angle",
+            header="time,nut_axial_accel,screw_angle,screw_speed",
             comments="",
         )
     return root

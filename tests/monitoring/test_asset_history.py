@@ -3,6 +3,7 @@ recordings, then evidence and the change statistic accumulate; a recording recor
 counts once; the history round-trips exactly through JSON. Synthetic diagnoses, no model.
 The stores are tests/monitoring/test_store.py."""
 
+import dataclasses
 import json
 import math
 
@@ -25,6 +26,7 @@ from prsm_health.monitoring.asset import (
     AssetHistory,
     bundle_priors,
     names_a_fault,
+    training_spread,
     validate_asset_id,
 )
 from prsm_health.monitoring.evidence import Cusum, Evidence
@@ -32,14 +34,23 @@ from prsm_health.monitoring.evidence import Cusum, Evidence
 CLASSES = ("healthy", "lubrication", "wear")
 
 
-def diagnosis(a=1.0, b=10.0, probabilities=None, fault_class=CANNOT_TELL, class_set=None):
+def diagnosis(
+    a=1.0,
+    b=10.0,
+    probabilities=None,
+    fault_class=CANNOT_TELL,
+    class_set=None,
+    observable=True,
+    ood_score=None,
+):
     probabilities = probabilities or {"healthy": 0.5, "lubrication": 0.25, "wear": 0.25}
     return Diagnosis(
         clearance=ClearanceInterval(10e-6, 8e-6, 12e-6),
         fault_class=fault_class,
         class_probabilities=probabilities,
         class_set=list(CLASSES) if class_set is None else class_set,
-        observability=Observability(True, True),
+        observability=Observability(True, observable),
+        ood_score=ood_score,
         indicators={"a": a, "b": b, "gone": None},
         model=ModelReference("m", "1", "paper01", "flight-ema"),
     )
@@ -254,3 +265,73 @@ def test_bundle_priors_are_those_of_the_recordings_kind():
 
     assert bundle_priors(Bundle(), check=True) == ({"check_x": 0.5}, {"healthy": 1.0}, ["check_x"])
     assert bundle_priors(Bundle(), check=False) == (None, None, ["a", "b"])
+
+
+@pytest.mark.parametrize(
+    ("blind", "why"),
+    [
+        ({"observable": 0.2}, "observable in 20 % of its windows"),
+        ({"observable": False}, "could not show its fault class"),
+        ({"observable": 1.0, "ood_score": 3.0}, "unlike the model's training set"),
+    ],
+)
+def test_an_answer_the_model_could_not_see_adds_no_evidence_and_no_cusum_step(blind, why):
+    before, _ = recorded([*BASE, (1.5, 10.0, WEAR)])
+    h, d = before.record("blind", diagnosis(5.0, 30.0, WEAR, **blind), prior_scale=PRIOR)
+    assert h.evidence == before.evidence and h.cusum == before.cusum
+    assert len(h.entries) == 5 and not h.entries[-1].baseline  # recorded all the same
+    # its distance and changes are shown: seen, it would have alarmed at once (> k + h)
+    assert h.entries[-1].distance == d.asset.baseline.distance > 6.5
+    assert d.asset.baseline.changes
+    assert d.asset.evidence.recordings == 1 and not d.asset.evidence.change_alarm
+    assert any("added no class evidence" in w and why in w for w in d.warnings)
+
+
+def test_an_answer_seen_in_half_its_windows_adds_its_evidence_and_cusum_step():
+    before, _ = recorded(BASE)
+    seen = diagnosis(5.0, 30.0, WEAR, observable=0.5, ood_score=1.4)
+    h, d = before.record("half", seen, prior_scale=PRIOR)
+    assert h.evidence.recordings == 1
+    assert h.cusum == Cusum().update(d.asset.baseline.distance) and h.cusum.alarm
+    assert not any("added no class evidence" in w for w in d.warnings)
+    # in a baseline in the making an answer not seen joins it as any other (no note)
+    h, d = AssetHistory("u").record("first", diagnosis(observable=0.0))
+    assert h.entries[0].baseline and h.evidence is None and d.warnings == []
+
+
+def test_without_a_measured_repeatability_the_training_spread_keeps_a_healthy_unit_quiet():
+    import pandas as pd
+
+    from prsm_health.diagnostics.estimators import DistributionGuard
+
+    # a window model's guard fitted on 40 units' windows: each unit's level its own (between
+    # units σ = 1), its windows scattering σ = 0.1 around it
+    rng = np.random.default_rng(5)
+    names = ["a", "b", "c"]
+    levels = rng.normal([2.0, -1.0, 0.5], 1.0, size=(40, 3))
+    rows = np.repeat(levels, 10, axis=0) + rng.normal(0.0, 0.1, (400, 3))
+
+    class Bundle:  # no check part: no repeatability measured
+        feature_names = names
+        guard = DistributionGuard().fit(pd.DataFrame(rows, columns=names))
+        check = None
+
+    scale, prior, baseline_names = bundle_priors(Bundle(), check=False)
+    assert scale == training_spread(Bundle()) and baseline_names == names and prior is None
+    assert all(0.5 < scale[n] < 2.0 for n in names)  # the spread between units, ≫ 0.1
+    # a healthy unit: three baseline recordings that agree to 1e-4, then ten that scatter as
+    # its windows do
+    unit = rng.normal([2.0, -1.0, 0.5], 1.0)
+    noise = [1e-4] * 3 + [0.1] * 10
+    values = [unit + rng.normal(0.0, sigma, 3) for sigma in noise]
+
+    def alarms(prior_scale):
+        h, out = AssetHistory("u"), []
+        for i, x in enumerate(values):
+            d = dataclasses.replace(diagnosis(), indicators=dict(zip(names, x.tolist())))
+            h, d = h.record(f"r{i}", d, prior_scale=prior_scale, names=names)
+            out.append(d.asset.evidence.change_alarm)
+        return out
+
+    assert not any(alarms(scale))
+    assert any(alarms(None))  # the baseline's own near-zero spread: the same unit cries wolf
