@@ -1,0 +1,186 @@
+"""The actuator's compliance chain between its two position sensors, and the thread clearance
+read from a reversal's lost motion through it.
+
+A slow reversal under a load that follows the motion (±F) pushes the nut from one set of flanks
+onto the other. Between the angle sensor and the position sensor, the nut lags the rigid
+kinematics (lead × angle) by the play crossed plus every elastic deflection carried by the
+load; the lag's jump between the two directions is the *lost motion* L
+(:func:`prsm_health.signals.lost_motion.lost_motion_step`). Where the sensors sit decides which
+elements count (the simulator's instrumentation, :mod:`prsm_health.simulation.sensors`):
+
+- ``screw_angle`` is the motor's resolver divided by the reduction N: it reads the gearbox
+  *input*, so the gearhead's backlash and torsion and the coupling are between the sensors;
+- ``nut_position`` reads the nut against the housing (the LVDT's rod is the nut's), so the
+  screw's axial travel on its thrust bearing counts, and the linkage and payload beyond the
+  rod do not.
+
+The chain, from the angle sensor to the position sensor, each term as the peak-to-peak lag
+between +F and −F [m] (``p`` the nut travel per screw radian, lead/2π,
+:attr:`~prsm_health.physics.kinematics.SpeedRatios.nut`):
+
+- gearhead backlash: 2·b_g·p (b_g the half-backlash at the output, ``gear_backlash``);
+- gear and coupling torsion: the screw torque T = F·p/η_s (η_s the screw's efficiency: the
+  motor drives against the load on both strokes), twisting the gear (k_g, at the output) and
+  the coupling (k_c) in series: 2T·(1/k_g + 1/k_c)·p;
+- thrust bearing (and the screw between bearing and nut, which its stiffness includes):
+  2F/k_b + 2·play_b (play_b the half-play, ``thrust_bearing_play``);
+- thread contacts: 2·δ(F), δ the axial approach of the rollers' engagements with the load
+  shared over the engaged threads (paper 04) and over the rollers
+  (:func:`~prsm_health.physics.stiffness.axial.axial_stiffness`; its screw-shaft term is left
+  out: the drive train's bearing stiffness already holds the screw, 1.5e8 N/m "in all");
+- linkage: 0, beyond the position sensor.
+
+Drive-train figures and their sources: :mod:`prsm_health.actuator.drive_train` (gear: Yaskawa
+SGMMV manual §11.1.1, 3 arcmin backlash and 10 arcmin torsion at rated torque; coupling:
+RINGFEDER GWB DKN size 20, 1.5e3 N·m/rad; thrust bearing: engineering estimate).
+
+**What a fitted step reads.** :func:`~prsm_health.signals.lost_motion.lost_motion_step` fits
+one step on the direction of motion over the whole reversal, so it reads the lag averaged over
+the samples of each direction. A play is crossed whole at every load; an elastic term follows
+the load, which in a cosine reversal is F·|cos φ| with φ uniform in time: a linear term reads
+2/π of its peak-to-peak, a Hertzian one (δ ∝ F^(2/3)) about 0.71. :func:`compliance_chain`'s
+``reversal_shape`` gives the chain as that reading sees it (``"constant"``: ±F held, the
+peak-to-peak itself).
+
+**Clearance.** Every roller's thread contacts on the screw side and on the nut side each have
+two flanks and a half-clearance b: each side's dead band is 2b, the sides are in series, so a
+reversal crosses 4b of play at zero load (paper 01's f(δ, b) on both engagements) —
+:data:`CLEARANCE_SLOPE`. :func:`clearance_from_lost_motion` inverts L = chain + 4·b.
+Simulated units read a slightly lower slope (3.80 on the built-in check with uneven wear): the
+rollers' gaps differ (wear spread, pitch errors), the rollers with the smaller gaps carry more
+of the load and, Hertzian, are the stiffer, so the common approach follows a load-weighted
+mean of the gaps, below their plain mean.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.drive_train import SCREW_EFFICIENCY, DriveTrain
+from prsm_health.core.errors import require, require_range
+
+from .kinematics import speed_ratios
+from .stiffness.axial import axial_stiffness
+
+#: Lost motion per metre of the thread half-clearance b: 4 (module docstring, Clearance).
+CLEARANCE_SLOPE = 4.0
+REVERSAL_SHAPES = ("constant", "cosine")
+#: Phases of a cosine reversal averaged over (uniform in time): the mean of |cos φ|^(2/3)
+#: over 256 midpoints is exact to ~1e-4.
+_PHASES = 256
+
+
+@dataclass(frozen=True)
+class LostMotionChain:
+    """Each element's lost motion [m] between the angle and the position sensor, for a reversal
+    between +``load_amplitude`` and −``load_amplitude`` (module docstring: the equations).
+
+    Attributes
+    ----------
+    gear_backlash, gear_coupling_twist, thrust_bearing, thread_contacts, linkage : float [m]
+    load_amplitude : float [N]
+    reversal_shape : {"constant", "cosine"}
+        ``constant``: the peak-to-peak at ±F; ``cosine``: as a step fitted over a cosine
+        reversal reads it (elastic terms averaged over the load's |cos φ|).
+    """
+
+    gear_backlash: float
+    gear_coupling_twist: float
+    thrust_bearing: float
+    thread_contacts: float
+    linkage: float
+    load_amplitude: float
+    reversal_shape: str
+
+    @property
+    def terms(self) -> dict[str, float]:
+        """Element → its lost motion [m], in the chain's order."""
+        return {f.name: getattr(self, f.name) for f in fields(self)[:5]}
+
+    @property
+    def total(self) -> float:
+        """The lost motion of the chain at b = 0 [m]."""
+        return float(sum(self.terms.values()))
+
+
+def compliance_chain(
+    design: PRSMDesign,
+    drive_train: DriveTrain,
+    load_amplitude: float,
+    *,
+    reversal_shape: str = "constant",
+    screw_efficiency: float = SCREW_EFFICIENCY,
+) -> LostMotionChain:
+    """The actuator's lost motion at b = 0 for a reversal under ±``load_amplitude`` [N], element
+    by element (module docstring: the equations, the sensors' places, the sources).
+
+    Parameters
+    ----------
+    design : PRSMDesign
+    drive_train : DriveTrain
+        ``coupled = False`` takes the reduction and coupling as rigid, ``rigid_thrust_bearing``
+        the bearing, ``gear_stiffness = 0`` the gear.
+    load_amplitude : float [N]
+        F > 0, the load on each side of the reversal.
+    reversal_shape : {"constant", "cosine"}
+        How the load follows the reversal: held at ±F (the peak-to-peak), or F·cos of the
+        cosine reversal (the built-in check's), read as a fitted step.
+    screw_efficiency : float [-]
+        η_s of the screw torque T = F·p/η_s (default: the drive train's estimate, 0.85).
+    """
+    require_range("load_amplitude", load_amplitude, 1e-3, 1e7, unit="N")
+    require(
+        reversal_shape in REVERSAL_SHAPES,
+        "reversal_shape",
+        reversal_shape,
+        f"must be one of {', '.join(REVERSAL_SHAPES)}",
+    )
+    require_range("screw_efficiency", screw_efficiency, 0.1, 1.0)
+    dt = drive_train
+    lead = speed_ratios(design).nut  # nut travel per screw radian [m/rad]
+    # the loads the reading averages over (one for ±F held)
+    if reversal_shape == "cosine":
+        phases = (np.arange(_PHASES) + 0.5) * (0.5 * math.pi / _PHASES)
+        loads = load_amplitude * np.cos(phases)
+    else:
+        loads = np.array([float(load_amplitude)])
+    mean_load = float(np.mean(loads))
+
+    rigid_drive = not dt.coupled
+    backlash = 0.0 if rigid_drive or not dt.geared else 2.0 * dt.gear_backlash * lead
+    twist = 0.0
+    if not rigid_drive:
+        compliance = 1.0 / dt.coupling_stiffness
+        if dt.geared and dt.gear_stiffness > 0.0:
+            compliance += 1.0 / dt.gear_stiffness
+        twist = 2.0 * mean_load * lead / screw_efficiency * compliance * lead
+    bearing = 0.0
+    if not dt.rigid_thrust_bearing:
+        bearing = 2.0 * mean_load / dt.thrust_bearing_stiffness + 2.0 * dt.thrust_bearing_play
+    axial = axial_stiffness(design, loads)
+    contact = axial.deformation - axial.deformation_split["shaft"]
+    return LostMotionChain(
+        gear_backlash=float(backlash),
+        gear_coupling_twist=float(twist),
+        thrust_bearing=float(bearing),
+        thread_contacts=float(2.0 * np.mean(contact)),
+        linkage=0.0,
+        load_amplitude=float(load_amplitude),
+        reversal_shape=reversal_shape,
+    )
+
+
+def clearance_from_lost_motion(
+    lost_motion: float, chain: LostMotionChain, slope: float = CLEARANCE_SLOPE
+) -> float:
+    """The thread half-clearance b [m] from a reversal's lost motion L [m]:
+    b = (L − chain.total)/slope, slope 4 (module docstring: 4b of play at zero load). Negative
+    when L is below the chain (a preload, or a chain softer than the actuator's): not clipped,
+    so the error shows."""
+    require(math.isfinite(lost_motion), "lost_motion", lost_motion, "must be a finite length")
+    require_range("slope", slope, 0.5, 10.0)
+    return (lost_motion - chain.total) / slope
