@@ -1,4 +1,5 @@
-"""An asset's status at a glance — ``healthy``, ``watch`` or ``alarm`` — with the reasons, from
+"""An asset's status at a glance — ``healthy``, ``unknown``, ``watch`` or ``alarm`` — with the
+reasons, from
 what the store keeps of it: its evidence and change statistic after its latest recording, its
 baseline, and its latest diagnosis's class. The one rule the fleet page shows
 (docs/service.md, Dashboard); the page only displays it.
@@ -9,9 +10,12 @@ baseline, and its latest diagnosis's class. The one rule the fleet page shows
 * **watch**: the change statistic above half its threshold (a change building up), the
   evidence's most probable class a fault though not yet named, or the latest diagnosis naming a
   fault class (one recording: the evidence has not confirmed it);
-* **healthy**: none of these. Said with its limits — the reasons say so while the baseline is
-  incomplete (no change can be scored), before any evidence has accumulated, and when the
-  latest diagnosis cannot tell the class.
+* **healthy**: none of these, and something says healthy — the evidence names it or leans to
+  it, or the latest diagnosis names it; said with its limits (the reasons say so while the
+  baseline is incomplete or before any evidence has accumulated);
+* **unknown**: none of these, and nothing says healthy either (the diagnoses could not tell
+  the class, no evidence yet): the page says "cannot tell" and what to record next, never
+  "healthy" for an asset nothing has shown to be.
 """
 
 from __future__ import annotations
@@ -22,8 +26,8 @@ from prsm_health.diagnostics.contract import CANNOT_TELL
 
 from .asset import HEALTHY
 
-#: The status words, from the best to the worst.
-LEVELS = ("healthy", "watch", "alarm")
+#: The status levels, from the best to the worst.
+LEVELS = ("healthy", "unknown", "watch", "alarm")
 #: A change statistic above this share of its threshold puts the asset on watch.
 WATCH_SHARE = 0.5
 
@@ -79,5 +83,13 @@ def asset_status(
         notes.append("no evidence accumulated yet (the baseline's recordings add none)")
     if latest_class == CANNOT_TELL:
         notes.append("the latest diagnosis cannot tell the class")
-    level = "alarm" if alarm else "watch" if watch else "healthy"
+    top = max(posterior, key=posterior.get) if posterior and evidence.get("recordings") else None
+    says_healthy = HEALTHY in (named, top, latest_class)
+    if alarm or watch:
+        level = "alarm" if alarm else "watch"
+    elif says_healthy:
+        level = "healthy"
+    else:
+        level = "unknown"
+        notes.append("record next: health checks of the unit (its baseline, then evidence)")
     return {"level": level, "reasons": alarm + watch + notes}

@@ -1,4 +1,4 @@
-"""The asset status rule (healthy / watch / alarm) of the fleet page: each branch of
+"""The asset status rule (healthy / unknown / watch / alarm) of the fleet page: each branch of
 :func:`prsm_health.monitoring.status.asset_status` on the evidence the store keeps."""
 
 import pytest
@@ -31,7 +31,10 @@ def evidence(**given):
         (evidence(change_statistic=WATCH_SHARE * 5.0), "healthy", "healthy", None),
         (evidence(posterior={"healthy": 0.3, "wear": 0.7}), "healthy", "watch", "leans to wear"),
         (evidence(), "wear", "watch", "latest diagnosis names wear"),
+        # the evidence leans to healthy: healthy, with the latest's limit said
         (evidence(), "cannot_tell", "healthy", "cannot tell the class"),
+        # nothing says healthy: unknown, never healthy, and what to record next
+        (evidence(recordings=0, posterior={}), "cannot_tell", "unknown", "record next"),
     ],
 )
 def test_each_branch_of_the_rule(state, latest, level, reason):
@@ -47,6 +50,7 @@ def test_the_worst_level_wins_and_every_reason_is_kept():
     state = evidence(change_alarm=True, posterior={"healthy": 0.4, "wear": 0.6})
     status = asset_status(state, BASELINE, "wear")
     assert status["level"] == "alarm" and status["level"] == LEVELS[-1]
+    assert LEVELS.index("unknown") < LEVELS.index("watch")
     assert len(status["reasons"]) == 3  # the alarm first, then the two watches
     assert "change alarm" in status["reasons"][0]
 
@@ -60,3 +64,13 @@ def test_without_a_complete_baseline_it_says_no_change_is_scored():
     assert making["level"] == "healthy" and "baseline 1 of 3" in making["reasons"][0]
     complete = asset_status(evidence(recordings=0), BASELINE, "healthy")
     assert complete["level"] == "healthy" and "no evidence" in complete["reasons"][0]
+
+
+def test_an_asset_nothing_has_shown_healthy_is_not_called_healthy():
+    # one recording, its class not told, no evidence: "unknown" with why and what to record
+    status = asset_status(
+        evidence(recordings=0, posterior={}), {"recordings": 1, "needed": 3}, "cannot_tell"
+    )
+    assert status["level"] == "unknown"
+    assert any("baseline 1 of 3" in r for r in status["reasons"])
+    assert any("record next" in r for r in status["reasons"])

@@ -288,7 +288,7 @@ class AssetStatus(BaseModel):
     """The asset at a glance (``prsm_health.monitoring.status.asset_status``; docs/service.md,
     Dashboard)."""
 
-    level: str = Field(description="'healthy', 'watch' or 'alarm'")
+    level: str = Field(description="'healthy', 'unknown' (cannot tell yet), 'watch' or 'alarm'")
     reasons: list[str] = Field(description="why, worst first, and what it cannot tell yet")
 
 
@@ -419,7 +419,7 @@ class AssetSummary(BaseModel):
     evidence: AssetEvidence | None = Field(
         description="its accumulated evidence after its latest recording (null: none recorded)"
     )
-    status: AssetStatus = Field(description="healthy, watch or alarm, and why")
+    status: AssetStatus = Field(description="healthy, unknown, watch or alarm, and why")
     prognosis: PrognosisBrief | None = Field(
         None, description="with `prognosis=true`: the RUL in brief, or why there is none"
     )

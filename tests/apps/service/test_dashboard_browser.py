@@ -261,7 +261,7 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
         link = page.locator(f"a:text-is('{asset['asset_id']}')")
         word = page.locator("#fleet tbody tr", has=link).locator("td").first.locator(".status-word")
         level = asset["status"]["level"]
-        assert level in ("healthy", "watch", "alarm")
+        assert level in ("healthy", "unknown", "watch", "alarm")
         assert word.text_content() == level
         assert f"status-{level}" in word.get_attribute("class").split()
         colour = word.evaluate("(e) => getComputedStyle(e).backgroundColor")

@@ -36,7 +36,7 @@ PH.ready(async () => {
   }
 });
 
-// healthy / watch / alarm, as the service's rule gives it (GET /v1/assets: status), in word
+// healthy / unknown / watch / alarm, as the service's rule gives it (GET /v1/assets: status), in word
 // and colour, with its reasons below
 function statusCell(status) {
   const cell = PH.el("td");
