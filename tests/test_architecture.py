@@ -37,6 +37,8 @@ ONE_JOB = {
     "physics/stiffness/cylinder.py": "paper 05's electric-cylinder deformation model",
     "actuator/design.py": "the PRSM design dataclasses, their validation and the presets",
     "diagnostics/estimators.py": "the scikit-learn estimators of a diagnosis model",
+    "simulation/sensors.py": "the sensor models: what each sensor of a profile makes of a truth "
+    "signal (its errors, filters, noise), and the delay its filters give",
     "simulation/dynamics/_kernels.py": "the numba right-hand side and RK4 of the PRSM model",
 }
 

@@ -28,7 +28,14 @@ between +F and −F [m] (``p`` the nut travel per screw radian, lead/2π,
   shared over the engaged threads (paper 04) and over the rollers
   (:func:`~prsm_health.physics.stiffness.axial.axial_stiffness`; its screw-shaft term is left
   out: the drive train's bearing stiffness already holds the screw, 1.5e8 N/m "in all");
-- linkage: 0, beyond the position sensor.
+- linkage: 0, beyond the position sensor;
+- sensor lag: the sensors' own delays (not the actuator's: ``sensor_delays``, 0 for ideal
+  sensors). A channel read through a filter lags the motion by its group delay τ (at the
+  reversal's frequency; a first-order low-pass at f_c: τ ≈ 1/(2π·f_c)), so the position
+  reads x − τ_x·v and the angle θ − τ_θ·ω: the lag position − p·angle gains −(τ_x − τ_θ)·v,
+  which flips with the motion as the play does. Over the two directions that is
+  2·(τ_x − τ_θ)·|v| (negative when the angle lags more; a delay common to both cancels), v the
+  nut speed p·ω.
 
 Drive-train figures and their sources: :mod:`prsm_health.actuator.drive_train` (gear: Yaskawa
 SGMMV manual §11.1.1, 3 arcmin backlash and 10 arcmin torsion at rated torque; coupling:
@@ -40,7 +47,12 @@ the samples of each direction. A play is crossed whole at every load; an elastic
 the load, which in a cosine reversal is F·|cos φ| with φ uniform in time: a linear term reads
 2/π of its peak-to-peak, a Hertzian one (δ ∝ F^(2/3)) about 0.71. :func:`compliance_chain`'s
 ``reversal_shape`` gives the chain as that reading sees it (``"constant"``: ±F held, the
-peak-to-peak itself).
+peak-to-peak itself). The step is fitted beside a polynomial in the position, which cannot
+absorb a term that flips with the motion; each position is passed in both directions, so the
+step reads the lag's mean times the direction: the sensor lag reads 2·Δτ·p·ω times the mean of
+|cos φ|, 2/π, like a linear elastic term (measured, the flight-ema LVDT's 0.318 ms as a pure
+delay on an ideal run: +6.64 µm against the 6.45 µm of this mean, the 3 % the fit's polynomial
+and the nut's elastic motion move).
 
 **Clearance.** Every roller's thread contacts on the screw side and on the nut side each have
 two flanks and a half-clearance b: each side's dead band is 2b, the sides are in series, so a
@@ -55,6 +67,7 @@ mean of the gaps, below their plain mean.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -69,6 +82,8 @@ from .stiffness.axial import axial_stiffness
 #: Lost motion per metre of the thread half-clearance b: 4 (module docstring, Clearance).
 CLEARANCE_SLOPE = 4.0
 REVERSAL_SHAPES = ("constant", "cosine")
+#: The channels the lost motion reads, whose delays enter the sensor term.
+DELAYED_CHANNELS = ("nut_position", "screw_angle")
 #: Phases of a cosine reversal averaged over (uniform in time): the mean of |cos φ|^(2/3)
 #: over 256 midpoints is exact to ~1e-4.
 _PHASES = 256
@@ -82,6 +97,8 @@ class LostMotionChain:
     Attributes
     ----------
     gear_backlash, gear_coupling_twist, thrust_bearing, thread_contacts, linkage : float [m]
+    sensor_lag : float [m]
+        The position sensor's delay behind the angle sensor's, as lost motion (0: ideal).
     load_amplitude : float [N]
     reversal_shape : {"constant", "cosine"}
         ``constant``: the peak-to-peak at ±F; ``cosine``: as a step fitted over a cosine
@@ -93,13 +110,14 @@ class LostMotionChain:
     thrust_bearing: float
     thread_contacts: float
     linkage: float
+    sensor_lag: float
     load_amplitude: float
     reversal_shape: str
 
     @property
     def terms(self) -> dict[str, float]:
         """Element → its lost motion [m], in the chain's order."""
-        return {f.name: getattr(self, f.name) for f in fields(self)[:5]}
+        return {f.name: getattr(self, f.name) for f in fields(self)[:6]}
 
     @property
     def total(self) -> float:
@@ -114,6 +132,8 @@ def compliance_chain(
     *,
     reversal_shape: str = "constant",
     screw_efficiency: float = SCREW_EFFICIENCY,
+    speed_amplitude: float | None = None,
+    sensor_delays: Mapping[str, float] | None = None,
 ) -> LostMotionChain:
     """The actuator's lost motion at b = 0 for a reversal under ±``load_amplitude`` [N], element
     by element (module docstring: the equations, the sensors' places, the sources).
@@ -131,6 +151,14 @@ def compliance_chain(
         cosine reversal (the built-in check's), read as a fitted step.
     screw_efficiency : float [-]
         η_s of the screw torque T = F·p/η_s (default: the drive train's estimate, 0.85).
+    speed_amplitude : float [rad/s], optional
+        The screw speed ω of the reversal (its amplitude for a cosine); needed with
+        ``sensor_delays``.
+    sensor_delays : mapping, optional
+        ``{"nut_position": τ_x, "screw_angle": τ_θ}`` [s], each channel's group delay at the
+        reversal's frequency (a missing channel: 0; from a simulated instrumentation,
+        :func:`prsm_health.simulation.sensors.channel_group_delay`). None: ideal sensors, no
+        sensor term.
     """
     require_range("load_amplitude", load_amplitude, 1e-3, 1e7, unit="N")
     require(
@@ -161,6 +189,21 @@ def compliance_chain(
     bearing = 0.0
     if not dt.rigid_thrust_bearing:
         bearing = 2.0 * mean_load / dt.thrust_bearing_stiffness + 2.0 * dt.thrust_bearing_play
+    sensor_lag = 0.0
+    if sensor_delays is not None:
+        unknown = set(sensor_delays) - set(DELAYED_CHANNELS)
+        require(
+            not unknown, "sensor_delays", sorted(unknown), f"keys: {', '.join(DELAYED_CHANNELS)}"
+        )
+        require(speed_amplitude is not None, "speed_amplitude", None, "needed with sensor_delays")
+        require_range("speed_amplitude", speed_amplitude, 1e-6, 1e4, unit="rad/s")
+        delays = {c: float(sensor_delays.get(c, 0.0)) for c in DELAYED_CHANNELS}
+        for channel, delay in delays.items():
+            require_range(f"sensor_delays.{channel}", delay, -1.0, 1.0, unit="s")
+        # |v| averaged like the loads: p·ω·|cos φ| follows the same phases as F·|cos φ|
+        mean_speed = lead * speed_amplitude * mean_load / load_amplitude
+        lag = delays["nut_position"] - delays["screw_angle"]
+        sensor_lag = 2.0 * lag * mean_speed
     axial = axial_stiffness(design, loads)
     contact = axial.deformation - axial.deformation_split["shaft"]
     return LostMotionChain(
@@ -169,6 +212,7 @@ def compliance_chain(
         thrust_bearing=float(bearing),
         thread_contacts=float(2.0 * np.mean(contact)),
         linkage=0.0,
+        sensor_lag=float(sensor_lag),
         load_amplitude=float(load_amplitude),
         reversal_shape=reversal_shape,
     )

@@ -40,12 +40,27 @@ TRANSVERSE = {
 
 
 # ----------------------------------------------------------------------------- signal blocks
+def _lowpass_sos(corner: float, rate: float) -> np.ndarray | None:
+    """The first-order low-pass at ``corner`` [Hz] run at ``rate``, None where it is left out."""
+    if corner <= 0 or corner >= _MAX_CORNER * rate:
+        return None
+    return signal.butter(1, corner, btype="low", fs=rate, output="sos")
+
+
 def _lowpass(x: np.ndarray, corner: float, rate: float) -> np.ndarray:
     """First-order causal low-pass at ``corner`` [Hz], started in steady state at x[0]."""
-    if corner <= 0 or corner >= _MAX_CORNER * rate:
+    sos = _lowpass_sos(corner, rate)
+    if sos is None:
         return x
-    sos = signal.butter(1, corner, btype="low", fs=rate, output="sos")
     return signal.sosfilt(sos, x, zi=signal.sosfilt_zi(sos) * x[0])[0]
+
+
+def _group_delay(sos: np.ndarray | None, frequency: float, rate: float) -> float:
+    """Group delay [s] at ``frequency`` of a filter run at ``rate`` (0 for no filter)."""
+    if sos is None:
+        return 0.0
+    _, samples = signal.group_delay(signal.sos2tf(sos), w=[frequency], fs=rate)
+    return float(samples[0]) / rate
 
 
 def _highpass(x: np.ndarray, corner: float, rate: float) -> np.ndarray:
@@ -160,6 +175,15 @@ class Sensor:
             amplitudes_name,
             list(amplitudes),
             f"needs one amplitude per entry of {orders_name} ({len(orders)})",
+        )
+
+    def group_delay(self, frequency: float, rate: float, factor: int) -> float:
+        """The delay [s] the sensor's filters give a signal at ``frequency`` [Hz] (the truth at
+        the integration ``rate``, logged every ``factor``-th sample), beyond the logger's
+        anti-alias decimation (linear phase, no delay, common to every channel). Only the
+        sensors that read a motion or a drive quantity model it."""
+        raise ParameterError(
+            "channel", self.KIND, "has no group-delay model (angle, speed, position, load, torque)"
         )
 
     def to_dict(self) -> dict:
@@ -299,6 +323,10 @@ class AngleSensor(_ReportsOutput):
         self._range("noise", 0.0, 0.1)
         self._range("gear_ratio", 1.0, 1000.0)
 
+    def group_delay(self, frequency: float, rate: float, factor: int) -> float:
+        """0: the angle is read as it is (errors, noise, quantisation; no filter)."""
+        return 0.0
+
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         theta = decimate(_truth(truth, self.SOURCE, channel), factor)
         phases = rng.uniform(0.0, 2 * np.pi, len(self.harmonic_orders))
@@ -345,6 +373,15 @@ class SpeedEstimate(_ReportsOutput):
         self._range("bandwidth", 0.0, 1e6)
         require(isinstance(self.exact, bool), "exact", self.exact, "must be true or false")
         self._range("gear_ratio", 1.0, 1000.0)
+
+    def group_delay(self, frequency: float, rate: float, factor: int) -> float:
+        """The backward difference's half sample plus the velocity filter's delay, both at the
+        sample rate (0 when ``exact``)."""
+        if self.exact:
+            return 0.0
+        sample_rate = rate / factor
+        lowpass = _lowpass_sos(self.bandwidth, sample_rate)
+        return 0.5 / sample_rate + _group_delay(lowpass, frequency, sample_rate)
 
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         if self.exact:
@@ -439,6 +476,10 @@ class TorqueEstimate(Sensor):
         # None (= the drive train's motor) has no TOML form: such keys are left out.
         return {k: v for k, v in super().to_dict().items() if v is not None}
 
+    def group_delay(self, frequency: float, rate: float, factor: int) -> float:
+        """The current loop's low-pass, run at the integration rate."""
+        return _group_delay(_lowpass_sos(self.bandwidth, rate), frequency, rate)
+
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         gain = 1.0 + rng.normal(0.0, self.gain_sigma)
         phases = rng.uniform(0.0, 2 * np.pi, len(self.ripple_orders))
@@ -493,6 +534,10 @@ class _LinearTransducer(Sensor):
             self.full_scale,
             "must be > 0 when nonlinearity is given (it is a fraction of the full scale)",
         )
+
+    def group_delay(self, frequency: float, rate: float, factor: int) -> float:
+        """The conditioning electronics' low-pass, run at the integration rate."""
+        return _group_delay(_lowpass_sos(self.bandwidth, rate), frequency, rate)
 
     def measure(self, channel, truth, rate, factor, rng, measured) -> np.ndarray:
         gain = 1.0 + rng.normal(0.0, self.gain_sigma)
@@ -783,3 +828,31 @@ SENSOR_CLASSES: dict[str, type[Sensor]] = {
     # last: a new entry takes the next child stream, so the others' draws are unchanged
     "housing_temperature": TemperatureSensor,
 }
+
+
+def channel_group_delay(
+    instrumentation, channel: str, frequency: float, integration_rate: float
+) -> float:
+    """The delay [s] the sensor of ``channel`` gives a signal at ``frequency`` [Hz]: its
+    filters' group delay (:meth:`Sensor.group_delay`, scipy.signal.group_delay on the filter
+    the sensor applies), the anti-alias decimation left out (linear phase, common to all).
+
+    Parameters
+    ----------
+    instrumentation : Instrumentation
+    channel : str
+        A fitted channel whose sensor reads a motion or a drive quantity (``screw_angle``,
+        ``screw_speed``, ``nut_position``, ``drive_torque``, ``axial_load``).
+    frequency : float [Hz]
+        Of the motion (a reversal's 1/period); well below a corner the delay barely depends on it.
+    integration_rate : float [Hz]
+        The rate the sensors' filters run at (a run's 1/``scenario["integration_step"]``); a
+        multiple of the instrumentation's sample rate.
+    """
+    require(channel in SENSOR_CLASSES, "channel", channel, f"must be one of {list(SENSOR_CLASSES)}")
+    spec = getattr(instrumentation, channel)
+    require(spec is not None, "channel", channel, f"is not fitted in {instrumentation.name!r}")
+    require_range("frequency", frequency, 0.0, 0.5 * instrumentation.sample_rate, unit="Hz")
+    factor = int(round(integration_rate / instrumentation.sample_rate))
+    require(factor >= 1, "integration_rate", integration_rate, "must be ≥ the sample rate")
+    return spec.group_delay(frequency, integration_rate, factor)

@@ -6,7 +6,9 @@ paper-01 design, ``ideal`` instrumentation, seed 0: the lost-motion step
 default drive train — intercept and slope of a line fit —, then at b = 0 with one drive-train
 figure changed at a time, each beside the chain's prediction
 (:func:`prsm_health.physics.lost_motion_chain.compliance_chain`, read as the cosine reversal's
-fitted step). Quoted in docs/diagnostics.md ("Clearance from the check's lost motion").
+fitted step); last, at b = 0 the ``flight-ema`` sensors against ``ideal`` beside the chain's
+sensor term (the LVDT's filter delay, :func:`prsm_health.simulation.sensors.channel_group_delay`).
+Quoted in docs/diagnostics.md ("Clearance from the check's lost motion").
 
     python tools/studies/lost_motion_chain.py        # ≈ 30 s on one core
 """
@@ -23,7 +25,9 @@ from prsm_health.physics.kinematics import speed_ratios
 from prsm_health.physics.load_rating import load_ratings
 from prsm_health.physics.lost_motion_chain import compliance_chain
 from prsm_health.signals.lost_motion import lost_motion_step
+from prsm_health.simulation.instrumentation import load_instrumentation
 from prsm_health.simulation.scenario import simulate
+from prsm_health.simulation.sensors import channel_group_delay
 
 DESIGN = preset("paper01")
 REVERSAL = HealthCheck(
@@ -53,18 +57,24 @@ CHANGES = {
 }
 
 
-def simulated_step(clearance: float, drive_train: DriveTrain) -> float:
+def simulated_run(clearance: float, drive_train: DriveTrain, instrumentation: str = "ideal"):
+    """(lost-motion step [m], integration rate [Hz]) of the slow reversal."""
     run = simulate(
         DESIGN,
         HealthState.uniform(clearance),
         OperatingProfile(check=REVERSAL),
-        "ideal",
+        instrumentation,
         0,
         drive_train=drive_train,
     )
     c = run.phases()["slow reversal"].channels
     lead = speed_ratios(DESIGN).nut
-    return lost_motion_step(c["nut_position"], c["screw_angle"], lead, np.sign(c["screw_speed"]))
+    step = lost_motion_step(c["nut_position"], c["screw_angle"], lead, np.sign(c["screw_speed"]))
+    return step, 1.0 / run.scenario["integration_step"]
+
+
+def simulated_step(clearance: float, drive_train: DriveTrain) -> float:
+    return simulated_run(clearance, drive_train)[0]
 
 
 def main() -> None:
@@ -88,6 +98,31 @@ def main() -> None:
         sim = simulated_step(0.0, dt)
         pred = compliance_chain(DESIGN, dt, load, reversal_shape="cosine").total
         print(f"  {label:24s} {sim * 1e6:6.2f}  {pred * 1e6:6.2f}  {(sim - pred) * 1e6:+5.2f}")
+
+    phase = REVERSAL.phases[0]
+    ideal, rate = simulated_run(0.0, DriveTrain())
+    flight = simulated_run(0.0, DriveTrain(), "flight-ema")[0]
+    instrumentation = load_instrumentation("flight-ema")
+    delays = {
+        c: channel_group_delay(instrumentation, c, 1.0 / phase.reversal_period, rate)
+        for c in ("nut_position", "screw_angle")
+    }
+    sensed = compliance_chain(
+        DESIGN,
+        DriveTrain(),
+        load,
+        reversal_shape="cosine",
+        speed_amplitude=phase.speed,
+        sensor_delays=delays,
+    )
+    print(
+        "\nb = 0, flight-ema sensors: group delays "
+        + ", ".join(f"{c} {d * 1e3:.3f} ms" for c, d in delays.items())
+    )
+    print(
+        f"  simulated {flight * 1e6:.2f} (ideal {ideal * 1e6:.2f}, +{(flight - ideal) * 1e6:.2f})"
+        f"; chain {sensed.total * 1e6:.2f} (sensor lag +{sensed.sensor_lag * 1e6:.2f})"
+    )
 
 
 if __name__ == "__main__":
