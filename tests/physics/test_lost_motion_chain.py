@@ -11,7 +11,7 @@ import pytest
 
 from prsm_health.actuator.design import preset
 from prsm_health.actuator.drive_train import DriveTrain
-from prsm_health.actuator.health_check import CheckPhase, HealthCheck
+from prsm_health.actuator.health_check import BUILT_IN, HealthCheck
 from prsm_health.actuator.states import HealthState, OperatingProfile
 from prsm_health.core.errors import ParameterError
 from prsm_health.physics.kinematics import speed_ratios
@@ -117,20 +117,10 @@ def test_clearance_inverts_the_chain():
         compliance_chain(DESIGN, DriveTrain(), LOAD, reversal_shape="square")
 
 
+#: The built-in check's slow reversal alone (the phase the lost-motion step is read on).
 REVERSAL = HealthCheck(
     "slow-reversal",
-    (
-        CheckPhase(
-            "slow reversal",
-            "reversing",
-            speed=10.0,
-            load="25 % C_a",
-            duration=0.5,
-            ramp_time=0.05,
-            reversal_shape="cosine",
-            reversal_period=0.25,
-        ),
-    ),
+    tuple(p for p in BUILT_IN["health-check"].phases if p.name == "slow reversal"),
 )
 
 
