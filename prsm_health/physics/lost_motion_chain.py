@@ -62,6 +62,16 @@ Simulated units read a slightly lower slope (3.80 on the built-in check with une
 rollers' gaps differ (wear spread, pitch errors), the rollers with the smaller gaps carry more
 of the load and, Hertzian, are the stiffer, so the common approach follows a load-weighted
 mean of the gaps, below their plain mean.
+
+References
+----------
+- Paper 01 (docs/references.md) §1.1–1.3 — the backlash function f(δ, b) of each thread
+  engagement (the dead band of 2b per engagement behind :data:`CLEARANCE_SLOPE`).
+- Paper 04 (docs/references.md) — the axial stiffness of the engaged threads,
+  1/K_total = 1/K_engaged + 1/K_shaft (the thread-contact term; its K_shaft part left out).
+- ISO 230-2:2014 §3.2 — the reversal value B: the mean offset between the two directions of
+  approach, which :func:`~prsm_health.signals.lost_motion.lost_motion_step` fits.
+- Drive train: :mod:`prsm_health.actuator.drive_train` (the datasheets named above).
 """
 
 from __future__ import annotations
