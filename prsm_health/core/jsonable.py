@@ -30,6 +30,18 @@ def json_ready(value):
     return value
 
 
+def as_finite(value) -> float | None:
+    """``value`` as a finite float, or None (missing, None, a bool, NaN, ±inf, not a number):
+    the lenient reading of a number that came through a table or a JSON file."""
+    if value is None or isinstance(value, bool):
+        return None
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) else None
+
+
 def finite_or_none(value) -> float | None:
     """A finite float, or None for None/NaN/±inf."""
     if value is None:

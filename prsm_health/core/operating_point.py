@@ -12,11 +12,11 @@ request fields.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 from .errors import require
+from .jsonable import as_finite
 
 #: The design of a recording from a rig that is not a PRSM: the indicators that need a PRSM's
 #: kinematics are NaN (an imported rig's labels say ``design = None``).
@@ -38,16 +38,9 @@ _NUMBERS = {
 def _usable(name: str, value) -> float | None:
     """``value`` as a float when it is a valid ``name`` (a finite number in its range; numpy
     scalars too), else None (absent, None, NaN read back from a table, text, a bool)."""
-    if value is None or isinstance(value, (bool, str)):
-        return None
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        return None
+    number = None if isinstance(value, str) else as_finite(value)
     low, inclusive, _ = _NUMBERS[name]
-    if not math.isfinite(number) or (
-        low is not None and not (number >= low if inclusive else number > low)
-    ):
+    if number is None or (low is not None and not (number >= low if inclusive else number > low)):
         return None
     return number
 

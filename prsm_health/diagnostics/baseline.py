@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from prsm_health.core.errors import ParameterError, require
+from prsm_health.core.jsonable import as_finite
 
 #: 1/Φ⁻¹(3/4): makes the median absolute deviation a consistent estimate of a normal
 #: distribution's standard deviation (Hampel 1974).
@@ -49,17 +50,6 @@ PRIOR_WEIGHT = 3.0
 CENTRE_FLOOR = 0.01
 #: … nor below this fraction of the prior scale, where one is given.
 PRIOR_FLOOR = 0.1
-
-
-def finite_float(value) -> float | None:
-    """``value`` as a finite float, or None (missing, None, NaN, ±inf, not a number)."""
-    if value is None or isinstance(value, bool):
-        return None
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        return None
-    return value if math.isfinite(value) else None
 
 
 def mad_factor(n: int) -> float:
@@ -207,7 +197,7 @@ class Baseline:
             f"empty or one identifier per row ({len(rows)})",
         )
         require(
-            finite_float(prior_weight) is not None and prior_weight >= 0,
+            as_finite(prior_weight) is not None and prior_weight >= 0,
             "prior_weight",
             prior_weight,
             "a finite number >= 0",
@@ -217,14 +207,14 @@ class Baseline:
         priors = {
             str(name): float(value)
             for name, value in (prior_scale or {}).items()
-            if finite_float(value) is not None and value > 0
+            if as_finite(value) is not None and value > 0
         }
         if names is None:
-            names = [n for n in rows[0] if all(finite_float(r.get(n)) is not None for r in rows)]
+            names = [n for n in rows[0] if all(as_finite(r.get(n)) is not None for r in rows)]
         kept, centres, scales = [], [], []
         for name in dict.fromkeys(names):
             values = np.array(
-                [v for v in (finite_float(r.get(name)) for r in rows) if v is not None], dtype=float
+                [v for v in (as_finite(r.get(name)) for r in rows) if v is not None], dtype=float
             )
             if values.size == 0:
                 continue
@@ -251,7 +241,7 @@ class Baseline:
         recording lacks the indicator (missing, None, NaN)."""
         out = {}
         for name, centre, scale in zip(self.names, self.center, self.scale):
-            x = finite_float(row.get(name))
+            x = as_finite(row.get(name))
             out[name] = float("nan") if x is None else (x - centre) / scale
         return out
 

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from prsm_health.core.errors import require
-from prsm_health.diagnostics.baseline import finite_float
+from prsm_health.core.jsonable import as_finite
 from prsm_health.diagnostics.contract import CANNOT_TELL
 
 #: Floor of a class probability in :meth:`Evidence.update`: one recording changes a class's
@@ -167,15 +167,15 @@ class Evidence:
             unknown,
             f"classes of the evidence only: {', '.join(self.classes)}",
         )
-        require(finite_float(floor) is not None and 0 < floor < 1, "floor", floor, "in (0, 1)")
+        require(as_finite(floor) is not None and 0 < floor < 1, "floor", floor, "in (0, 1)")
         require(
-            finite_float(forgetting) is not None and 0 < forgetting <= 1,
+            as_finite(forgetting) is not None and 0 < forgetting <= 1,
             "forgetting",
             forgetting,
             "in (0, 1]",
         )
         prior = _class_weights(self.classes, training_prior, "training_prior")
-        p = np.array([finite_float(probabilities.get(c, 0.0)) or 0.0 for c in self.classes])
+        p = np.array([as_finite(probabilities.get(c, 0.0)) or 0.0 for c in self.classes])
         log_lik = np.log(np.maximum(p, floor)) - np.log(prior)
         log_post = forgetting * np.array(self.log_posterior) + log_lik
         return Evidence(self.classes, tuple(_normalised(log_post).tolist()), self.recordings + 1)
@@ -209,7 +209,7 @@ def _class_weights(classes: tuple[str, ...], weights: Mapping | None, field: str
         return np.full(len(classes), 1.0 / len(classes))
     missing = [c for c in classes if c not in weights]
     require(not missing, field, sorted(weights), f"a value for every class: {', '.join(classes)}")
-    values = np.array([finite_float(weights[c]) or 0.0 for c in classes])
+    values = np.array([as_finite(weights[c]) or 0.0 for c in classes])
     require(bool(np.all(values > 0)), field, dict(weights), "probabilities > 0 for every class")
     return values / values.sum()
 
@@ -249,16 +249,14 @@ class Cusum:
 
     def __post_init__(self):
         require(
-            finite_float(self.statistic) is not None and self.statistic >= 0,
+            as_finite(self.statistic) is not None and self.statistic >= 0,
             "Cusum.statistic",
             self.statistic,
             "a finite number >= 0",
         )
+        require(as_finite(self.reference) is not None, "Cusum.reference", self.reference, "finite")
         require(
-            finite_float(self.reference) is not None, "Cusum.reference", self.reference, "finite"
-        )
-        require(
-            finite_float(self.threshold) is not None and self.threshold > 0,
+            as_finite(self.threshold) is not None and self.threshold > 0,
             "Cusum.threshold",
             self.threshold,
             "a finite number > 0",
@@ -267,7 +265,7 @@ class Cusum:
     def update(self, value: float) -> Cusum:
         """The statistic after one more change score ``value``; a missing (None, NaN) score
         leaves it as it is."""
-        x = finite_float(value)
+        x = as_finite(value)
         if x is None:
             return self
         s = max(0.0, self.statistic + x - self.reference)
