@@ -478,6 +478,24 @@ BUILT_IN: dict[str, HealthCheck] = {
                 duration=0.52,
                 ramp_time=_RAMP,
             ),
+            # Clearance by physics: the slow reversal again at a lighter load, ±10 % C_a, so
+            # the lost motion extrapolates to zero load and the unit's own stiffnesses drop out
+            # of the reading (prsm_health.diagnostics.clearance_gauge: the reading's spread
+            # over the documented bearing, coupling and lubricant ranges falls from ≈ 4 to
+            # ≈ 0.2 µm of b). 10 % rather than 5 %: the extrapolation's weights grow the noise
+            # ×2 at 10 %, and at 5 % the light reversal's own error doubled (measured,
+            # tools/studies/clearance_gauge.py). Last, so the phases before it are the check
+            # as it was (the models trained on them read the same phases).
+            CheckPhase(
+                "light reversal",
+                "reversing",
+                speed=10.0,
+                load="10 % C_a",
+                duration=0.5,
+                ramp_time=_RAMP,
+                reversal_shape="cosine",
+                reversal_period=0.25,
+            ),
         ),
     ),
 }

@@ -29,7 +29,14 @@ from prsm_health.core.jsonable import finite_or_none
 from prsm_health.core.run import Run
 
 from .answer import ambiguous, fault_answer, not_observable
-from .contract import CANNOT_TELL, ClearanceInterval, Diagnosis, Observability
+from .contract import (
+    CANNOT_TELL,
+    ClearanceInterval,
+    Diagnosis,
+    MeasuredClearance,
+    Observability,
+    ReversalRead,
+)
 
 #: Prefix of a change feature: the robust z-score of an indicator against the unit's baseline.
 CHANGE_PREFIX = "z_"
@@ -150,14 +157,100 @@ def baseline_only_note(cls: str, reason: str) -> str:
     )
 
 
-def cut_note(cut: dict[str, str], classes) -> str:
+def measured_clearance(reading, bundle, commissioning, learnt, notes: list[str]):
+    """(the clearance measured by physics, its contract part) from a check's reversals
+    (:mod:`~prsm_health.diagnostics.clearance_gauge`), the learnt reading ``learnt`` (a
+    :class:`ClearanceInterval` or None) beside it; (None, None) without a reversal or a
+    design. Adds to ``notes`` why a reversal was not read, the gauge's own notes, a
+    disagreement with the learnt reading and, not commissioned, how to narrow the interval."""
+    gauge = bundle.clearance_gauge
+    if gauge is None or not reading.reversals:
+        return None, None
+    measured = gauge.read(reading.reversals, commissioning)
+    for phase, why in reading.unread_reversals.items():
+        notes.append(
+            f'reversal "{phase}" not read ({why}): the clearance is measured from '
+            f"{len(measured.reversals)} reversal(s)"
+            + ("" if measured.stiffness_factor is not None else ", through the nominal chain")
+        )
+    notes.extend(measured.notes)
+    clearance = ClearanceInterval(measured.estimate, measured.lower, measured.upper)
+    agree = None
+    if learnt is not None and learnt.estimate is not None:
+        agree = bool(learnt.lower <= measured.upper and measured.lower <= learnt.upper)
+        if not agree:
+            notes.append(
+                f"measured clearance {_um(measured.estimate)} [{_um(measured.lower)}, "
+                f"{_um(measured.upper)}] µm and the learnt model's {_um(learnt.estimate)} "
+                f"[{_um(learnt.lower)}, {_um(learnt.upper)}] µm disagree beyond their intervals: "
+                "the measured one is the actuator's physics, the learnt one what the training "
+                "fleet taught — a unit unlike that fleet, or a sensor to check"
+            )
+    if not measured.commissioned:
+        notes.append(
+            f"clearance measured without this unit's commissioning: its interval holds the "
+            f"datasheets' ranges of bearing play and gearhead backlash (±"
+            f"{_um(measured.upper - measured.estimate)} µm); give the as-built clearance once "
+            "(diagnose --asset ID --as-built-clearance B) to narrow it"
+        )
+    part = MeasuredClearance(
+        zero_load_lost_motion=measured.zero_load_lost_motion,
+        stiffness_factor=measured.stiffness_factor,
+        reversals=[ReversalRead(p, load, lost) for p, load, lost in measured.reversals],
+        commissioned=measured.commissioned,
+        budget=dict(measured.budget),
+        learnt=learnt,
+        agree=agree,
+    )
+    return clearance, part
+
+
+#: The indicators physics reads from a check without a trained model: the lubricant's torque
+#: ratio and the housing temperature (and the measured clearance).
+PHYSICS_INDICATORS = (
+    "check_torque_low",
+    "check_torque_high",
+    "check_torque_ratio",
+    "check_temperature",
+)
+#: The zero-load lost motion of a check, among its indicators: what commissioning stores.
+ZERO_LOAD_LOST_MOTION = "check_zero_load_lost_motion"
+
+
+def read_check_by_physics(run: Run, bundle, diagnosis: Diagnosis, commissioning=None) -> None:
+    """What a check shows without a trained check part, into ``diagnosis`` (of its windows):
+    the clearance measured from its reversals (then ``clearance``, observable) and the
+    physics indicators (:data:`PHYSICS_INDICATORS`, :data:`ZERO_LOAD_LOST_MOTION`)."""
+    if bundle.design is None:
+        return
+    reading = check_reading(run, bundle.design)
+    notes: list[str] = []
+    clearance, measured = measured_clearance(reading, bundle, commissioning, None, notes)
+    for name in PHYSICS_INDICATORS:
+        diagnosis.indicators[name] = finite_or_none(reading.indicators.get(name))
+    if measured is not None:
+        diagnosis.clearance = clearance
+        diagnosis.measured_clearance = measured
+        diagnosis.indicators[ZERO_LOAD_LOST_MOTION] = measured.zero_load_lost_motion
+        # a recording's observability is a share of its windows: the check shows it whole
+        diagnosis.observability = Observability(1.0, diagnosis.observability.fault)
+    diagnosis.warnings.extend(notes)
+
+
+def _um(value: float) -> str:
+    return f"{value * 1e6:.1f}"
+
+
+def cut_note(cut: dict[str, str], classes, clearance_read: bool = False) -> str:
     """The one line of a check whose phases are cut short or too short to read (``cut``: role
     → its shortfall, :attr:`CheckReading.cut
     <prsm_health.signals.check_indicators.CheckReading.cut>`): which phases, how long against
-    what they need, what that hides (the clearance, and those of ``classes`` whose role is
-    cut), what to do."""
+    what they need, what that hides (the clearance unless another reversal measured it —
+    ``clearance_read`` —, and those of ``classes`` whose role is cut), what to do."""
     hidden = (
-        ["the clearance (its interval is the whole trained range)"] if "reversal" in cut else []
+        ["the clearance (its interval is the whole trained range)"]
+        if "reversal" in cut and not clearance_read
+        else []
     )
     hidden += [c for c, r in ROLE_OF_CLASS.items() if r in cut and c in classes]
     shortfalls = "; ".join(dict.fromkeys(cut.values()))
@@ -167,7 +260,7 @@ def cut_note(cut: dict[str, str], classes) -> str:
     )
 
 
-def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
+def diagnose_check(run: Run, bundle, baseline=None, commissioning=None) -> Diagnosis:
     """Diagnosis of one health-check recording by the bundle's check model.
 
     Parameters
@@ -178,6 +271,10 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
         With a ``check`` part.
     baseline : Baseline or None
         The unit's own baseline: the change model reads the recording against it.
+    commissioning : Commissioning or None
+        The unit's constant lost motion fixed at commissioning
+        (:class:`~prsm_health.diagnostics.clearance_gauge.Commissioning`): the measured
+        clearance then reads against it.
     """
     model = CheckModel.from_part(bundle.check)
     reading = check_reading(run, bundle.design)
@@ -198,13 +295,18 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
     x = _matrix([row], names)
     estimate = float(model.clearance.predict(x)[0])
     lower, upper = (float(a[0]) for a in model.clearance.predict_interval(x))
-    if not sees_clearance:
-        lower, upper = model.clearance_range
-        if "reversal" not in reading.cut:
-            notes.append(
-                "no slow reversal under load in this check: clearance is not observable; the "
-                "interval is the whole trained range"
-            )
+    learnt = ClearanceInterval(finite_or_none(estimate), lower, upper) if sees_clearance else None
+    clearance, measured = measured_clearance(reading, bundle, commissioning, learnt, notes)
+    if clearance is None:
+        clearance = ClearanceInterval(finite_or_none(estimate), lower, upper)
+        if not sees_clearance:
+            clearance = ClearanceInterval(finite_or_none(estimate), *model.clearance_range)
+            if "reversal" not in reading.cut:
+                notes.append(
+                    "no slow reversal under load in this check: clearance is not observable; "
+                    "the interval is the whole trained range"
+                )
+    sees_clearance = sees_clearance or measured is not None
     relative = baseline is not None and model.fault_relative is not None
     if relative:
         classifier = model.fault_relative
@@ -214,7 +316,7 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
         x_fault = x
     classes = [str(c) for c in classifier.classes_]
     if reading.cut:  # the first line: what to fix first
-        notes.insert(0, cut_note(reading.cut, classes))
+        notes.insert(0, cut_note(reading.cut, classes, clearance_read=measured is not None))
     probabilities = {
         c: float(p) for c, p in zip(classes, np.asarray(classifier.predict_proba(x_fault))[0])
     }
@@ -244,8 +346,10 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
             "read alone: no baseline of this unit (its first health checks); against a "
             "baseline the change of each indicator is read too"
         )
+    if measured is not None:
+        row[ZERO_LOAD_LOST_MOTION] = measured.zero_load_lost_motion
     return Diagnosis(
-        clearance=ClearanceInterval(finite_or_none(estimate), lower, upper),
+        clearance=clearance,
         fault_class=fault_class,
         class_probabilities=probabilities,
         class_set=class_set,
@@ -257,4 +361,5 @@ def diagnose_check(run: Run, bundle, baseline=None) -> Diagnosis:
         indicator_groups={},
         undecided=undecided,
         check_phases=dict(reading.roles),
+        measured_clearance=measured,
     )

@@ -99,6 +99,53 @@ class ClearanceInterval(ContractPart):
 
 
 @dataclass(frozen=True, eq=False)
+class ReversalRead(ContractPart):
+    """One reversal of a health check the clearance was measured from."""
+
+    phase: str = describe("the phase's name")
+    load: float = describe("its load amplitude [N]")
+    lost_motion: float = describe("its lost motion over the settled samples [m]")
+
+
+@dataclass(frozen=True, eq=False)
+class MeasuredClearance(ContractPart):
+    """A health check's clearance measured by physics (the reversals' lost motion through the
+    actuator's compliance chain, docs/diagnostics.md "Clearance measured by physics"): the
+    diagnosis' ``clearance`` then, with the learnt model's beside it as a cross-check."""
+
+    zero_load_lost_motion: float = describe(
+        "the lost motion extrapolated to zero load (two reversals) or read through the nominal "
+        "chain (one) [m]"
+    )
+    stiffness_factor: float | None = describe(
+        "the unit's elastic lost motion against the chain's, from the two reversals; null with "
+        "one (the nominal chain)"
+    )
+    reversals: list[ReversalRead] = describe("the reversals read, heaviest first")
+    commissioned: bool = describe(
+        "whether the constant offset (bearing play, gearhead backlash, sensor lag) is the unit's "
+        "own, fixed at commissioning from its as-built clearance; false: the datasheets' "
+        "ranges, in the budget"
+    )
+    budget: dict[str, float] = describe(
+        "error budget: term → its standard deviation [m of clearance]; the interval is their "
+        "root sum square times a conformal factor"
+    )
+    learnt: ClearanceInterval | None = describe(
+        "the learnt check model's clearance on the same recording (null without a check model)"
+    )
+    agree: bool | None = describe(
+        "whether the measured and learnt intervals overlap (null without a learnt one); a "
+        "warning says when they do not"
+    )
+
+    def __post_init__(self):
+        # read back from JSON: the parts as mappings
+        object.__setattr__(self, "reversals", [ReversalRead.of(r) for r in self.reversals])
+        object.__setattr__(self, "learnt", ClearanceInterval.of(self.learnt))
+
+
+@dataclass(frozen=True, eq=False)
 class Observability(ContractPart):
     """Whether the recording lets the model see each target.
 
@@ -280,6 +327,12 @@ class Diagnosis:
         omit_empty=True,
         default=None,
     )
+    measured_clearance: MeasuredClearance | None = describe(
+        "a health check with a reversal under load: the clearance measured by physics (then "
+        "``clearance``), its budget and the learnt model's reading beside it",
+        omit_empty=True,
+        default=None,
+    )
     check_phases: dict[str, str] = describe(
         "a health-check recording: role → the phase that gave it (e.g. 'no_load' → 'no-load "
         "stroke'); the roles the check lacked are in undecided.missing or the warnings",
@@ -300,6 +353,7 @@ class Diagnosis:
         self.window = WindowSpan.of(self.window)
         self.undecided = Undecided.of(self.undecided)
         self.asset = AssetState.of(self.asset)
+        self.measured_clearance = MeasuredClearance.of(self.measured_clearance)
 
     def to_json(self) -> dict:
         """The Diagnosis contract as plain JSON values."""

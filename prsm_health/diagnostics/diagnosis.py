@@ -107,6 +107,14 @@ class ModelBundle:
         checks alone): it reads health-check recordings only."""
         return self.check is not None and self.clearance is None and self.fault is None
 
+    @cached_property  # the chain's sensor delays: once per loaded model
+    def clearance_gauge(self):
+        """The health check's clearance gauge for this model's actuator
+        (:func:`~prsm_health.diagnostics.clearance_gauge.gauge_for`); None without a design."""
+        from .clearance_gauge import gauge_for
+
+        return gauge_for(self.design, self.metadata, self.check)
+
     @property
     def design_name(self) -> str:
         return self.design.name if self.design is not None else NO_DESIGN
@@ -545,6 +553,7 @@ def diagnose(
     window: float | None = None,
     windows: tuple[list[Run], list[str]] | None = None,
     baseline=None,
+    commissioning=None,
 ) -> Diagnosis:
     """Diagnose a recording: a :class:`Diagnosis` of the whole, with one per window — or, for a
     health-check recording and a bundle with a check model, one of the check read phase by
@@ -562,9 +571,15 @@ def diagnose(
     baseline : Baseline or None
         The unit's own baseline (:class:`prsm_health.diagnostics.baseline.Baseline`): a check
         recording is then read against it too.
+    commissioning : Commissioning or None
+        The unit's constant lost motion fixed at commissioning
+        (:class:`prsm_health.diagnostics.clearance_gauge.Commissioning`): a check's measured
+        clearance reads against it.
     """
     split = None if windows is None else [windows]
-    return diagnose_runs([run], bundle, window=window, split=split, baseline=baseline)[0]
+    return diagnose_runs(
+        [run], bundle, window=window, split=split, baseline=baseline, commissioning=commissioning
+    )[0]
 
 
 def diagnose_runs(
@@ -574,12 +589,13 @@ def diagnose_runs(
     window: float | None = None,
     split: list[tuple[list[Run], list[str]]] | None = None,
     baseline=None,
+    commissioning=None,
 ) -> list[Diagnosis]:
     """Diagnose several recordings in one batch (every window's indicators in one call):
     one :class:`Diagnosis` per run, each as :func:`diagnose` gives it; ``split``: each run
-    already cut by :func:`split_windows` (``window`` then ignored); ``baseline``: of the unit
-    all the runs belong to."""
-    from .check_model import diagnose_check, is_check
+    already cut by :func:`split_windows` (``window`` then ignored); ``baseline`` and
+    ``commissioning``: of the unit all the runs belong to."""
+    from .check_model import diagnose_check, is_check, read_check_by_physics
 
     bundle = bundle or load_bundle()
     for run in runs:
@@ -591,7 +607,7 @@ def diagnose_runs(
         raise PRSMHealthError(CHECK_ONLY.format(name=bundle.name))
     # a check recording is read phase by phase when the model can (and was not cut already)
     checks = {
-        i: diagnose_check(run, bundle, baseline)
+        i: diagnose_check(run, bundle, baseline, commissioning)
         for i, run in enumerate(runs)
         if bundle.check is not None and split is None and is_check(run)
     }
@@ -602,10 +618,11 @@ def diagnose_runs(
         window=window,
         split=None if split is None else [split[i] for i in rest],
     )
-    if bundle.check is None:  # one line on why a check reads out of distribution
+    if bundle.check is None:  # one line on why; what physics reads without a model
         for i, d in zip(rest, windowed):
             if is_check(runs[i]):
                 d.warnings.append(NO_CHECK_PART.format(name=bundle.name))
+                read_check_by_physics(runs[i], bundle, d, commissioning)
     if baseline is not None and bundle.check is not None:
         for d in windowed:
             d.warnings.append(
@@ -620,7 +637,8 @@ def diagnose_runs(
 NO_CHECK_PART = (
     "model {name!r} has no health-check part: this check is read window by window across its "
     "phases, which no window of its training mixed (expect out-of-distribution windows or "
-    "cannot_tell); to read it phase by phase, train one with "
+    "cannot_tell) — only what physics reads alone is the check's (the clearance from its "
+    "reversals, the torque ratio, the temperature); to read it phase by phase, train one with "
     '`prsm-health train` on a dataset of check recordings (docs/diagnostics.md, "A health '
     'check for your own actuator")'
 )

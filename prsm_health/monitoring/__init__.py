@@ -20,7 +20,13 @@ from .asset import (
 )
 from .evidence import Cusum, Evidence
 from .file_store import FileAssetStore
-from .steps import asset_baseline, diagnose_asset, record_diagnosis
+from .steps import (
+    asset_baseline,
+    asset_reference,
+    commission,
+    diagnose_asset,
+    record_diagnosis,
+)
 from .store import AssetStore, Stored, VersionConflict
 
 __all__ = [
@@ -35,7 +41,9 @@ __all__ = [
     "Stored",
     "VersionConflict",
     "asset_baseline",
+    "asset_reference",
     "bundle_priors",
+    "commission",
     "diagnose_asset",
     "names_a_fault",
     "record_diagnosis",

@@ -32,8 +32,10 @@ from dataclasses import dataclass, field
 
 from prsm_health.core.errors import require
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
-from prsm_health.core.jsonable import finite_or_none
+from prsm_health.core.jsonable import as_finite, finite_or_none
 from prsm_health.diagnostics.baseline import Baseline
+from prsm_health.diagnostics.check_model import ZERO_LOAD_LOST_MOTION
+from prsm_health.diagnostics.clearance_gauge import Commissioning
 from prsm_health.diagnostics.contract import (
     CANNOT_TELL,
     OOD_LIMIT,
@@ -250,12 +252,16 @@ class AssetHistory:
         The class evidence of the recordings not in the baseline (None before the first).
     cusum : Cusum
         The change statistic of their distances from the baseline.
+    as_built_clearance : float or None [m]
+        The unit's clearance as built (measured at assembly), given at commissioning: its
+        baseline checks then fix the gauge's constant offset (:meth:`commissioning`).
     """
 
     asset_id: str
     entries: tuple[AssetEntry, ...] = ()
     evidence: Evidence | None = None
     cusum: Cusum = Cusum()
+    as_built_clearance: float | None = None
 
     def __post_init__(self):
         validate_asset_id(self.asset_id)
@@ -279,6 +285,19 @@ class AssetHistory:
             names=names,
             recordings=[e.recording_id for e in members],
         )
+
+    def commissioning(self):
+        """The unit's constant lost motion fixed at commissioning
+        (:class:`~prsm_health.diagnostics.clearance_gauge.Commissioning`): its as-built
+        clearance and the zero-load lost motion of its baseline checks; None without either."""
+        if self.as_built_clearance is None:
+            return None
+        values = [
+            finite_or_none(e.indicators.get(ZERO_LOAD_LOST_MOTION))
+            for e in self.members([ZERO_LOAD_LOST_MOTION])
+        ]
+        values = [v for v in values if v is not None]
+        return Commissioning.from_checks(values, self.as_built_clearance) if values else None
 
     def members(self, names: Sequence[str] | None = None) -> list[AssetEntry]:
         """The baseline's recordings of one kind: those put in it that have any of ``names``
@@ -541,6 +560,7 @@ class AssetHistory:
             "entries": [e.to_json() for e in self.entries],
             "evidence": None if self.evidence is None else self.evidence.to_json(),
             "cusum": self.cusum.to_json(),
+            "as_built_clearance": self.as_built_clearance,
         }
 
     @classmethod
@@ -554,6 +574,7 @@ class AssetHistory:
             tuple(AssetEntry.from_json(e) for e in data["entries"]),
             None if evidence is None else Evidence.from_json(evidence),
             Cusum.from_json(data["cusum"]),
+            as_finite(data.get("as_built_clearance")),  # histories before it: None
         )
 
 

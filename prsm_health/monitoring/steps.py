@@ -27,6 +27,29 @@ def asset_baseline(store: AssetStore, bundle, asset_id: str) -> Baseline | None:
     return store.load(asset_id).history.baseline(prior_scale, names)
 
 
+def asset_reference(store: AssetStore, bundle, asset_id: str):
+    """(baseline, commissioning) of an asset, what a recording of it is read against:
+    :func:`asset_baseline` and its :meth:`~.asset.AssetHistory.commissioning` (None without an
+    as-built clearance)."""
+    return asset_baseline(store, bundle, asset_id), store.load(asset_id).history.commissioning()
+
+
+def commission(store: AssetStore, asset_id: str, as_built_clearance: float) -> None:
+    """Give an asset its as-built clearance [m] (measured at assembly): its baseline checks
+    then fix the clearance gauge's constant offset (:meth:`~.asset.AssetHistory.commissioning`).
+    Giving it again replaces it."""
+    from dataclasses import replace
+
+    from prsm_health.core.errors import require_range
+
+    require_range("as_built_clearance", as_built_clearance, -20e-6, 200e-6, unit="m")
+
+    def change(history):
+        return replace(history, as_built_clearance=float(as_built_clearance)), None
+
+    store.update(validate_asset_id(asset_id), change)
+
+
 def record_diagnosis(
     store: AssetStore,
     bundle,
@@ -91,8 +114,10 @@ def diagnose_asset(
 
     validate_asset_id(asset_id)
     with store.locked(asset_id):
-        baseline = asset_baseline(store, bundle, asset_id)
-        diagnosis = diagnose(run, bundle, window=window, baseline=baseline)
+        baseline, commissioning = asset_reference(store, bundle, asset_id)
+        diagnosis = diagnose(
+            run, bundle, window=window, baseline=baseline, commissioning=commissioning
+        )
         return record_diagnosis(
             store,
             bundle,
@@ -107,4 +132,4 @@ def diagnose_asset(
         )
 
 
-__all__ = ["asset_baseline", "diagnose_asset", "record_diagnosis"]
+__all__ = ["asset_baseline", "asset_reference", "commission", "diagnose_asset", "record_diagnosis"]

@@ -23,7 +23,7 @@ between +F and −F [m] (``p`` the nut travel per screw radian, lead/2π,
   motor drives against the load on both strokes), twisting the gear (k_g, at the output) and
   the coupling (k_c) in series: 2T·(1/k_g + 1/k_c)·p;
 - thrust bearing (and the screw between bearing and nut, which its stiffness includes):
-  2F/k_b + 2·play_b (play_b the half-play, ``thrust_bearing_play``);
+  2F/k_b, and its play 2·play_b (play_b the half-play, ``thrust_bearing_play``);
 - thread contacts: 2·δ(F), δ the axial approach of the rollers' engagements with the load
   shared over the engaged threads (paper 04) and over the rollers
   (:func:`~prsm_health.physics.stiffness.axial.axial_stiffness`; its screw-shaft term is left
@@ -106,7 +106,9 @@ class LostMotionChain:
 
     Attributes
     ----------
-    gear_backlash, gear_coupling_twist, thrust_bearing, thread_contacts, linkage : float [m]
+    gear_backlash, gear_coupling_twist, thrust_bearing, thrust_bearing_play, thread_contacts,
+    linkage : float [m]
+        ``thrust_bearing`` its elastic part 2F/k_b, ``thrust_bearing_play`` its play 2·play_b.
     sensor_lag : float [m]
         The position sensor's delay behind the angle sensor's, as lost motion (0: ideal).
     load_amplitude : float [N]
@@ -118,6 +120,7 @@ class LostMotionChain:
     gear_backlash: float
     gear_coupling_twist: float
     thrust_bearing: float
+    thrust_bearing_play: float
     thread_contacts: float
     linkage: float
     sensor_lag: float
@@ -127,12 +130,24 @@ class LostMotionChain:
     @property
     def terms(self) -> dict[str, float]:
         """Element → its lost motion [m], in the chain's order."""
-        return {f.name: getattr(self, f.name) for f in fields(self)[:6]}
+        return {f.name: getattr(self, f.name) for f in fields(self)[:7]}
 
     @property
     def total(self) -> float:
         """The lost motion of the chain at b = 0 [m]."""
         return float(sum(self.terms.values()))
+
+    @property
+    def constant(self) -> float:
+        """Its part that does not follow the load [m]: the plays crossed whole (gearhead
+        backlash, thrust-bearing play) and the sensors' lag (a speed's, not a load's)."""
+        return self.gear_backlash + self.thrust_bearing_play + self.linkage + self.sensor_lag
+
+    @property
+    def elastic(self) -> float:
+        """Its part that follows the load [m]: torsion, the bearing's and the threads'
+        deflections."""
+        return self.total - self.constant
 
 
 def compliance_chain(
@@ -144,6 +159,8 @@ def compliance_chain(
     screw_efficiency: float = SCREW_EFFICIENCY,
     speed_amplitude: float | None = None,
     sensor_delays: Mapping[str, float] | None = None,
+    load_shares=None,
+    screw_torque: float | None = None,
 ) -> LostMotionChain:
     """The actuator's lost motion at b = 0 for a reversal under ±``load_amplitude`` [N], element
     by element (module docstring: the equations, the sensors' places, the sources).
@@ -169,6 +186,16 @@ def compliance_chain(
         reversal's frequency (a missing channel: 0; from a simulated instrumentation,
         :func:`prsm_health.simulation.sensors.channel_group_delay`). None: ideal sensors, no
         sensor term.
+    load_shares : array-like, optional
+        |F(t)|/F over the samples the reading averages, each in [0, 1] (the load follows the
+        speed, so a recording gives them as |ω(t)|/ω): overrides ``reversal_shape`` — a
+        triangle reversal, or a step fitted only where the speed is beyond a share of its
+        amplitude (:func:`~prsm_health.signals.lost_motion.settled_lost_motion_step`).
+    screw_torque : float [N·m], optional
+        The mean |torque| on the screw over the samples read, measured (the drive's torque
+        through the reduction): the torsion term is then 2·T·(1/k_g + 1/k_c)·p with it instead
+        of F·p/η_s — the friction the load does not carry (preload, viscous drag, a degraded
+        lubricant) winds the train up too.
     """
     require_range("load_amplitude", load_amplitude, 1e-3, 1e7, unit="N")
     require(
@@ -181,7 +208,16 @@ def compliance_chain(
     dt = drive_train
     lead = speed_ratios(design).nut  # nut travel per screw radian [m/rad]
     # the loads the reading averages over (one for ±F held)
-    if reversal_shape == "cosine":
+    if load_shares is not None:
+        shares = np.asarray(load_shares, dtype=float).ravel()
+        require(
+            len(shares) > 0 and bool(np.all((shares >= 0.0) & (shares <= 1.0))),
+            "load_shares",
+            f"{len(shares)} values",
+            "must be one or more shares of the load in [0, 1]",
+        )
+        loads = load_amplitude * shares
+    elif reversal_shape == "cosine":
         phases = (np.arange(_PHASES) + 0.5) * (0.5 * math.pi / _PHASES)
         loads = load_amplitude * np.cos(phases)
     else:
@@ -195,10 +231,12 @@ def compliance_chain(
         compliance = 1.0 / dt.coupling_stiffness
         if dt.geared and dt.gear_stiffness > 0.0:
             compliance += 1.0 / dt.gear_stiffness
-        twist = 2.0 * mean_load * lead / screw_efficiency * compliance * lead
-    bearing = 0.0
+        torque = mean_load * lead / screw_efficiency if screw_torque is None else screw_torque
+        twist = 2.0 * torque * compliance * lead
+    bearing = bearing_play = 0.0
     if not dt.rigid_thrust_bearing:
-        bearing = 2.0 * mean_load / dt.thrust_bearing_stiffness + 2.0 * dt.thrust_bearing_play
+        bearing = 2.0 * mean_load / dt.thrust_bearing_stiffness
+        bearing_play = 2.0 * dt.thrust_bearing_play
     sensor_lag = 0.0
     if sensor_delays is not None:
         unknown = set(sensor_delays) - set(DELAYED_CHANNELS)
@@ -220,6 +258,7 @@ def compliance_chain(
         gear_backlash=float(backlash),
         gear_coupling_twist=float(twist),
         thrust_bearing=float(bearing),
+        thrust_bearing_play=float(bearing_play),
         thread_contacts=float(2.0 * np.mean(contact)),
         linkage=0.0,
         sensor_lag=float(sensor_lag),

@@ -78,7 +78,7 @@ from .angle_domain import (
     synchronous_average_periods,
 )
 from .features import extract_features, run_design
-from .lost_motion import lost_motion_step
+from .lost_motion import SETTLED_SHARE, lost_motion_step, settled_lost_motion_step
 from .percentiles import percentiles
 from .spectra import bandpass_rows, hilbert_envelope, welch_psd
 
@@ -218,12 +218,48 @@ class CheckReading:
         The roles whose phase the recording has, but cut short or too short to read
         (:func:`role_shortfall`): ``'"<phase>" 0.09 s of the 0.25 s it needs'``; not read,
         not in ``roles``.
+    reversals : tuple of ReversalStep
+        Every whole reversing phase under a known load, read for the clearance by physics
+        (:func:`reversal_steps`), heaviest first.
+    unread_reversals : dict of phase → reason
+        The reversing phases under load not read, with why (cut, too short, a channel).
     """
 
     indicators: dict[str, float]
     roles: dict[str, str] = field(default_factory=dict)
     missing: dict[str, str] = field(default_factory=dict)
     cut: dict[str, str] = field(default_factory=dict)
+    reversals: tuple[ReversalStep, ...] = ()
+    unread_reversals: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class ReversalStep:
+    """One whole reversing phase under a known load, read for the thread clearance by physics
+    (:mod:`prsm_health.diagnostics.clearance_gauge`): its lost-motion step over the settled
+    samples (:func:`~prsm_health.signals.lost_motion.settled_lost_motion_step`).
+
+    Attributes
+    ----------
+    phase : str
+    load : float [N]
+        The load amplitude (commanded, else from a load cell), > 0.
+    speed : float [rad/s]
+        The screw speed amplitude (commanded, else measured), > 0.
+    lost_motion : float [m]
+    load_shares : ndarray
+        |load|/``load`` of the samples the step was fitted on (the load follows the speed).
+    drive_torque : float [N·m]
+        The mean |drive torque| over those samples (NaN without the channel): the torque
+        that winds up the reduction and the coupling.
+    """
+
+    phase: str
+    load: float
+    speed: float
+    lost_motion: float
+    load_shares: np.ndarray = field(repr=False)
+    drive_torque: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -648,6 +684,10 @@ def check_indicators(
         of that phase are left out: the slow reversal excites little and the other roles read
         the vibration.
 
+        ``reversals``: every whole reversing phase under a known load read for the clearance
+        by physics (:func:`reversal_steps`), heaviest first; ``unread_reversals`` those it
+        could not read, with why.
+
     Raises
     ------
     PRSMHealthError
@@ -664,7 +704,8 @@ def check_indicators(
     if gear_ratio is None:
         gear_ratio = run.operating.gear_ratio
     gear_ratio = float(gear_ratio) if _is_number(gear_ratio) and gear_ratio > 0 else 1.0
-    found, missing, cut = _read_roles(phase_conditions(run), design, gear_ratio)
+    conditions = phase_conditions(run)
+    found, missing, cut = _read_roles(conditions, design, gear_ratio)
     roles: dict[str, str] = {}
     if "housing_temperature" in run.channels:
         out["check_temperature"] = float(np.mean(run.channels["housing_temperature"]))
@@ -692,7 +733,46 @@ def check_indicators(
             reason = _high_load(phase.run, design, gear_ratio, out)
             if reason:
                 missing[role] = reason
-    return CheckReading(out, roles, missing, cut)
+    reversals, unread = reversal_steps(conditions, design, gear_ratio)
+    return CheckReading(out, roles, missing, cut, reversals, unread)
+
+
+def reversal_steps(
+    conditions: list[PhaseCondition], design: PRSMDesign, gear_ratio: float = 1.0
+) -> tuple[tuple[ReversalStep, ...], dict[str, str]]:
+    """(steps, unread): the lost-motion step of every whole reversing phase under a known
+    load (above :data:`NO_LOAD_SHARE` of C_a) that has the position, angle and speed it needs,
+    heaviest load first; and the reversing phases under load left out, with why (cut or too
+    short, :func:`role_shortfall`; channels missing)."""
+    limit = NO_LOAD_SHARE * load_ratings(design).dynamic
+    lead = speed_ratios(design).nut
+    out, unread = [], {}
+    for c in conditions:
+        if c.motion != "reversing" or c.load is None or not abs(c.load) > limit:
+            continue
+        channels = c.run.channels
+        speed = _measured_speed(c.run)
+        lacking = [k for k in ("nut_position", "screw_angle") if k not in channels]
+        if speed is None or lacking:
+            unread[c.name] = "missing channel(s) " + ", ".join(lacking or ["screw_speed"])
+            continue
+        short = role_shortfall("reversal", c, design, gear_ratio)
+        if short is not None:
+            unread[c.name] = short
+            continue
+        step, shares = settled_lost_motion_step(
+            channels["nut_position"], channels["screw_angle"], speed, lead
+        )
+        amplitude = abs(c.speed) if _is_number(c.speed) and c.speed != 0 else math.nan
+        torque = math.nan
+        if "drive_torque" in channels:
+            settled = np.abs(speed) >= SETTLED_SHARE * float(np.percentile(np.abs(speed), 98))
+            torque = float(np.mean(np.abs(np.asarray(channels["drive_torque"])[settled])))
+        if math.isfinite(step) and math.isfinite(amplitude):
+            out.append(ReversalStep(c.name, abs(float(c.load)), amplitude, step, shares, torque))
+        else:
+            unread[c.name] = "no lost motion: the nut did not cross the play both ways"
+    return tuple(sorted(out, key=lambda r: -r.load)), unread
 
 
 # ---------------------------------------------------------------------------- measurement

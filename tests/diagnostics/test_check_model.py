@@ -72,7 +72,12 @@ def test_a_check_is_read_phase_by_phase_and_names_a_class_alone(check_run):
     assert d.check_phases["high_load"] == "heavy"
     assert d.fault_class == "healthy" and d.undecided is None
     assert d.observability["clearance"] and d.observability["fault"]
-    assert d.clearance["estimate"] == pytest.approx(10e-6)
+    # the clearance is measured by physics from the one reversal, the learnt one beside it
+    measured = d.measured_clearance
+    assert [r.phase for r in measured.reversals] == ["swing"]
+    assert measured.stiffness_factor is None and not measured.commissioned
+    assert measured.learnt["estimate"] == pytest.approx(10e-6)
+    assert d.clearance["lower"] < d.clearance["estimate"] < d.clearance["upper"]
     assert not d.windows  # a check is not cut into windows
     assert any("tooth_damage" in w and "not observable" in w for w in d.warnings)
     assert any("read alone" in w for w in d.warnings)

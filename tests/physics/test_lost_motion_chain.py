@@ -50,12 +50,14 @@ def test_elastic_terms_scale_with_the_compliance():
 def test_plays_add_whole():
     base = _chain()
     played = _chain(thrust_bearing_play=5e-6)
-    assert played.thrust_bearing - base.thrust_bearing == pytest.approx(10e-6, rel=1e-9)
+    assert played.thrust_bearing_play - base.thrust_bearing_play == pytest.approx(10e-6, rel=1e-9)
     assert base.gear_backlash == pytest.approx(2 * DriveTrain().gear_backlash * LEAD, rel=1e-12)
     assert _chain(gear_backlash=0.0).gear_backlash == 0.0
     # a play is crossed whole whatever the load's shape; elastic terms read less in a cosine
     cos_played, cos_base = _chain("cosine", thrust_bearing_play=5e-6), _chain("cosine")
-    assert cos_played.thrust_bearing - cos_base.thrust_bearing == pytest.approx(10e-6, rel=1e-9)
+    assert cos_played.thrust_bearing_play - cos_base.thrust_bearing_play == pytest.approx(
+        10e-6, rel=1e-9
+    )
     assert cos_base.gear_backlash == base.gear_backlash
     assert cos_base.gear_coupling_twist == pytest.approx(
         base.gear_coupling_twist * 2 / math.pi, rel=1e-5

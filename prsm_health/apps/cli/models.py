@@ -13,7 +13,7 @@ from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
 from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
 from prsm_health.io import read_recording
-from prsm_health.monitoring import FileAssetStore, diagnose_asset
+from prsm_health.monitoring import FileAssetStore, commission, diagnose_asset
 from prsm_health.training.check_part import is_check_dataset, train_check_part
 from prsm_health.training.check_training import CHECK_CV
 from prsm_health.training.evaluation import evaluate_model
@@ -184,10 +184,13 @@ def diagnose(args) -> int:
     if args.asset is None:
         result = diagnose_recording(run, bundle, window=args.window)
     else:
+        store = FileAssetStore(args.store)
+        if args.as_built_clearance is not None:
+            commission(store, args.asset, args.as_built_clearance)
         result = diagnose_asset(
             run,
             bundle,
-            FileAssetStore(args.store),
+            store,
             args.asset,
             content_id(args.file, args.map),
             healthy=True if args.healthy else (False if args.unhealthy else None),
@@ -218,6 +221,7 @@ def _check_asset_options(args) -> None:
             ("--healthy", getattr(args, "healthy", False)),
             ("--unhealthy", getattr(args, "unhealthy", False)),
             ("--operating-hours", getattr(args, "operating_hours", None) is not None),
+            ("--as-built-clearance", getattr(args, "as_built_clearance", None) is not None),
             ("--time", getattr(args, "time", None) is not None),
         )
         if value
@@ -245,6 +249,7 @@ def diagnosis_rows(file: str, result) -> list:
             "µm (90 % interval)",
         ),
     ]
+    rows += measured_rows(getattr(result, "measured_clearance", None))
     rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
     u = getattr(result, "undecided", None)
     if u is not None:
@@ -270,6 +275,28 @@ def diagnosis_rows(file: str, result) -> list:
     rows += [("model", f"{result.model['name']} v{result.model['version']}", "")]
     rows += asset_rows(getattr(result, "asset", None))
     rows += [("warning", text, "") for text in result.warnings]
+    return rows
+
+
+def measured_rows(measured) -> list:
+    """How a check's clearance was measured (physics) and the learnt reading beside it."""
+    if measured is None:
+        return []
+    how = f"{len(measured.reversals)} reversal(s)"
+    if measured.stiffness_factor is not None:
+        how += f" to zero load (stiffness ×{measured.stiffness_factor:.2f})"
+    how += ", commissioned" if measured.commissioned else ", not commissioned"
+    rows = [("clearance measured by", f"lost motion: {how}", "")]
+    learnt = measured.learnt
+    if learnt is not None and learnt.estimate is not None:
+        agree = "agrees" if measured.agree else "DISAGREES"
+        rows.append(
+            (
+                "learnt clearance",
+                f"{um(learnt.estimate)} [{um(learnt.lower)}, {um(learnt.upper)}]",
+                f"µm (cross-check: {agree})",
+            )
+        )
     return rows
 
 

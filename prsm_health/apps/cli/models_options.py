@@ -155,6 +155,17 @@ def add_model_commands(command) -> None:
         help="--asset: the unit's operating hours at the recording [h]",
     )
     d.add_argument(
+        "--as-built-clearance",
+        type=finite_float,
+        default=None,
+        metavar="B",
+        default_text="not given",
+        help="--asset: the unit's thread half-clearance as built, measured at assembly [m], "
+        "e.g. 6e-6 — given once, at commissioning: its baseline checks then fix the constant "
+        "lost motion of its drive (bearing play, gearhead backlash, sensor lag) and the "
+        "clearance a check measures narrows to the unit's own (docs/diagnostics.md)",
+    )
+    d.add_argument(
         "--time",
         type=iso_time,
         default=None,

@@ -30,6 +30,7 @@ from prsm_health.core.operating_point import OperatingPoint
 from prsm_health.core.run import MIN_SAMPLES, Run
 from prsm_health.diagnostics.baseline import Baseline
 from prsm_health.diagnostics.check_model import is_check
+from prsm_health.diagnostics.clearance_gauge import Commissioning
 from prsm_health.diagnostics.contract import Diagnosis
 from prsm_health.diagnostics.diagnosis import diagnose, split_windows
 from prsm_health.io import read_with_warnings
@@ -359,7 +360,10 @@ def diagnose_body(
     check_asset_fields(params.asset_id, params.healthy, params.recording_id)
     cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
     base = None if baseline is None else baseline.get(params.asset_id)
-    diagnosis = diagnose(run, bundle, windows=_windows(run, cut), baseline=base)
+    commissioning = None if baseline is None else baseline.commissioning_of(params.asset_id)
+    diagnosis = diagnose(
+        run, bundle, windows=_windows(run, cut), baseline=base, commissioning=commissioning
+    )
     if notes:
         diagnosis.warnings[:0] = notes
     if params.asset_id is None:
@@ -441,7 +445,10 @@ def diagnose_upload(
     check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
     cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
     base = None if baseline is None else baseline.get(asset_id)
-    diagnosis = diagnose(run, bundle, windows=_windows(run, cut), baseline=base)
+    commissioning = None if baseline is None else baseline.commissioning_of(asset_id)
+    diagnosis = diagnose(
+        run, bundle, windows=_windows(run, cut), baseline=base, commissioning=commissioning
+    )
     recording = {
         "filename": upload.filename,
         "samples": len(run),
@@ -471,11 +478,17 @@ class BaselineFor:
 
     asset_id: str
     baseline: Baseline | None = None
+    commissioning: Commissioning | None = None
 
     def get(self, asset_id: str | None) -> Baseline | None:
         """The baseline, when the request's asset is the one it was loaded for (a JSON
         body's asset id is found before the body is parsed: :func:`peek_asset_id`)."""
         return self.baseline if asset_id == self.asset_id else None
+
+    def commissioning_of(self, asset_id: str | None) -> Commissioning | None:
+        """The asset's commissioning (:meth:`AssetHistory.commissioning
+        <prsm_health.monitoring.asset.AssetHistory.commissioning>`), as :meth:`get`."""
+        return self.commissioning if asset_id == self.asset_id else None
 
 
 _ASSET_KEY = re.compile(rb'"asset_id"\s*:\s*"([A-Za-z0-9][A-Za-z0-9._:-]{0,127})"')

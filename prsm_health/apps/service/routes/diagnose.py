@@ -6,7 +6,7 @@ import anyio
 from fastapi import APIRouter, Request
 
 from prsm_health.actuator.design import PRESETS
-from prsm_health.monitoring import asset_baseline
+from prsm_health.monitoring import asset_reference
 from prsm_health.monitoring.sqlite_store import utc_now
 
 from ..diagnosing import (
@@ -237,8 +237,10 @@ async def load_baseline(store, bundle, asset_id: str | None) -> BaselineFor | No
     """The baseline of the asset a request names (None without one), for the worker."""
     if asset_id is None:
         return None
-    baseline = await anyio.to_thread.run_sync(asset_baseline, store, bundle, asset_id)
-    return BaselineFor(asset_id, baseline)
+    baseline, commissioning = await anyio.to_thread.run_sync(
+        asset_reference, store, bundle, asset_id
+    )
+    return BaselineFor(asset_id, baseline, commissioning)
 
 
 async def store_answer(store, bundle, answer, received_at: str) -> bytes:

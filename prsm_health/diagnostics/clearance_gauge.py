@@ -1,0 +1,398 @@
+"""The thread clearance *measured* from a health check's reversals by the actuator's own physics,
+with an error budget: the health check read as a measuring instrument.
+
+A slow reversal under ±F crosses the threads' play, 4·b (b the mean half-clearance: the screw
+and nut engagements each have a dead band of 2b, in series), plus every elastic deflection and
+play between the angle and the position sensor
+(:mod:`prsm_health.physics.lost_motion_chain`). The check's reversals give the lost motion L_i
+at loads F_i (:class:`~prsm_health.signals.check_indicators.ReversalStep`, fitted over the
+settled samples, where the nut rests on its flanks). The gauge reads
+
+    L_i = L_0 + k·E(F_i),        L_0 = 4·b + C,
+
+E(F) the chain's elastic lost motion at F (thread contacts with their load sharing, gear and
+coupling torsion, thrust bearing), k a unit's factor on it (its real stiffnesses against the
+nominal ones), C the constant part (gearhead backlash, thrust-bearing play, the sensors' lag).
+
+- **Two loads** (the built-in check's ±25 % and ±10 % C_a): k = (L_1 − L_2)/(E_1 − E_2),
+  L_0 = L_1 − k·E_1 — the unit's stiffnesses drop out (measured: bearing 1.0–2.0e8 N/m,
+  coupling 1–3e3 N·m/rad, lubricant and friction move the reading ≤ 0.2 µm of b, against up to
+  4 µm from one reversal read through the nominal chain).
+- **One load**: k = 1, the nominal chain; the stiffness term of the budget says how far that
+  can be off.
+
+b = (L_0 − C)/4. C is the actuator's: from its drive train and sensors (**nominal**: the
+datasheets' backlash, a thrust bearing's play, the sensors' filter delays), or — better —
+fixed at **commissioning** (:class:`Commissioning`): where a unit's as-built clearance b_c is
+known (measured at assembly), its first checks' L_0 give C = L_0 − 4·b_c, the unit's own, and
+every later reading is b_c + (L_0 − L_0,c)/4. Without it the budget carries the unknown plays.
+
+**Temperature.** The housing temperature changes the oil's viscosity, so the friction torque
+and the torsion it winds up; that term is elastic (∝ the load) and the two-load extrapolation
+removes it (measured over 10–70 °C: ≤ 0.01 µm of b). With one reversal it is part of the
+stiffness term. No thermal-expansion correction is made: the simulator's thread geometry does
+not expand (docs/validation.md), and on hardware it is a constant of the unit over a check that
+commissioning at the service temperature absorbs.
+
+**Budget and interval.** Each term's standard deviation in b (:meth:`GaugeReading.budget`):
+the reversals' repeatability through the extrapolation's weights, the stiffness shape (the
+chain's form against a unit's), uneven gaps between rollers (the load-weighted gap the reversal
+reads is below the plain mean when gaps differ: one-sided, grows with b), the constant offsets
+when not commissioned, and the slope. Their root sum square, times a conformal factor
+(:data:`CONFORMAL_SCALE`: the 90 % quantile of |error|/sd on simulated units whose build is
+drawn from the documented ranges, ``tools/studies/clearance_gauge.py``), is the 90 % interval's
+half-width.
+
+References
+----------
+- ISO 230-2:2014 §3.2 — the reversal value (the lost motion between the two directions).
+- Paper 01 (docs/references.md) §1.1–1.3 — the backlash function f(δ, b), 2b per engagement.
+- Paper 04 — the axial stiffness of the engaged threads (the chain's contact term).
+- A. N. Angelopoulos, S. Bates, "A gentle introduction to conformal prediction and
+  distribution-free uncertainty quantification", arXiv:2107.07511 (2021), §2 — the split
+  conformal quantile ⌈(n+1)(1−α)⌉/n of normalised scores.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.drive_train import DriveTrain
+from prsm_health.core.errors import ParameterError, require, require_range
+from prsm_health.physics.kinematics import speed_ratios
+from prsm_health.physics.lost_motion_chain import (
+    CLEARANCE_SLOPE,
+    DELAYED_CHANNELS,
+    compliance_chain,
+)
+
+#: Two reversals are extrapolated to zero load when the heavier's load is at least this many
+#: times the lighter's: closer, the extrapolation's weights blow the noise up (at 1.5 the
+#: lighter reversal's noise enters ×3).
+EXTRAPOLATION_RATIO = 1.5
+#: The stiffness factor k two reversals may give [-]: beyond it the reversals disagree with
+#: any plausible actuator (the documented ranges give 0.9–1.4), and the reading falls back to
+#: the heavier reversal with the nominal chain.
+STIFFNESS_FACTOR_RANGE = (0.5, 2.0)
+#: Standard deviation of k across the documented builds (bearing stiffness 1.0–2.0e8 N/m,
+#: coupling 1–3e3 N·m/rad, lubricant, friction: k 0.93–1.34, ``tools/studies/clearance_gauge.py
+#: --factors``): the stiffness term of a one-reversal reading.
+STIFFNESS_FACTOR_SD = 0.12
+#: Standard deviation [m of lost motion] of one reversal's settled step between repeat checks
+#: of one unit (sensor noise, the flight-ema LVDT and resolver; measured by the study's repeat
+#: checks).
+REVERSAL_REPEATABILITY = 0.15e-6
+#: Standard deviation [m of b] of the two-load extrapolation's stiffness-shape error across the
+#: documented builds (the chain's form against a unit's; measured by the study's factors).
+SHAPE_SD = 0.15e-6
+#: Standard deviation of the uneven-gap term per metre of b [-]: the reading falls below the
+#: mean gap by up to ≈ 6 % of b at a wear spread of 0.3 (measured by the study's factors); a
+#: wear spread drawn from [0, 0.3] gives about this share as its standard deviation.
+UNEVEN_GAP_SHARE = 0.025
+#: Relative standard deviation of the slope 4 [-]: 4.03–4.05 measured on the settled steps.
+SLOPE_SD = 0.01
+#: Conformal factor on the budget's standard deviation for a 90 % interval (without a
+#: calibration of the unit's own recipe): measured by ``tools/studies/clearance_gauge.py`` on
+#: flight-ema units drawn from the documented ranges (docs/diagnostics.md).
+CONFORMAL_SCALE = 1.645
+
+
+#: The reversals' frequency [Hz] the sensors' delays are taken at: the built-in check's
+#: 0.25 s period (well below the filters' corners the delay barely depends on it).
+NOMINAL_REVERSAL_FREQUENCY = 4.0
+#: The sensors' filters are evaluated at this multiple of the sample rate (they stand for
+#: analog filters; their delay is the same at any rate well above the corner).
+DELAY_RATE_FACTOR = 10
+#: The thrust bearing's half-play a unit may have [m]: 0 (preloaded pair) to 5 µm (an
+#: unpreloaded angular-contact pair after running-in; engineering estimate, the range the
+#: reading's factor table is measured over).
+BEARING_HALF_PLAY = (0.0, 5e-6)
+#: The gearhead's backlash a unit may have, as multiples of the datasheet's [-]: a new
+#: gearhead within its catalogue value (Yaskawa SGMMV: ≤ 3 arcmin) up to twice it (worn).
+BACKLASH_SHARE = (0.0, 2.0)
+#: The sensors' lag a unit may have, as multiples of the datasheets' [-]: the filter corners'
+#: tolerance (±20 %).
+SENSOR_LAG_SHARE = (0.8, 1.2)
+
+
+def offset_ranges(design: PRSMDesign, drive_train: DriveTrain) -> dict[str, OffsetRange]:
+    """The constant terms' ranges [m of lost motion] as deviations from the nominal chain's
+    (``Gauge.chain(...).constant``): the thrust bearing's play (:data:`BEARING_HALF_PLAY`)
+    and the gearhead's backlash (:data:`BACKLASH_SHARE`). The sensors' lag is speed-dependent
+    and enters by :data:`SENSOR_LAG_SHARE` at reading time."""
+    lead = speed_ratios(design).nut
+    play_nominal = 2.0 * drive_train.thrust_bearing_play
+    out = {
+        "thrust-bearing play": OffsetRange(
+            2.0 * BEARING_HALF_PLAY[0] - play_nominal, 2.0 * BEARING_HALF_PLAY[1] - play_nominal
+        )
+    }
+    if drive_train.geared and drive_train.coupled:
+        backlash = 2.0 * drive_train.gear_backlash * lead
+        out["gearhead backlash"] = OffsetRange(
+            (BACKLASH_SHARE[0] - 1.0) * backlash, (BACKLASH_SHARE[1] - 1.0) * backlash
+        )
+    return out
+
+
+@dataclass(frozen=True)
+class OffsetRange:
+    """A constant term of the lost motion the gauge cannot see, as the range a unit's value
+    lies in [m of lost motion]: nominal = its middle, budget = a uniform's sd over it."""
+
+    low: float
+    high: float
+
+    @property
+    def nominal(self) -> float:
+        return 0.5 * (self.low + self.high)
+
+    @property
+    def sd(self) -> float:
+        return (self.high - self.low) / math.sqrt(12.0)
+
+
+@dataclass(frozen=True)
+class Commissioning:
+    """A unit's constant lost motion fixed at commissioning: C = L_0,c − 4·b_c [m], from its
+    as-built clearance b_c [m] and the median zero-load lost motion of its first checks."""
+
+    offset: float
+    clearance: float
+    checks: int
+
+    def __post_init__(self):
+        require(math.isfinite(self.offset), "commissioning.offset", self.offset, "finite [m]")
+        require_range("commissioning.clearance", self.clearance, -50e-6, 1e-3, unit="m")
+        require(self.checks >= 1, "commissioning.checks", self.checks, "must be ≥ 1")
+
+    @classmethod
+    def from_checks(
+        cls, zero_load_lost_motions: Sequence[float], clearance: float, slope=CLEARANCE_SLOPE
+    ) -> Commissioning:
+        """From the zero-load lost motions [m] of the unit's first checks and its as-built
+        clearance b_c [m]; NaN readings are left out (none left: refused)."""
+        import numpy as np
+
+        values = [float(v) for v in zero_load_lost_motions if v is not None and math.isfinite(v)]
+        if not values:
+            raise ParameterError(
+                "commissioning", "no zero-load lost motion", "needs ≥ 1 check with its reversals"
+            )
+        return cls(float(np.median(values)) - slope * clearance, float(clearance), len(values))
+
+
+@dataclass(frozen=True)
+class Gauge:
+    """What the gauge knows of the actuator: its design, drive train and sensors.
+
+    Attributes
+    ----------
+    design : PRSMDesign
+    drive_train : DriveTrain
+        Nominal figures (datasheets); its backlash and bearing play are the constant offset's
+        nominal values.
+    sensor_delays : mapping or None
+        ``{"nut_position": τ_x, "screw_angle": τ_θ}`` [s], the sensors' group delays (None:
+        no sensor term; :func:`~prsm_health.physics.lost_motion_chain.compliance_chain`).
+    offsets : mapping of name → OffsetRange
+        The constant terms' ranges [m of lost motion] (their middles are the nominal C).
+    conformal_scale : float
+        The interval's factor on the budget's sd (:data:`CONFORMAL_SCALE`).
+    """
+
+    design: PRSMDesign
+    drive_train: DriveTrain = field(default_factory=DriveTrain)
+    sensor_delays: Mapping[str, float] | None = None
+    offsets: Mapping[str, OffsetRange] = field(default_factory=dict)
+    conformal_scale: float = CONFORMAL_SCALE
+
+    @classmethod
+    def nominal(
+        cls,
+        design: PRSMDesign,
+        drive_train: DriveTrain | None = None,
+        instrumentation=None,
+        *,
+        reversal_frequency: float = NOMINAL_REVERSAL_FREQUENCY,
+        conformal_scale: float = CONFORMAL_SCALE,
+    ) -> Gauge:
+        """The gauge of an actuator from its datasheets: the drive train's figures (default:
+        the flight EMA's), the sensors' filter delays of an instrumentation profile (name,
+        file or :class:`~prsm_health.simulation.instrumentation.Instrumentation`; None: no
+        sensor term) at the reversals' frequency [Hz], and the documented ranges of the
+        constant terms (:func:`offset_ranges`)."""
+        drive_train = DriveTrain() if drive_train is None else drive_train
+        delays = None
+        if instrumentation is not None:
+            from prsm_health.simulation.instrumentation import load_instrumentation
+            from prsm_health.simulation.sensors import channel_group_delay
+
+            profile = load_instrumentation(instrumentation)
+            rate = DELAY_RATE_FACTOR * profile.sample_rate
+            delays = {
+                c: channel_group_delay(profile, c, reversal_frequency, rate)
+                for c in DELAYED_CHANNELS
+                if getattr(profile, c, None) is not None
+            }
+        return cls(design, drive_train, delays, offset_ranges(design, drive_train), conformal_scale)
+
+    def chain(self, reversal):
+        """The compliance chain at a reversal: its load, speed and the load shares its step
+        was read at, and the torsion from its measured drive torque where it has one
+        (through the reduction: N·η_g of the motor's)."""
+        dt = self.drive_train
+        torque = None
+        if math.isfinite(getattr(reversal, "drive_torque", math.nan)):
+            torque = reversal.drive_torque * (
+                dt.gear_ratio * dt.gear_efficiency if dt.geared else 1.0
+            )
+        return compliance_chain(
+            self.design,
+            dt,
+            reversal.load,
+            load_shares=reversal.load_shares,
+            speed_amplitude=reversal.speed,
+            sensor_delays=self.sensor_delays,
+            screw_torque=torque,
+        )
+
+    def read(self, reversals, commissioning: Commissioning | None = None) -> GaugeReading | None:
+        """The clearance from a check's reversals (:class:`~prsm_health.signals.check_indicators.ReversalStep`,
+        any order); None without any."""
+        reversals = sorted(reversals, key=lambda r: -r.load)
+        if not reversals:
+            return None
+        heavy, light = reversals[0], reversals[-1]
+        chain_heavy = self.chain(heavy)
+        constant, elastic_heavy = chain_heavy.constant, chain_heavy.elastic
+        notes = []
+        factor = None
+        weights = (1.0,)
+        if len(reversals) > 1 and heavy.load >= EXTRAPOLATION_RATIO * light.load:
+            elastic_light = self.chain(light).elastic
+            k = (heavy.lost_motion - light.lost_motion) / (elastic_heavy - elastic_light)
+            low, high = STIFFNESS_FACTOR_RANGE
+            if low <= k <= high:
+                factor = k
+                r = elastic_heavy / (elastic_heavy - elastic_light)
+                weights = (1.0 - r, r)  # L_0 = (1 − r)·L_1 + r·L_2
+            else:
+                notes.append(
+                    f"the reversals at ±{heavy.load:.4g} N and ±{light.load:.4g} N give a "
+                    f"stiffness {k:.2f}× the chain's, outside {low:g}–{high:g}: read from "
+                    f'"{heavy.phase}" alone with the nominal chain'
+                )
+        elif len(reversals) > 1:
+            notes.append(
+                f"the reversals' loads (±{heavy.load:.4g} N, ±{light.load:.4g} N) are too close "
+                f"to extrapolate (a ratio ≥ {EXTRAPOLATION_RATIO:g} is needed): read from "
+                f'"{heavy.phase}" with the nominal chain'
+            )
+        if factor is None:
+            zero_load = heavy.lost_motion - elastic_heavy
+            used = (heavy,)
+        else:
+            zero_load = heavy.lost_motion - factor * elastic_heavy
+            used = (heavy, light)
+        slope = CLEARANCE_SLOPE
+        if commissioning is not None:
+            estimate = (zero_load - commissioning.offset) / slope
+        else:
+            nominal = constant + sum(o.nominal for o in self.offsets.values())
+            estimate = (zero_load - nominal) / slope
+        budget = {
+            "repeatability": REVERSAL_REPEATABILITY
+            * math.sqrt(sum(w * w for w in weights))
+            / slope,
+            "stiffness": (
+                SHAPE_SD if factor is not None else STIFFNESS_FACTOR_SD * elastic_heavy / slope
+            ),
+            "uneven gaps": UNEVEN_GAP_SHARE * max(estimate, 0.0),
+            "slope": SLOPE_SD
+            * abs(estimate - (commissioning.clearance if commissioning is not None else 0.0)),
+        }
+        if commissioning is None:
+            for name, offset in self.offsets.items():
+                budget[name] = offset.sd / slope
+            lag = OffsetRange(*(share * chain_heavy.sensor_lag for share in SENSOR_LAG_SHARE))
+            budget["sensor lag"] = lag.sd / slope
+        else:  # the commissioning's own repeatability
+            budget["commissioning"] = budget["repeatability"] / math.sqrt(commissioning.checks)
+        sd = math.sqrt(sum(v * v for v in budget.values()))
+        half = self.conformal_scale * sd
+        return GaugeReading(
+            estimate=estimate,
+            lower=estimate - half,
+            upper=estimate + half,
+            zero_load_lost_motion=zero_load,
+            stiffness_factor=factor,
+            reversals=tuple((r.phase, r.load, r.lost_motion) for r in used),
+            budget=budget,
+            commissioned=commissioning is not None,
+            notes=tuple(notes),
+        )
+
+
+@dataclass(frozen=True)
+class GaugeReading:
+    """One check's clearance by physics.
+
+    Attributes
+    ----------
+    estimate, lower, upper : float [m]
+        The mean half-clearance b and its 90 % interval.
+    zero_load_lost_motion : float [m]
+        L_0, the lost motion extrapolated to zero load (what commissioning stores).
+    stiffness_factor : float or None
+        k of the two-load extrapolation (None: one reversal, the nominal chain).
+    reversals : tuple of (phase, load [N], lost motion [m])
+        The reversals read.
+    budget : dict of term → sd [m of b]
+    commissioned : bool
+        Whether the constant offset is the unit's own (:class:`Commissioning`).
+    notes : tuple of str
+    """
+
+    estimate: float
+    lower: float
+    upper: float
+    zero_load_lost_motion: float
+    stiffness_factor: float | None
+    reversals: tuple
+    budget: dict
+    commissioned: bool
+    notes: tuple = ()
+
+    @property
+    def sd(self) -> float:
+        """The budget's root sum square [m of b]."""
+        return math.sqrt(sum(v * v for v in self.budget.values()))
+
+
+def gauge_for(design: PRSMDesign | None, metadata: Mapping, check_part: Mapping | None = None):
+    """The gauge of a model bundle's actuator (None without a design): the drive train and
+    the instrumentation of the recipe it was trained on (``metadata["trained_on"]["recipe"]``;
+    the flight EMA's drive train where it does not say), and the conformal factor its check
+    part was calibrated with (else :data:`CONFORMAL_SCALE`)."""
+    if design is None:
+        return None
+    from prsm_health.actuator.drive_train import load_drive_train
+
+    recipe = (metadata.get("trained_on") or {}).get("recipe") or {}
+    drive = recipe.get("drive_train")
+    drive_train = load_drive_train(drive) if drive else DriveTrain()
+    instrumentation = recipe.get("instrumentation") or metadata.get("instrumentation")
+    calibration = (check_part or {}).get("gauge") or {}
+    try:
+        return Gauge.nominal(
+            design,
+            drive_train,
+            instrumentation,
+            conformal_scale=float(calibration.get("conformal_scale", CONFORMAL_SCALE)),
+        )
+    except ParameterError:  # an instrumentation this package does not know: no sensor term
+        return Gauge.nominal(design, drive_train, None)
