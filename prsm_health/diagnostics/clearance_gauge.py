@@ -94,10 +94,12 @@ SHAPE_SD = 0.15e-6
 UNEVEN_GAP_SHARE = 0.025
 #: Relative standard deviation of the slope 4 [-]: 4.03–4.05 measured on the settled steps.
 SLOPE_SD = 0.01
-#: Conformal factor on the budget's standard deviation for a 90 % interval (without a
-#: calibration of the unit's own recipe): measured by ``tools/studies/clearance_gauge.py`` on
-#: flight-ema units drawn from the documented ranges (docs/diagnostics.md).
+#: Conformal factors on the budget's standard deviation for a 90 % interval, not commissioned
+#: and commissioned (where a model's check part has none of its own recipe): measured by
+#: ``tools/studies/clearance_gauge.py`` on flight-ema units drawn from the documented ranges
+#: (docs/diagnostics.md).
 CONFORMAL_SCALE = 1.645
+COMMISSIONED_SCALE = 1.645
 
 
 #: The reversals' frequency [Hz] the sensors' delays are taken at: the built-in check's
@@ -200,8 +202,9 @@ class Gauge:
         no sensor term; :func:`~prsm_health.physics.lost_motion_chain.compliance_chain`).
     offsets : mapping of name → OffsetRange
         The constant terms' ranges [m of lost motion] (their middles are the nominal C).
-    conformal_scale : float
-        The interval's factor on the budget's sd (:data:`CONFORMAL_SCALE`).
+    conformal_scale, commissioned_scale : float
+        The interval's factor on the budget's sd, not commissioned and commissioned
+        (:data:`CONFORMAL_SCALE`, :data:`COMMISSIONED_SCALE`).
     """
 
     design: PRSMDesign
@@ -209,6 +212,7 @@ class Gauge:
     sensor_delays: Mapping[str, float] | None = None
     offsets: Mapping[str, OffsetRange] = field(default_factory=dict)
     conformal_scale: float = CONFORMAL_SCALE
+    commissioned_scale: float = COMMISSIONED_SCALE
 
     @classmethod
     def nominal(
@@ -219,6 +223,7 @@ class Gauge:
         *,
         reversal_frequency: float = NOMINAL_REVERSAL_FREQUENCY,
         conformal_scale: float = CONFORMAL_SCALE,
+        commissioned_scale: float = COMMISSIONED_SCALE,
     ) -> Gauge:
         """The gauge of an actuator from its datasheets: the drive train's figures (default:
         the flight EMA's), the sensors' filter delays of an instrumentation profile (name,
@@ -238,7 +243,8 @@ class Gauge:
                 for c in DELAYED_CHANNELS
                 if getattr(profile, c, None) is not None
             }
-        return cls(design, drive_train, delays, offset_ranges(design, drive_train), conformal_scale)
+        offsets = offset_ranges(design, drive_train)
+        return cls(design, drive_train, delays, offsets, conformal_scale, commissioned_scale)
 
     def chain(self, reversal):
         """The compliance chain at a reversal: its load, speed and the load shares its step
@@ -323,7 +329,7 @@ class Gauge:
         else:  # the commissioning's own repeatability
             budget["commissioning"] = budget["repeatability"] / math.sqrt(commissioning.checks)
         sd = math.sqrt(sum(v * v for v in budget.values()))
-        half = self.conformal_scale * sd
+        half = (self.conformal_scale if commissioning is None else self.commissioned_scale) * sd
         return GaugeReading(
             estimate=estimate,
             lower=estimate - half,
@@ -387,12 +393,11 @@ def gauge_for(design: PRSMDesign | None, metadata: Mapping, check_part: Mapping 
     drive_train = load_drive_train(drive) if drive else DriveTrain()
     instrumentation = recipe.get("instrumentation") or metadata.get("instrumentation")
     calibration = (check_part or {}).get("gauge") or {}
+    scales = {
+        "conformal_scale": float(calibration.get("conformal_scale", CONFORMAL_SCALE)),
+        "commissioned_scale": float(calibration.get("commissioned_scale", COMMISSIONED_SCALE)),
+    }
     try:
-        return Gauge.nominal(
-            design,
-            drive_train,
-            instrumentation,
-            conformal_scale=float(calibration.get("conformal_scale", CONFORMAL_SCALE)),
-        )
+        return Gauge.nominal(design, drive_train, instrumentation, **scales)
     except ParameterError:  # an instrumentation this package does not know: no sensor term
-        return Gauge.nominal(design, drive_train, None)
+        return Gauge.nominal(design, drive_train, None, **scales)

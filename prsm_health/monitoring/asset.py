@@ -479,7 +479,9 @@ class AssetHistory:
             filename=filename,
             healthy=healthy,
         )
-        history = AssetHistory(self.asset_id, (*self.entries, entry), evidence, cusum)
+        history = dataclasses.replace(
+            self, entries=(*self.entries, entry), evidence=evidence, cusum=cusum
+        )
         return history, dataclasses.replace(
             diagnosis, asset=state, warnings=[*diagnosis.warnings, *notes]
         )

@@ -66,7 +66,8 @@ BASELINE_ONLY_CASES = ("preload_loss",)
 
 def check_table(dataset, progress: bool = False):
     """The check indicators of every run of a dataset of check recordings, with the run
-    labels, as a DataFrame (one row per run)."""
+    labels and its reversals (``reversals``: what the clearance gauge reads), as a DataFrame
+    (one row per run)."""
     import pandas as pd
 
     design = getattr(dataset, "design", None)
@@ -81,8 +82,10 @@ def check_table(dataset, progress: bool = False):
         run = dataset.run(int(run_id), truth=False)
         if run.check_phase is None:
             raise PRSMHealthError(f"{dataset.path}: run {run_id} is no health-check recording")
-        row = dict(check_reading(run, design).indicators)
+        reading = check_reading(run, design)
+        row = dict(reading.indicators)
         row.update(run.labels)
+        row["reversals"] = reading.reversals
         rows.append(row)
     return pd.DataFrame(rows)
 
@@ -228,9 +231,11 @@ def _train_check_model(
     import pandas as pd
 
     from prsm_health.datasets import Dataset
+    from prsm_health.diagnostics.clearance_gauge import gauge_for
     from prsm_health.diagnostics.estimators import ClearanceEstimator, FaultClassifier
 
     from .evaluation import cross_validated_metrics
+    from .gauge_calibration import calibrate_gauge
 
     dirs = [check_dir] if isinstance(check_dir, (str, Path)) else list(check_dir)
     checks, base = [Dataset(d) for d in dirs], Dataset(baseline_dir)
@@ -303,6 +308,9 @@ def _train_check_model(
         "clearance_range": [float(np.min(y_clearance)), float(np.max(y_clearance))],
     }
     metrics["held_out"] = _held_out(part, table[~train], changes[~train], names, relative_names)
+    gauge = gauge_for(checks[0].design, {"trained_on": {"recipe": checks[0].manifest["recipe"]}})
+    if gauge is not None:
+        part["gauge"], metrics["gauge"] = calibrate_gauge(gauge, table, base_table)
     return part, metrics
 
 

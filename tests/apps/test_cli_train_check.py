@@ -113,11 +113,19 @@ def test_train_on_checks_builds_a_check_part_that_reads_a_check_phase_by_phase(
     assert bundle.design_name == "paper02"
     metrics = json.loads(out.with_name("own.check.metrics.json").read_text())
     assert metrics["check"]["runs"] == {"train": 12, "test": 4}
+    # the clearance gauge calibrated on the training units' checks, commissioned by their
+    # baselines, and scored on the held-out units'
+    gauge = metrics["check"]["gauge"]
+    assert gauge["commissioned"]["calibration_checks"] == 12
+    assert gauge["nominal"]["held_out_checks"] == 4
+    assert bundle.check["gauge"]["commissioned_scale"] > 0
+    assert bundle.clearance_gauge.commissioned_scale == bundle.check["gauge"]["commissioned_scale"]
 
     ds = Dataset(dataset)
     held_out = int(ds.runs.loc[ds.runs["split"] == "test", "run_id"].iloc[0])
     d = diagnose(ds.run(held_out, truth=False), bundle)
     assert d.check_phases and not d.windows  # phase by phase, not window by window
+    assert d.measured_clearance is not None and d.measured_clearance.learnt is not None
     assert not [w for w in d.warnings if "no health-check part" in w]
 
     # the front door: the recording as a file, read against the unit's baseline

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -39,6 +38,7 @@ from prsm_health.actuator.states import HealthState, OperatingProfile
 from prsm_health.diagnostics.clearance_gauge import Commissioning, Gauge
 from prsm_health.signals.check_indicators import check_indicators
 from prsm_health.simulation.scenario import Scenario, SimulationOptions
+from prsm_health.training.gauge_calibration import conformal_factor
 
 DESIGN = preset("paper01")
 #: What a unit is built and installed with: uniform draws.
@@ -58,7 +58,6 @@ TEMPERATURE = (283.15, 343.15)
 COMMISSIONING_CHECKS = 2
 SERVICE_CHECKS = 3
 SEEDS = {"calibration": 710_000, "fresh": 720_000}
-LEVEL = 0.9
 
 
 def draw_unit(seed: int) -> dict:
@@ -148,13 +147,6 @@ def one_unit(task) -> dict:
             }
         )
     return {"kind": kind, "seed": seed, "unit": unit, "checks": checks}
-
-
-def conformal_factor(scores, level: float = LEVEL) -> float:
-    """The split-conformal quantile: the ⌈(n+1)·level⌉-th smallest score."""
-    scores = np.sort(np.asarray(scores, float))
-    rank = min(len(scores), math.ceil((len(scores) + 1) * level))
-    return float(scores[rank - 1])
 
 
 def summary(units: list[dict], key: str, scale: float | None) -> dict:
