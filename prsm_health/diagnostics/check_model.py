@@ -157,16 +157,18 @@ def baseline_only_note(cls: str, reason: str) -> str:
     )
 
 
-def measured_clearance(reading, bundle, commissioning, learnt, notes: list[str]):
+def measured_clearance(reading, bundle, commissioning, learnt, notes: list[str], indicators: dict):
     """(the clearance measured by physics, its contract part) from a check's reversals
     (:mod:`~prsm_health.diagnostics.clearance_gauge`), the learnt reading ``learnt`` (a
     :class:`ClearanceInterval` or None) beside it; (None, None) without a reversal or a
     design. Adds to ``notes`` why a reversal was not read, the gauge's own notes, a
-    disagreement with the learnt reading and, not commissioned, how to narrow the interval."""
+    disagreement with the learnt reading and, not commissioned, how to narrow the interval;
+    to ``indicators`` the gauge's (:data:`~.clearance_gauge.GAUGE_INDICATORS`)."""
     gauge = bundle.clearance_gauge
     if gauge is None or not reading.reversals:
         return None, None
     measured = gauge.read(reading.reversals, commissioning)
+    indicators.update(measured.indicators())
     for phase, why in reading.unread_reversals.items():
         notes.append(
             f'reversal "{phase}" not read ({why}): the clearance is measured from '
@@ -213,8 +215,6 @@ PHYSICS_INDICATORS = (
     "check_torque_ratio",
     "check_temperature",
 )
-#: The zero-load lost motion of a check, among its indicators: what commissioning stores.
-ZERO_LOAD_LOST_MOTION = "check_zero_load_lost_motion"
 
 
 def read_check_by_physics(run: Run, bundle, diagnosis: Diagnosis, commissioning=None) -> None:
@@ -225,13 +225,14 @@ def read_check_by_physics(run: Run, bundle, diagnosis: Diagnosis, commissioning=
         return
     reading = check_reading(run, bundle.design)
     notes: list[str] = []
-    clearance, measured = measured_clearance(reading, bundle, commissioning, None, notes)
+    clearance, measured = measured_clearance(
+        reading, bundle, commissioning, None, notes, diagnosis.indicators
+    )
     for name in PHYSICS_INDICATORS:
         diagnosis.indicators[name] = finite_or_none(reading.indicators.get(name))
     if measured is not None:
         diagnosis.clearance = clearance
         diagnosis.measured_clearance = measured
-        diagnosis.indicators[ZERO_LOAD_LOST_MOTION] = measured.zero_load_lost_motion
         # a recording's observability is a share of its windows: the check shows it whole
         diagnosis.observability = Observability(1.0, diagnosis.observability.fault)
     diagnosis.warnings.extend(notes)
@@ -296,7 +297,7 @@ def diagnose_check(run: Run, bundle, baseline=None, commissioning=None) -> Diagn
     estimate = float(model.clearance.predict(x)[0])
     lower, upper = (float(a[0]) for a in model.clearance.predict_interval(x))
     learnt = ClearanceInterval(finite_or_none(estimate), lower, upper) if sees_clearance else None
-    clearance, measured = measured_clearance(reading, bundle, commissioning, learnt, notes)
+    clearance, measured = measured_clearance(reading, bundle, commissioning, learnt, notes, row)
     if clearance is None:
         clearance = ClearanceInterval(finite_or_none(estimate), lower, upper)
         if not sees_clearance:
@@ -346,8 +347,6 @@ def diagnose_check(run: Run, bundle, baseline=None, commissioning=None) -> Diagn
             "read alone: no baseline of this unit (its first health checks); against a "
             "baseline the change of each indicator is read too"
         )
-    if measured is not None:
-        row[ZERO_LOAD_LOST_MOTION] = measured.zero_load_lost_motion
     return Diagnosis(
         clearance=clearance,
         fault_class=fault_class,

@@ -92,6 +92,10 @@ SHAPE_SD = 0.15e-6
 #: mean gap by up to ≈ 6 % of b at a wear spread of 0.3 (measured by the study's factors); a
 #: wear spread drawn from [0, 0.3] gives about this share as its standard deviation.
 UNEVEN_GAP_SHARE = 0.025
+#: The same through the unit's own chain (commissioned: the heaviest reversal with k_c), per
+#: metre of clearance gained since commissioning [-]: the heavier reversal reads nearer the
+#: mean gap (measured by the study).
+COMMISSIONED_GAP_SHARE = 0.02
 #: Relative standard deviation of the slope 4 [-]: 4.03–4.05 measured on the settled steps.
 SLOPE_SD = 0.01
 #: Conformal factors on the budget's standard deviation for a 90 % interval, not commissioned
@@ -140,6 +144,16 @@ def offset_ranges(design: PRSMDesign, drive_train: DriveTrain) -> dict[str, Offs
     return out
 
 
+#: The gauge's quantities a check diagnosis lists among its indicators (name → the
+#: :class:`GaugeReading` attribute): an asset's history keeps them, and its commissioning reads
+#: them back (:meth:`Commissioning.from_indicators`).
+GAUGE_INDICATORS = {
+    "check_zero_load_lost_motion": "zero_load_lost_motion",
+    "check_stiffness_factor": "stiffness_factor",
+    "check_elastic_lost_motion": "elastic_lost_motion",
+}
+
+
 @dataclass(frozen=True)
 class OffsetRange:
     """A constant term of the lost motion the gauge cannot see, as the range a unit's value
@@ -159,32 +173,67 @@ class OffsetRange:
 
 @dataclass(frozen=True)
 class Commissioning:
-    """A unit's constant lost motion fixed at commissioning: C = L_0,c − 4·b_c [m], from its
-    as-built clearance b_c [m] and the median zero-load lost motion of its first checks."""
+    """A unit's own chain fixed at commissioning, where its as-built clearance b_c is known:
+    its stiffness factor k_c (the median of its first checks' two-load k; 1 where they had one
+    reversal) and its constant lost motion C = median(L_1 − k_c·E_1) − 4·b_c [m] over those
+    checks (L_1, E_1: the heaviest reversal's lost motion and the nominal chain's elastic part
+    there). A later check reads b = (L_1 − k_c·E_1 − C)/4.
+
+    Attributes
+    ----------
+    offset : float [m]
+        C.
+    clearance : float [m]
+        b_c.
+    checks : int
+    stiffness_factor : float
+        k_c.
+    """
 
     offset: float
     clearance: float
     checks: int
+    stiffness_factor: float = 1.0
 
     def __post_init__(self):
         require(math.isfinite(self.offset), "commissioning.offset", self.offset, "finite [m]")
         require_range("commissioning.clearance", self.clearance, -50e-6, 1e-3, unit="m")
         require(self.checks >= 1, "commissioning.checks", self.checks, "must be ≥ 1")
+        low, high = STIFFNESS_FACTOR_RANGE
+        require_range("commissioning.stiffness_factor", self.stiffness_factor, low, high)
 
     @classmethod
-    def from_checks(
-        cls, zero_load_lost_motions: Sequence[float], clearance: float, slope=CLEARANCE_SLOPE
-    ) -> Commissioning:
-        """From the zero-load lost motions [m] of the unit's first checks and its as-built
-        clearance b_c [m]; NaN readings are left out (none left: refused)."""
+    def from_readings(cls, readings: Sequence, clearance: float) -> Commissioning:
+        """From the unit's first checks — each ``(zero_load_lost_motion, stiffness_factor,
+        elastic_lost_motion)`` [m, -, m] of a :class:`GaugeReading` (the factor None with one
+        reversal) — and its as-built clearance b_c [m]; readings with a NaN left out (none
+        left: refused)."""
         import numpy as np
 
-        values = [float(v) for v in zero_load_lost_motions if v is not None and math.isfinite(v)]
-        if not values:
+        usable = [
+            (float(z), 1.0 if k is None else float(k), float(e))
+            for z, k, e in readings
+            if z is not None
+            and e is not None
+            and math.isfinite(z)
+            and math.isfinite(e)
+            and (k is None or math.isfinite(k))
+        ]
+        if not usable:
             raise ParameterError(
                 "commissioning", "no zero-load lost motion", "needs ≥ 1 check with its reversals"
             )
-        return cls(float(np.median(values)) - slope * clearance, float(clearance), len(values))
+        own = float(np.median([k for _, k, _ in usable]))
+        # L_1 − k_c·E_1 = L_0 + (k − k_c)·E_1 of each check
+        lost = [z + (k - own) * e for z, k, e in usable]
+        offset = float(np.median(lost)) - CLEARANCE_SLOPE * clearance
+        return cls(offset, float(clearance), len(usable), own)
+
+    @classmethod
+    def from_indicators(cls, rows: Sequence[Mapping], clearance: float) -> Commissioning:
+        """:meth:`from_readings` of the first checks' indicators (:data:`GAUGE_INDICATORS`)."""
+        names = list(GAUGE_INDICATORS)
+        return cls.from_readings([tuple(row.get(n) for n in names) for row in rows], clearance)
 
 
 @dataclass(frozen=True)
@@ -267,8 +316,10 @@ class Gauge:
         )
 
     def read(self, reversals, commissioning: Commissioning | None = None) -> GaugeReading | None:
-        """The clearance from a check's reversals (:class:`~prsm_health.signals.check_indicators.ReversalStep`,
-        any order); None without any."""
+        """The clearance from a check's reversals
+        (:class:`~prsm_health.signals.check_indicators.ReversalStep`, any order); None without
+        any. Commissioned with a stiffness factor, the heaviest reversal is read through the
+        unit's own chain (module docstring); else the reversals extrapolate to zero load."""
         reversals = sorted(reversals, key=lambda r: -r.load)
         if not reversals:
             return None
@@ -276,15 +327,15 @@ class Gauge:
         chain_heavy = self.chain(heavy)
         constant, elastic_heavy = chain_heavy.constant, chain_heavy.elastic
         notes = []
-        factor = None
-        weights = (1.0,)
+        factor, weights, elastic_gap = None, (1.0,), elastic_heavy
         if len(reversals) > 1 and heavy.load >= EXTRAPOLATION_RATIO * light.load:
             elastic_light = self.chain(light).elastic
-            k = (heavy.lost_motion - light.lost_motion) / (elastic_heavy - elastic_light)
+            elastic_gap = elastic_heavy - elastic_light
+            k = (heavy.lost_motion - light.lost_motion) / elastic_gap
             low, high = STIFFNESS_FACTOR_RANGE
             if low <= k <= high:
                 factor = k
-                r = elastic_heavy / (elastic_heavy - elastic_light)
+                r = elastic_heavy / elastic_gap
                 weights = (1.0 - r, r)  # L_0 = (1 − r)·L_1 + r·L_2
             else:
                 notes.append(
@@ -298,36 +349,40 @@ class Gauge:
                 f"to extrapolate (a ratio ≥ {EXTRAPOLATION_RATIO:g} is needed): read from "
                 f'"{heavy.phase}" with the nominal chain'
             )
-        if factor is None:
-            zero_load = heavy.lost_motion - elastic_heavy
-            used = (heavy,)
-        else:
-            zero_load = heavy.lost_motion - factor * elastic_heavy
-            used = (heavy, light)
+        used = (heavy,) if factor is None else (heavy, light)
+        zero_load = heavy.lost_motion - (1.0 if factor is None else factor) * elastic_heavy
         slope = CLEARANCE_SLOPE
-        if commissioning is not None:
-            estimate = (zero_load - commissioning.offset) / slope
-        else:
-            nominal = constant + sum(o.nominal for o in self.offsets.values())
-            estimate = (zero_load - nominal) / slope
-        budget = {
-            "repeatability": REVERSAL_REPEATABILITY
-            * math.sqrt(sum(w * w for w in weights))
-            / slope,
-            "stiffness": (
-                SHAPE_SD if factor is not None else STIFFNESS_FACTOR_SD * elastic_heavy / slope
-            ),
-            "uneven gaps": UNEVEN_GAP_SHARE * max(estimate, 0.0),
-            "slope": SLOPE_SD
-            * abs(estimate - (commissioning.clearance if commissioning is not None else 0.0)),
-        }
+        budget = {}
         if commissioning is None:
+            estimate = (
+                zero_load - constant - sum(o.nominal for o in self.offsets.values())
+            ) / slope
+            budget["repeatability"] = (
+                REVERSAL_REPEATABILITY * math.sqrt(sum(w * w for w in weights)) / slope
+            )
+            budget["stiffness"] = (
+                SHAPE_SD if factor is not None else STIFFNESS_FACTOR_SD * elastic_heavy / slope
+            )
             for name, offset in self.offsets.items():
                 budget[name] = offset.sd / slope
             lag = OffsetRange(*(share * chain_heavy.sensor_lag for share in SENSOR_LAG_SHARE))
             budget["sensor lag"] = lag.sd / slope
-        else:  # the commissioning's own repeatability
-            budget["commissioning"] = budget["repeatability"] / math.sqrt(commissioning.checks)
+            reference, gap_share = 0.0, UNEVEN_GAP_SHARE
+        else:
+            # the heaviest reversal through the unit's own chain: its stiffness factor, fixed at
+            # commissioning, does not follow the uneven gaps the way the extrapolation does
+            own = commissioning.stiffness_factor
+            own_zero_load = heavy.lost_motion - own * elastic_heavy
+            estimate = (own_zero_load - commissioning.offset) / slope
+            budget["repeatability"] = REVERSAL_REPEATABILITY / slope
+            # k_c from the commissioning checks' two reversals: their noise over the lever E_1 − E_2
+            k_noise = REVERSAL_REPEATABILITY * math.sqrt(2.0) / abs(elastic_gap)
+            budget["commissioning"] = math.hypot(
+                k_noise * elastic_heavy / slope, budget["repeatability"]
+            ) / math.sqrt(commissioning.checks)
+            reference, gap_share = commissioning.clearance, COMMISSIONED_GAP_SHARE
+        budget["uneven gaps"] = gap_share * max(estimate - reference, 0.0)
+        budget["slope"] = SLOPE_SD * abs(estimate - reference)
         sd = math.sqrt(sum(v * v for v in budget.values()))
         half = (self.conformal_scale if commissioning is None else self.commissioned_scale) * sd
         return GaugeReading(
@@ -336,6 +391,7 @@ class Gauge:
             upper=estimate + half,
             zero_load_lost_motion=zero_load,
             stiffness_factor=factor,
+            elastic_lost_motion=elastic_heavy,
             reversals=tuple((r.phase, r.load, r.lost_motion) for r in used),
             budget=budget,
             commissioned=commissioning is not None,
@@ -352,9 +408,12 @@ class GaugeReading:
     estimate, lower, upper : float [m]
         The mean half-clearance b and its 90 % interval.
     zero_load_lost_motion : float [m]
-        L_0, the lost motion extrapolated to zero load (what commissioning stores).
+        L_0, the lost motion extrapolated to zero load (two reversals) or read through the
+        nominal chain (one) — whether commissioned or not: what commissioning stores.
     stiffness_factor : float or None
         k of the two-load extrapolation (None: one reversal, the nominal chain).
+    elastic_lost_motion : float [m]
+        E_1, the nominal chain's elastic lost motion at the heaviest reversal.
     reversals : tuple of (phase, load [N], lost motion [m])
         The reversals read.
     budget : dict of term → sd [m of b]
@@ -368,6 +427,7 @@ class GaugeReading:
     upper: float
     zero_load_lost_motion: float
     stiffness_factor: float | None
+    elastic_lost_motion: float
     reversals: tuple
     budget: dict
     commissioned: bool
@@ -377,6 +437,10 @@ class GaugeReading:
     def sd(self) -> float:
         """The budget's root sum square [m of b]."""
         return math.sqrt(sum(v * v for v in self.budget.values()))
+
+    def indicators(self) -> dict[str, float | None]:
+        """The reading as check indicators (:data:`GAUGE_INDICATORS`)."""
+        return {name: getattr(self, attribute) for name, attribute in GAUGE_INDICATORS.items()}
 
 
 def gauge_for(design: PRSMDesign | None, metadata: Mapping, check_part: Mapping | None = None):

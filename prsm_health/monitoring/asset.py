@@ -34,8 +34,7 @@ from prsm_health.core.errors import require
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
 from prsm_health.core.jsonable import as_finite, finite_or_none
 from prsm_health.diagnostics.baseline import Baseline
-from prsm_health.diagnostics.check_model import ZERO_LOAD_LOST_MOTION
-from prsm_health.diagnostics.clearance_gauge import Commissioning
+from prsm_health.diagnostics.clearance_gauge import GAUGE_INDICATORS, Commissioning
 from prsm_health.diagnostics.contract import (
     CANNOT_TELL,
     OOD_LIMIT,
@@ -292,12 +291,11 @@ class AssetHistory:
         clearance and the zero-load lost motion of its baseline checks; None without either."""
         if self.as_built_clearance is None:
             return None
-        values = [
-            finite_or_none(e.indicators.get(ZERO_LOAD_LOST_MOTION))
-            for e in self.members([ZERO_LOAD_LOST_MOTION])
-        ]
-        values = [v for v in values if v is not None]
-        return Commissioning.from_checks(values, self.as_built_clearance) if values else None
+        members = self.members(list(GAUGE_INDICATORS)[:1])  # the checks the gauge read
+        if not members:
+            return None
+        rows = [{n: finite_or_none(e.indicators.get(n)) for n in GAUGE_INDICATORS} for e in members]
+        return Commissioning.from_indicators(rows, self.as_built_clearance)
 
     def members(self, names: Sequence[str] | None = None) -> list[AssetEntry]:
         """The baseline's recordings of one kind: those put in it that have any of ``names``

@@ -50,10 +50,10 @@ def _commissionings(gauge, base_table) -> dict:
     out = {}
     for unit, rows in base_table.groupby("unit_id").indices.items():
         readings = [gauge.read(base_table["reversals"].iloc[i]) for i in rows]
-        lost = [r.zero_load_lost_motion for r in readings if r is not None]
+        readings = [r.indicators() for r in readings if r is not None]
         as_built = real[rows]
-        if lost and np.isfinite(as_built).any():
-            out[unit] = Commissioning.from_checks(lost, float(np.nanmean(as_built)))
+        if readings and np.isfinite(as_built).any():
+            out[unit] = Commissioning.from_indicators(readings, float(np.nanmean(as_built)))
     return out
 
 

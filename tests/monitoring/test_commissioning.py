@@ -6,14 +6,18 @@ import math
 import pytest
 
 from prsm_health.core.errors import ParameterError
-from prsm_health.diagnostics.check_model import ZERO_LOAD_LOST_MOTION
+from prsm_health.diagnostics.clearance_gauge import GAUGE_INDICATORS
 from prsm_health.monitoring import AssetEntry, AssetHistory, FileAssetStore, commission
 from prsm_health.monitoring.steps import diagnose_asset
 from tests.diagnostics.test_check_model import bundle as stand_in_bundle
 
 
-def entry(name, lost_motion, baseline=True):
-    return AssetEntry(name, indicators={ZERO_LOAD_LOST_MOTION: lost_motion}, baseline=baseline)
+ZERO_LOAD, FACTOR, ELASTIC = GAUGE_INDICATORS
+
+
+def entry(name, lost_motion, baseline=True, factor=1.1, elastic=50e-6):
+    indicators = {ZERO_LOAD: lost_motion, FACTOR: factor, ELASTIC: elastic}
+    return AssetEntry(name, indicators=indicators, baseline=baseline)
 
 
 def test_the_offset_is_the_baseline_s_lost_motion_less_the_as_built_play():
@@ -23,8 +27,10 @@ def test_the_offset_is_the_baseline_s_lost_motion_less_the_as_built_play():
         as_built_clearance=5e-6,
     )
     c = history.commissioning()
-    # the median of the baseline checks that read one (not d, not the NaN of c)
+    # the median of the baseline checks that read one (not d, not the NaN of c); the factors
+    # equal: the zero-load lost motions themselves
     assert c.offset == pytest.approx(41e-6 - 4 * 5e-6) and c.checks == 2
+    assert c.stiffness_factor == pytest.approx(1.1)
     assert AssetHistory("unit-1", history.entries).commissioning() is None
     back = AssetHistory.from_json(history.to_json())
     assert back.as_built_clearance == 5e-6 and back.commissioning() == c

@@ -26,8 +26,8 @@ def _longest_built_in_check() -> float:
 
 
 #: Default longest recording of ``POST /v1/diagnose`` [s]: 2 s of in-service signal, or the
-#: longest built-in health check rounded up to the half second when that is longer (2.07 s →
-#: 2.5 s) — a check is one recording, read phase by phase, and must fit in one request.
+#: longest built-in health check rounded up to the half second when that is longer (2.62 s →
+#: 3 s) — a check is one recording, read phase by phase, and must fit in one request.
 DEFAULT_MAX_WINDOW_SECONDS = max(2.0, math.ceil(2.0 * _longest_built_in_check()) / 2.0)
 
 

@@ -310,12 +310,12 @@ def test_diagnose_rejects_bad_bodies(client, content, ctype, status):
 
 
 def test_diagnose_rejects_too_long_recordings(client):
-    # default limit: the longest built-in health check (2.07 s) rounded up to 2.5 s
-    assert DEFAULT_MAX_WINDOW_SECONDS == 2.5
-    body = {"sample_rate": 1000.0, "channels": {"nut_axial_accel": [0.0] * 2501}}
+    # default limit: the longest built-in health check (2.62 s) rounded up to 3 s
+    assert DEFAULT_MAX_WINDOW_SECONDS == 3.0
+    body = {"sample_rate": 1000.0, "channels": {"nut_axial_accel": [0.0] * 3001}}
     r = client.post("/v1/diagnose", json=body)
     assert r.status_code == 413
-    assert "at most 2.5 s" in r.json()["error"]
+    assert "at most 3 s" in r.json()["error"]
 
 
 def test_the_longest_built_in_check_fits_one_request():

@@ -238,16 +238,16 @@ def test_bad_sample_rate_metadata_is_422(app, recording):
 
 
 def test_recording_longer_than_max_window_is_413(app, reversing_run):
-    # 2.6 s of the run's channels repeated (no need to simulate that long: only its length
+    # 3.1 s of the run's channels repeated (no need to simulate that long: only its length
     # is checked)
     run = reversing_run(20e-6, seed=3).without_truth()
-    n = int(2.6 * run.sample_rate)
+    n = int(3.1 * run.sample_rate)
     reps = -(-n // len(run))
     channels = {k: np.tile(v, reps)[:n] for k, v in run.channels.items()}
     long = Run(np.arange(n) / run.sample_rate, channels, run.sample_rate, dict(run.labels))
     r = _post(app, write_run_arrow(long), ARROW)
     assert r.status_code == 413
-    assert "at most 2.5 s per request" in r.json()["error"]
+    assert "at most 3 s per request" in r.json()["error"]
 
 
 # ----------------------------------------------------------------------------- bombs
