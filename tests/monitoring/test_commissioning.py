@@ -11,7 +11,6 @@ from prsm_health.monitoring import AssetEntry, AssetHistory, FileAssetStore, com
 from prsm_health.monitoring.steps import diagnose_asset
 from tests.diagnostics.test_check_model import bundle as stand_in_bundle
 
-
 ZERO_LOAD, FACTOR, ELASTIC = GAUGE_INDICATORS
 
 

@@ -501,6 +501,18 @@ class ModelInfo(BaseModel):
     metrics: dict | None
 
 
+class CommissioningBody(BaseModel):
+    """An asset's commissioning: its thread half-clearance as built, measured at assembly. Its
+    baseline health checks then fix its own compliance chain, and every later check's
+    clearance is measured against it (docs/diagnostics.md, "Clearance measured by physics")."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    as_built_clearance: float = Field(
+        ge=-20e-6, le=200e-6, description="the half-clearance as built [m], e.g. 6e-6"
+    )
+
+
 class Error(BaseModel):
     error: str
 

@@ -276,7 +276,7 @@ def test_compressed_arrow_bomb_is_413_before_decoding(app, no_decoding):
     assert len(bomb) < 200_000
     r = _post(app, bomb, ARROW)
     assert r.status_code == 413
-    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 500000")
+    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 600000")
 
 
 def test_compressed_parquet_bomb_is_413_before_decoding(app, no_decoding):
@@ -286,7 +286,7 @@ def test_compressed_parquet_bomb_is_413_before_decoding(app, no_decoding):
     assert len(bomb) < 1_000_000
     r = _post(app, bomb, PARQUET)
     assert r.status_code == 413
-    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 500000")
+    assert r.json()["error"].startswith("recording too long: 5000000 samples, at most 600000")
 
 
 @pytest.mark.parametrize("kind", ["arrow-zstd", "parquet", "mcap"])

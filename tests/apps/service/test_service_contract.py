@@ -99,7 +99,7 @@ def test_published_schema_is_the_contract(doc):
     schemas = doc["components"]["schemas"]
     diagnosis = schemas["Diagnosis"]
     assert set(diagnosis["required"]) == CONTRACT_FIELDS
-    optional = {"window", "windows", "undecided", "check_phases", "asset"}
+    optional = {"window", "windows", "undecided", "check_phases", "asset", "measured_clearance"}
     assert set(diagnosis["properties"]) == CONTRACT_FIELDS | optional
     assert diagnosis["additionalProperties"] is False
     assert set(schemas["ClearanceInterval"]["required"]) == {"estimate", "lower", "upper"}

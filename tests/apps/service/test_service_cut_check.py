@@ -36,3 +36,35 @@ def test_a_cut_check_uploaded_is_warned_as_the_library_warns(cut_file, tmp_path)
     assert [served["clearance"]["lower"], served["clearance"]["upper"]] == list(
         bundle.check["clearance_range"]
     )
+
+
+def test_an_asset_commissioned_through_the_service_reads_its_own_chain(short_check_run, tmp_path):
+    """PUT the as-built clearance, then two checks under the asset: the first joins the
+    baseline (not yet commissioned), the second reads against the unit's own chain, its
+    interval narrower (no bearing play or gearhead backlash left in its budget)."""
+    bundle = load_bundle()
+    files = [
+        write_mcap(short_check_run(seed=seed).without_truth(), tmp_path / f"check-{seed}.mcap")
+        for seed in (4, 5)
+    ]
+    with LiveServer(create_app(None, tmp_path / "h.sqlite", bundle=bundle, warmup=False)) as live:
+        with live.client() as c:
+            bad = c.put("/v1/assets/u-1/commissioning", json={"as_built_clearance": 1.0})
+            assert bad.status_code == 422 and "error" in bad.json()
+            r = c.put("/v1/assets/u-1/commissioning", json={"as_built_clearance": 6e-6})
+            assert r.status_code == 200 and r.json() == {"as_built_clearance": 6e-6}
+            answers = [
+                c.post(
+                    "/v1/diagnose/file",
+                    files={"file": (f.name, f.read_bytes())},
+                    data={"asset_id": "u-1", "healthy": "true"},
+                ).json()["diagnosis"]
+                for f in files
+            ]
+    first, second = (a["measured_clearance"] for a in answers)
+    assert not first["commissioned"] and second["commissioned"]
+    assert (
+        "thrust-bearing play" in first["budget"] and "thrust-bearing play" not in second["budget"]
+    )
+    width = [a["clearance"]["upper"] - a["clearance"]["lower"] for a in answers]
+    assert width[1] < width[0]

@@ -2,7 +2,7 @@
 and evidence), ``GET /v1/assets/{asset_id}`` (one of them), ``GET
 /v1/assets/{asset_id}/evidence`` (its state after each of its recordings) and ``GET
 /v1/assets/{asset_id}/spectra`` (the spectra of its latest window): what the dashboard's
-pages read."""
+pages read; ``PUT /v1/assets/{asset_id}/commissioning`` (its as-built clearance)."""
 
 from typing import Annotated
 
@@ -10,6 +10,7 @@ import anyio
 from fastapi import APIRouter, Query, Request
 from fastapi import Path as PathParam
 
+from prsm_health.monitoring import commission
 from prsm_health.monitoring.sqlite_store import HistoryStore
 
 from ..responses import HTTPError, encode, json_response
@@ -18,6 +19,7 @@ from ..schemas import (
     AssetList,
     AssetRecordings,
     AssetSummary,
+    CommissioningBody,
     Error,
     Spectra,
 )
@@ -106,6 +108,27 @@ async def get_asset(
         return encode(summary)
 
     return json_response(await anyio.to_thread.run_sync(read))
+
+
+@router.put(
+    "/v1/assets/{asset_id}/commissioning",
+    summary="Commission an asset: its clearance as built",
+    response_model=None,
+    responses={
+        200: {"model": CommissioningBody},
+        422: {"model": Error, "description": "bad asset id or clearance"},
+    },
+)
+async def put_commissioning(
+    asset_id: Annotated[str, PathParam(pattern=ASSET_ID_PATTERN)],
+    body: CommissioningBody,
+    store: Store,
+):
+    """Give the asset its thread half-clearance as built (given again: replaced). Its
+    baseline health checks then fix its own compliance chain: the clearance of each later
+    check is measured against it (`measured_clearance.commissioned` true)."""
+    await anyio.to_thread.run_sync(commission, store, asset_id, body.as_built_clearance)
+    return json_response(encode({"as_built_clearance": body.as_built_clearance}))
 
 
 @router.get(
