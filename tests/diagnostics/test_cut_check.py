@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from prsm_health.diagnostics.diagnosis import diagnose, load_bundle
-from prsm_health.signals.check_indicators import check_indicators, phase_conditions
+from prsm_health.signals.check_indicators import check_indicators
+from prsm_health.signals.check_roles import phase_conditions
 
 CUTS = 20
 #: The roles each target of the check model needs (diagnostics.check_model: the clearance

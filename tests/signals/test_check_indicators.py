@@ -18,10 +18,9 @@ from prsm_health.signals.check_indicators import (
     ROLE_INDICATORS,
     ROLES,
     check_indicators,
-    find_roles,
-    phase_conditions,
     spectral_centroid,
 )
+from prsm_health.signals.check_roles import find_roles, phase_conditions
 
 RATE = 10_000.0  # the impact band is then 2–4 kHz
 DESIGN = preset("paper01")  # C_a ≈ 10.5 kN: 1000 N is 9.6 %, 2500 N 24 %

@@ -106,7 +106,7 @@ def test_mcap_topic_and_metadata_read_by_mcap(run, tmp_path):
         ]
         metadata = {m.name: m.metadata for m in reader.iter_metadata()}
     # one message per change: −1, then each phase and the ramp after it
-    assert [m["index"] for _, m in messages] == [-1, 0, -1, 1, -1, 2, -1, 3, -1, 4, -1]
+    assert [m["index"] for _, m in messages] == [-1, 0, -1, 1, -1, 2, -1, 3, -1, 4, -1, 5, -1]
     names = run.check.names()
     for log_time, m in messages:
         assert m["name"] == names.get(m["index"], "")
