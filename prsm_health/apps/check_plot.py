@@ -136,7 +136,7 @@ def check_figure(run: Run, diagnosis, *, design=None, reference: Run | None = No
         elif role == "torque_pair":
             _torque_pair(ax, phases[names[0]], phases[names[1]], result["indicators"])
         elif role == "reversal":
-            _reversal(ax, phases[names[0]], design)
+            _reversal(ax, phases, names[0], design, result.get("measured_clearance"))
         else:
             reference_phase = None if reference is None else reference.phases().get(names[0])
             _high_load(ax, phases[names[0]], design, run, result["indicators"], reference_phase)
@@ -204,14 +204,25 @@ def _torque_pair(ax, slow: Run, fast: Run, indicators: dict) -> None:
     ax.set_ylabel("drive torque [N·m]")
 
 
-def _reversal(ax, phase: Run, design) -> None:
+def _reversal(ax, phases: dict, name: str, design, measured: dict | None) -> None:
     # the nut's lag behind the screw's kinematic travel: its two branches (one per flank side)
-    # stand apart by the lost motion
-    travel = speed_ratios(design).nut * np.asarray(phase.channels["screw_angle"], float)
-    position = np.asarray(phase.channels["nut_position"], float)
-    lag = position - travel
-    lag -= np.median(lag)
-    ax.plot(1e3 * (travel - travel[0]), 1e6 * lag, lw=0.6, color="k")
+    # stand apart by the lost motion; each reversal the clearance was measured from, its loop
+    read = [(r["phase"], r["load"]) for r in (measured or {}).get("reversals", [])]
+    for (phase_name, load), colour in zip(read or [(name, None)], ("k", "tab:orange", "tab:blue")):
+        phase = phases[phase_name]
+        travel = speed_ratios(design).nut * np.asarray(phase.channels["screw_angle"], float)
+        lag = np.asarray(phase.channels["nut_position"], float) - travel
+        lag -= np.median(lag)
+        label = phase_name if load is None else f"{phase_name} (±{load:.0f} N)"
+        ax.plot(1e3 * (travel - travel[0]), 1e6 * lag, lw=0.6, color=colour, label=label)
+    if measured is not None:
+        how = "commissioned" if measured["commissioned"] else "not commissioned"
+        learnt = measured.get("learnt") or {}
+        text = f"clearance measured by lost motion ({how})"
+        if learnt.get("estimate") is not None:
+            agree = "agrees" if measured["agree"] else "DISAGREES"
+            text += f"; learnt {1e6 * learnt['estimate']:.1f} µm ({agree})"
+        ax.legend(fontsize=7, loc="upper left", title=text, title_fontsize=7)
     ax.set_xlabel("screw angle × lead (kinematic nut travel) [mm]")
     ax.set_ylabel("nut position − screw angle × lead [µm]", fontsize=8)
 

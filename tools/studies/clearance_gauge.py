@@ -101,9 +101,10 @@ def simulate_check(unit: dict, seed: int, clearance: float, temperature: float, 
 
 
 def _learnt(run, bundle):
+    """The shipped check model's own clearance (the cross-check beside the measured one)."""
     from prsm_health.diagnostics.check_model import diagnose_check
 
-    c = diagnose_check(run.without_truth(), bundle).clearance
+    c = diagnose_check(run.without_truth(), bundle).measured_clearance.learnt
     return [c.estimate, c.lower, c.upper]
 
 
@@ -154,7 +155,16 @@ def one_unit(task) -> dict:
                 "budget": own.budget,
             }
         )
-    return {"kind": kind, "seed": seed, "unit": unit, "checks": checks}
+    # the heaviest reversal's lost motion at each commissioning check (same unit, same b): the
+    # reversals' repeatability
+    heavy_steps = [r.reversals[0][2] for r in first]
+    return {
+        "kind": kind,
+        "seed": seed,
+        "unit": unit,
+        "checks": checks,
+        "commissioning": heavy_steps,
+    }
 
 
 def summary(units: list[dict], key: str, scale: float | None) -> dict:
@@ -234,6 +244,10 @@ def report(units: list[dict]) -> dict:
         term: float(np.mean([c["budget"][term] for u in fresh for c in u["checks"]]) * 1e6)
         for term in fresh[0]["checks"][0]["budget"]
     }
+    pairs = [u["commissioning"] for u in units]
+    out["reversal_repeatability_um"] = float(
+        np.std([a - b for a, b, *_ in pairs], ddof=1) / np.sqrt(2) * 1e6
+    )
     out["units"] = {"calibration": len(calibration), "fresh": len(fresh)}
     return out
 
