@@ -304,7 +304,89 @@ Fault class (drop of accuracy):
   on measured data (`prsm-health import`, `prsm-health evaluate`) before trusting it.
 """
         + check_card_section(metrics.get("check", {}))
+        + gauge_card_section(metrics.get("gauge", {}))
     )
+
+
+#: The tool that measures the clearance gauge's numbers.
+GAUGE_TOOL = "tools/studies/clearance_gauge.py"
+#: The gauge's readings in the card, in order: key → what it is.
+GAUGE_READINGS = {
+    "commissioned": "measured, commissioned (the unit's own chain, heavier reversal)",
+    "commissioned_two_load": "measured, commissioned on the zero-load extrapolation instead",
+    "one_reversal": "measured, commissioned, a check with one reversal",
+    "nominal": "measured, not commissioned (the datasheets' ranges)",
+    "learnt": "learnt (the check model's own clearance)",
+}
+
+
+def gauge_card_section(gauge: dict) -> str:
+    """The card's "Clearance measured by physics" section from ``metrics["gauge"]`` (the
+    study's numbers, :data:`GAUGE_TOOL`); empty before it is measured."""
+    if not gauge:
+        return ""
+    units = gauge["units"]
+    rows = []
+    for key, what in GAUGE_READINGS.items():
+        fresh = gauge[key]["fresh"]
+        rows.append(
+            [
+                what,
+                fixed(fresh["error_mean_um"], 2),
+                fixed(fresh["error_sd_um"], 2),
+                fixed(fresh["unit_bias_sd_um"], 2),
+                fixed(fresh.get("coverage"), 2),
+                fixed(gauge[key].get("conformal_scale"), 2),
+            ]
+        )
+    readings = table(
+        [
+            "clearance",
+            "error mean [µm]",
+            "error sd [µm]",
+            "unit bias sd [µm]",
+            "90 % coverage",
+            "conformal factor",
+        ],
+        rows,
+    )
+    factors = table(
+        ["factor", "range", "lower third: error mean (sd) [µm]", "upper third"],
+        (
+            [
+                name,
+                gauge["ranges"].get(name, MISSING),
+                f"{v['lower third'][0]:+.2f} ({v['lower third'][1]:.2f})",
+                f"{v['upper third'][0]:+.2f} ({v['upper third'][1]:.2f})",
+            ]
+            for name, v in gauge["by_factor"].items()
+        ),
+    )
+    budget = ", ".join(f"{k} {v:.2f}" for k, v in gauge["budget_mean_um"].items())
+    return f"""
+## Clearance measured by physics (the health check as a measuring instrument)
+
+*Measured by `{GAUGE_TOOL}`.* The clearance of a health check is measured from its reversals'
+lost motion through the actuator's compliance chain (docs/diagnostics.md, "Clearance measured
+by physics"); the check model's learnt clearance is its cross-check. Units of paper01 with the
+flight-ema sensors, each built from the ranges below (drawn uniformly), an as-built clearance
+of 2–8 µm and a worn one up to 30 µm; two checks at the as-built clearance (commissioning), three
+on the way to the worn one, each at a housing temperature of 10–70 °C with its own sensor noise.
+The conformal factor of each reading's 90 % interval is calibrated on {units["calibration"]}
+units, the figures are of {units["fresh"]} fresh units (seeds used nowhere else), against the
+realised mean clearance (the rollers' mean half-clearance, screw and nut sides):
+
+{readings}
+
+One reversal's repeatability between a unit's checks: {fixed(gauge["reversal_repeatability_um"], 3)}
+µm of lost motion. The commissioned reading's budget, mean over the fresh checks [µm of
+clearance]: {budget}.
+
+Sensitivity of the commissioned reading (fresh units; each factor's drawn values cut into
+thirds, the others drawn as usual — units, not a controlled change):
+
+{factors}
+"""
 
 
 def check_card_section(check: dict) -> str:

@@ -23,6 +23,20 @@ def test_a_check_without_a_check_part_says_so_in_one_line(short_check_run, windo
     assert "window by window" in line and "out-of-distribution" in line
     assert "prsm-health train" in line and "docs/diagnostics.md" in line
     assert not d.check_phases and d.windows  # read across its phases, not phase by phase
+    assert "what physics reads alone" in line
+
+
+def test_without_a_check_part_physics_still_reads_the_check(short_check_run, windows_only):
+    """The clearance measured from the check's reversal (the window model's own clearance
+    replaced), the torque ratio and the temperature, from the check's phases."""
+    d = diagnose(short_check_run(), windows_only)
+    measured = d.measured_clearance
+    assert measured is not None and [r.phase for r in measured.reversals] == ["swing"]
+    assert measured.learnt is None and d.observability["clearance"] == 1.0
+    assert d.clearance.lower < d.clearance.estimate < d.clearance.upper
+    assert d.indicators["check_torque_ratio"] > 0
+    assert d.indicators["check_temperature"] > 250
+    assert d.indicators["check_zero_load_lost_motion"] == measured.zero_load_lost_motion
 
 
 def test_a_recording_that_is_no_check_gets_no_such_line(reversing_run, windows_only):
