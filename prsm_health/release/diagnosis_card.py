@@ -378,9 +378,10 @@ realised mean clearance (the rollers' mean half-clearance, screw and nut sides):
 
 {readings}
 
-One reversal's repeatability between a unit's checks: {fixed(gauge["reversal_repeatability_um"], 3)}
-µm of lost motion. The commissioned reading's budget, mean over the fresh checks [µm of
-clearance]: {budget}.
+The heavier reversal's lost motion between a unit's two commissioning checks (one clearance,
+each at its own temperature: the friction's torsion, which the measured torque carries into
+the chain) has an sd of {fixed(gauge["commissioning_step_sd_um"], 2)} µm. The commissioned
+reading's budget, mean over the fresh checks [µm of clearance]: {budget}.
 
 Sensitivity of the commissioned reading (fresh units; each factor's drawn values cut into
 thirds, the others drawn as usual — units, not a controlled change):

@@ -18,6 +18,7 @@ table by factor, each factor's lower against upper third of its range).
 
     python tools/studies/clearance_gauge.py --units 30          # ≈ 20 min on 2 cores
     python tools/studies/clearance_gauge.py --factors           # one factor at a time, ≈ 1 min
+    python tools/studies/clearance_gauge.py --repeatability     # the sensors' scatter, ≈ 1 min
     python tools/studies/clearance_gauge.py --record clearance_gauge.json   # into the card
 
 Quoted in docs/diagnostics.md ("Clearance measured by physics") and models/MODEL_CARD.md.
@@ -156,8 +157,8 @@ def one_unit(task) -> dict:
                 "budget": own.budget,
             }
         )
-    # the heaviest reversal's lost motion at each commissioning check (same unit, same b): the
-    # reversals' repeatability
+    # the heaviest reversal's lost motion at each commissioning check (same unit and clearance,
+    # each at its own temperature: the friction's torsion moves it, the measured torque with it)
     heavy_steps = [r.reversals[0][2] for r in first]
     return {
         "kind": kind,
@@ -246,7 +247,7 @@ def report(units: list[dict]) -> dict:
         for term in fresh[0]["checks"][0]["budget"]
     }
     pairs = [u["commissioning"] for u in units]
-    out["reversal_repeatability_um"] = float(
+    out["commissioning_step_sd_um"] = float(
         np.std([a - b for a, b, *_ in pairs], ddof=1) / np.sqrt(2) * 1e6
     )
     out["units"] = {"calibration": len(calibration), "fresh": len(fresh)}
@@ -289,6 +290,37 @@ def one_factor(task):
     gauge = Gauge.nominal(DESIGN, instrumentation="flight-ema")
     two, one = gauge.read(reversals), gauge.read(reversals[:1])
     return label, b, real, two.estimate, one.estimate, two.stiffness_factor
+
+
+def one_repeat(task):
+    noise, sensor_seed = task
+    unit = {
+        "thrust_bearing_stiffness": DriveTrain().thrust_bearing_stiffness,
+        "thrust_bearing_play": 0.0,
+        "coupling_stiffness": DriveTrain().coupling_stiffness,
+        "gear_backlash_share": 1.0,
+        "friction_scale": 1.0,
+        "lubricant_degradation": 0.0,
+        "wear_spread": 0.0,
+        "lvdt_noise": noise,
+    }
+    run, _ = simulate_check(unit, 7, 10e-6, 313.15, sensor_seed)
+    return noise, [r.lost_motion for r in check_indicators(run, DESIGN).reversals]
+
+
+def repeatability(workers: int) -> None:
+    """The settled steps' scatter from the sensors alone: one unit, one clearance and
+    temperature, six sensor seeds, at the LVDT noise range's ends."""
+    tasks = [(noise, seed) for noise in RANGES["lvdt_noise"] for seed in range(6)]
+    with ProcessPoolExecutor(workers) as pool:
+        rows = list(pool.map(one_repeat, tasks))
+    for noise in RANGES["lvdt_noise"]:
+        steps = np.array([r for n, r in rows if n == noise]) * 1e6
+        print(
+            f"LVDT {noise * 1e6:g} µm RMS: sd of the settled step over 6 sensor seeds "
+            f"{steps[:, 0].std(ddof=1):.3f} µm (±25 % C_a), {steps[:, 1].std(ddof=1):.3f} µm "
+            "(±10 % C_a)"
+        )
 
 
 def factors(workers: int) -> None:
@@ -342,6 +374,9 @@ def main() -> None:
     parser.add_argument("--units", type=int, default=30, help="units per set")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--factors", action="store_true", help="one factor at a time instead")
+    parser.add_argument(
+        "--repeatability", action="store_true", help="the settled steps' scatter from the sensors"
+    )
     parser.add_argument("--out", type=Path, default=Path("clearance_gauge.json"))
     parser.add_argument(
         "--record",
@@ -354,6 +389,9 @@ def main() -> None:
     args = parser.parse_args()
     if args.factors:
         factors(args.workers)
+        return
+    if args.repeatability:
+        repeatability(args.workers)
         return
     if args.record is not None:
         record(json.loads(args.record.read_text())["result"])
