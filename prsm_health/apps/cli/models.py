@@ -110,6 +110,12 @@ def check_training_rows(result: dict) -> list:
                 "",
             )
         )
+    for kind, how in (("commissioned", "commissioned"), ("nominal", "not commissioned")):
+        g = m.get("gauge", {}).get(kind)
+        if g and g.get("held_out_error_sd") is not None:
+            error = f"{1e6 * g['held_out_error_mean']:+.2f} ± {1e6 * g['held_out_error_sd']:.2f}"
+            covered = share(g["held_out_coverage"], "checks")
+            rows.append((f"measured clearance, {how}", error, f"µm held out; interval {covered}"))
     return rows
 
 
