@@ -27,7 +27,7 @@ demo: $(STAMP)
 	$(BIN)/prsm-health simulate --clearance 22e-6 --speed 90 --load 0 --load-profile reversing \
 		--load-amplitude 20%C_a --load-frequency 10 --accel-time 0.002 --contact-law hertz \
 		--duration 2 --seed 99 --out $(DEMO)/recording.mcap --plot $(DEMO)/recording.png
-	$(BIN)/prsm-health simulate --profile health-check --clearance 22e-6 --seed 99 \
+	$(BIN)/prsm-health simulate --profile health-check --clearance 22e-6 --seed 99 --contact-law hertz \
 		--out $(DEMO)/check.parquet --plot $(DEMO)/check.png
 	$(BIN)/prsm-health diagnose $(DEMO)/recording.mcap --model $(DEMO)/model.skops --plot $(DEMO)/diagnosis.png
 	$(BIN)/prsm-health diagnose $(DEMO)/check.parquet > $(DEMO)/check-diagnosis.txt && head -n 4 $(DEMO)/check-diagnosis.txt
