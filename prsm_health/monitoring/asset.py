@@ -29,6 +29,7 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from prsm_health.core.errors import require
 from prsm_health.core.identifiers import ASSET_ID_PATTERN, ASSET_ID_RULE
@@ -171,6 +172,20 @@ def _by_size(changes: Mapping[str, float]) -> dict[str, float]:
     return dict(sorted(finite.items(), key=lambda kv: -abs(kv[1])))
 
 
+class OperatingRow(NamedTuple):
+    """A recorded diagnosis with operating hours, as a prognosis reads it
+    (:meth:`AssetHistory.operating_history`, the service's
+    :meth:`~.sqlite_store.HistoryStore.operating_history`); ``design`` is the diagnosing
+    model's."""
+
+    operating_hours: float
+    clearance_estimate: float | None
+    clearance_lower: float | None
+    clearance_upper: float | None
+    fault_class: str | None
+    design: str | None
+
+
 @dataclass(frozen=True)
 class AssetEntry:
     """One recording of an asset, as recorded in its history.
@@ -206,6 +221,8 @@ class AssetEntry:
         The recording's file name, for people.
     healthy : bool or None
         The label given with the recording (None: not said).
+    design : str or None
+        The diagnosing model's design (None in histories recorded before it was kept).
     """
 
     recording_id: str
@@ -221,6 +238,7 @@ class AssetEntry:
     source: str = ""
     filename: str | None = None
     healthy: bool | None = None
+    design: str | None = None
 
     def __post_init__(self):
         object.__setattr__(self, "state", AssetState.of(self.state))
@@ -296,6 +314,22 @@ class AssetHistory:
             return None
         rows = [{n: finite_or_none(e.indicators.get(n)) for n in GAUGE_INDICATORS} for e in members]
         return Commissioning.from_indicators(rows, self.as_built_clearance)
+
+    def operating_history(self) -> list[OperatingRow]:
+        """Its recordings with operating hours, as a prognosis reads them
+        (:func:`prsm_health.prognostics.history_of_readings`), in the order recorded."""
+        return [
+            OperatingRow(
+                e.operating_hours,
+                finite_or_none(e.clearance.get("estimate")),
+                finite_or_none(e.clearance.get("lower")),
+                finite_or_none(e.clearance.get("upper")),
+                e.fault_class,
+                e.design,
+            )
+            for e in self.entries
+            if e.operating_hours is not None
+        ]
 
     def members(self, names: Sequence[str] | None = None) -> list[AssetEntry]:
         """The baseline's recordings of one kind: those put in it that have any of ``names``
@@ -476,6 +510,7 @@ class AssetHistory:
             source=str(source or ""),
             filename=filename,
             healthy=healthy,
+            design=diagnosis.model.design if diagnosis.model is not None else None,
         )
         history = dataclasses.replace(
             self, entries=(*self.entries, entry), evidence=evidence, cusum=cusum

@@ -21,6 +21,7 @@ from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import dumps, json_ready
 from prsm_health.diagnostics.check_verdicts import check_verdicts
 
+from .asset import OperatingRow
 from .sqlite_assets import ASSET_SCHEMA, AssetTables, HistoryCache, insert_statement, named_rows
 from .status import asset_status
 
@@ -120,18 +121,6 @@ class SpectraRow(NamedTuple):
     operating_hours: float | None
     channel: str
     spectra: str
-
-
-class OperatingRow(NamedTuple):
-    """A stored diagnosis with operating hours, as a prognosis reads it
-    (:meth:`HistoryStore.operating_history`); ``design`` is the diagnosing model's."""
-
-    operating_hours: float
-    clearance_estimate: float | None
-    clearance_lower: float | None
-    clearance_upper: float | None
-    fault_class: str | None
-    design: str | None
 
 
 _INSERT_DIAGNOSIS = insert_statement("INSERT", "diagnoses", DiagnosisRow)

@@ -27,7 +27,7 @@ from .history import (
 from .method import HORIZON_FACTOR
 from .model_files import DEFAULT_PROGNOSTICS_MODEL, load_prognostics_model, save_prognostics_model
 from .prognosis import Prognosis
-from .rul import METHODS, RULModel, prognose
+from .rul import METHODS, RULModel, prognose, prognose_readings
 
 __all__ = [
     "DEFAULT_PROGNOSTICS_MODEL",
@@ -45,6 +45,7 @@ __all__ = [
     "simulated_histories",
     "load_prognostics_model",
     "prognose",
+    "prognose_readings",
     "history_of_readings",
     "read_history",
     "save_prognostics_model",

@@ -33,6 +33,7 @@ References
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -49,7 +50,14 @@ from prsm_health.core.version import __version__
 
 from .ageing_rul import AgeingRUL, PhysicsRUL
 from .degradation import FORMS, DegradationRUL
-from .history import Z90, model_design, one_line, validate_history
+from .history import (
+    Z90,
+    HistoryError,
+    history_of_readings,
+    model_design,
+    one_line,
+    validate_history,
+)
 from .method import Estimate, FleetSummary, RULMethod, TrainingFleet, UnitHistory
 from .prognosis import Prognosis
 from .similarity import SimilarityRUL
@@ -519,3 +527,40 @@ def prognose(history: pd.DataFrame, model: RULModel, method=None) -> Prognosis:
     )
     clean = validate_history(history, model)
     return model.predict(clean, method=method)
+
+
+def prognose_readings(
+    rows, model: RULModel, method=None, *, asset: str = "asset"
+) -> tuple[Prognosis, pd.DataFrame]:
+    """The prognosis of an asset from its stored readings (rows with operating hours, the
+    clearance with its interval and the diagnosing model's design: the CLI's
+    :meth:`~prsm_health.monitoring.asset.AssetHistory.operating_history`, the service's
+    :meth:`~prsm_health.monitoring.sqlite_store.HistoryStore.operating_history`), the
+    readings' notes first in its warnings; and the history it was made from.
+
+    Raises
+    ------
+    HistoryError
+        Fewer than 2 readings at distinct operating hours, a reading whose design is not
+        recorded, another design than the model's, a history :func:`prognose` refuses: one
+        sentence naming ``asset``.
+    """
+    missing = sum(1 for r in rows if r.design is None)
+    if missing:
+        raise HistoryError(
+            f"{asset}: {missing} of its diagnoses do not record the design that diagnosed them "
+            "(recorded before the design was kept): diagnose those recordings again",
+            field="history.design",
+        )
+    history, notes = history_of_readings(rows)
+    if len(history) < 2:
+        raise HistoryError(
+            f"{asset} has {len(history)} diagnosis(es) at distinct operating hours; a "
+            "prognosis needs at least 2 (give each recording its operating hours)",
+            field="history.age_hours",
+        )
+    try:
+        prognosis = prognose(history, model, method)
+    except HistoryError as exc:
+        raise HistoryError(f"{asset}: {exc}", field=exc.field, value=exc.value) from None
+    return replace(prognosis, warnings=[*notes, *prognosis.warnings]), history

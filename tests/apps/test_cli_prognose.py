@@ -264,3 +264,62 @@ def test_bad_fleet_inputs_are_one_line_exit_2(capsys, fleet, model_file, extra, 
     assert code == 2 and out == ""
     assert err.startswith("error: ") and err.count("\n") == 1, err
     assert words in err
+
+
+def _asset_store(directory, table, design="paper01", asset="unit-1"):
+    """A file store whose asset ``asset`` holds ``table``'s diagnoses as recorded entries."""
+    from dataclasses import replace
+
+    from prsm_health.monitoring import AssetEntry, FileAssetStore
+
+    store = FileAssetStore(directory)
+    entries = tuple(
+        AssetEntry(
+            f"rec-{i}",
+            operating_hours=float(row.age_hours),
+            fault_class="wear",
+            clearance={
+                "estimate": float(row.clearance),
+                "lower": float(row.clearance_lower),
+                "upper": float(row.clearance_upper),
+            },
+            design=design,
+        )
+        for i, row in enumerate(table.itertuples())
+    )
+    store.update(asset, lambda h: (replace(h, entries=entries), None))
+    return directory
+
+
+def test_an_asset_s_stored_diagnoses_are_its_history(capsys, tmp_path, model_file, history):
+    store = _asset_store(tmp_path / "assets", history["table"])
+    code, out, _ = run(
+        capsys, "prognose", "--asset", "unit-1", "--store", store, "--model", model_file, "--json"
+    )
+    assert code == 0
+    expected = prognose(history["table"], load_prognostics_model(model_file)).as_dict()
+    assert json.loads(out)["rul_hours"] == pytest.approx(expected["rul_hours"])
+    code, out, _ = run(
+        capsys, "prognose", "--asset", "unit-1", "--store", store, "--model", model_file
+    )
+    assert code == 0 and "asset unit-1" in out and "RUL" in out
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--asset", "nobody"], "no asset 'nobody'"),
+        ([], "a history table, a fleet dataset with --unit, or --asset ID"),
+        (["--asset", "unit-1", "--unit", "1"], "--unit applies to a fleet dataset"),
+        (["--asset", "unit-1", "somefile.csv"], "give no history or dataset"),
+        (["--asset", "old-1"], "do not record the design"),
+    ],
+)
+def test_bad_asset_inputs_are_one_line_exit_2(capsys, tmp_path, model_file, history, extra, words):
+    store = _asset_store(tmp_path / "assets", history["table"])
+    # an asset recorded before the design was kept
+    _asset_store(store, history["table"], design=None, asset="old-1")
+    code, out, err = run(capsys, "prognose", *extra, "--store", store, "--model", model_file)
+    assert code == 2 and out == ""
+    assert err.startswith("error: ") and err.count("\n") == 1, err
+    assert words in err

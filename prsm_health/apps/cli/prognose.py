@@ -8,10 +8,12 @@ from pathlib import Path
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.diagnostics.diagnosis import load_bundle
+from prsm_health.monitoring import FileAssetStore, validate_asset_id
 from prsm_health.prognostics import (
     fit_prognostics_model,
     fleet_histories,
     load_prognostics_model,
+    prognose_readings,
     read_history,
     save_prognostics_model,
 )
@@ -35,6 +37,12 @@ def is_dataset(source: str) -> bool:
 
 
 def prognose(args) -> int:
+    if args.asset is not None:
+        return _prognose_asset(args)
+    if args.source is None:
+        raise PRSMHealthError(
+            "prognose needs a history table, a fleet dataset with --unit, or --asset ID"
+        )
     fleet = is_dataset(args.source)
     if not fleet:
         for option, name in FLEET_OPTIONS:
@@ -69,11 +77,41 @@ def prognose(args) -> int:
     return 0
 
 
+def _prognose_asset(args) -> int:
+    """The prognosis of an asset recorded with ``diagnose --asset`` (its stored diagnoses with
+    operating hours), as the service makes it (:func:`prognose_readings`)."""
+    if args.source is not None:
+        raise PRSMHealthError(
+            f"--asset reads the asset's stored diagnoses: give no history or dataset "
+            f"({args.source})"
+        )
+    for option, name in FLEET_OPTIONS:
+        if getattr(args, name) is not None:
+            raise PRSMHealthError(f"{option} applies to a fleet dataset, not to --asset")
+    model = load_prognostics_model(args.model)
+    store = FileAssetStore(args.store)
+    asset = validate_asset_id(args.asset, "--asset")
+    if asset not in store.asset_ids():
+        raise PRSMHealthError(
+            f"no asset {asset!r} in {args.store} (diagnose its recordings with --asset "
+            f"{asset} --operating-hours H first)"
+        )
+    rows = store.load(asset).history.operating_history()
+    prognosis, history = prognose_readings(rows, model, args.method, asset=f"asset {asset!r}")
+    if args.json:
+        print_json(prognosis.as_dict())
+        return 0
+    print_table(_prognosis_rows(args, prognosis, history, None))
+    return 0
+
+
 def _prognosis_rows(args, prognosis, history, true_rul) -> list:
     rul, hi, m = prognosis.rul_hours, prognosis.health_indicator, prognosis.model
     latest = history.iloc[-1]  # the latest diagnosis, with its own (maybe uneven) interval
     ages = hi["ages_hours"]
     source = f"{args.source}, unit {args.unit}" if args.unit is not None else args.source
+    if args.asset is not None:
+        source = f"asset {args.asset} ({args.store})"
     rows = [
         ("history", source, ""),
         ("diagnoses", f"{len(ages)} from {hours(ages[0])} to {hours(ages[-1])}", "h"),

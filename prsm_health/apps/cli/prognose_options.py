@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from .assets_options import add_store
 from .options import SHIPPED_MODEL, add_json, finite_float
 
 #: ``prognose --method``'s choices (prognostics.METHODS, which imports pandas and scipy).
@@ -21,11 +22,24 @@ def add_prognose_command(command) -> None:
     )
     g.add_argument(
         "source",
+        nargs="?",
+        default=None,
         metavar="HISTORY_OR_DATASET",
         help="history table (.csv or .parquet: age_hours, clearance, clearance_lower, "
         "clearance_upper [h, m]; optional design, fault_class, unit_id), or a fleet dataset "
-        "directory or URL (prsm-health generate on a recipe with [life]) with --unit",
+        "directory or URL (prsm-health generate on a recipe with [life]) with --unit; or none "
+        "with --asset",
     )
+    g.add_argument(
+        "--asset",
+        default=None,
+        metavar="ID",
+        default_text="none",
+        help="an asset recorded with diagnose --asset ... --operating-hours H: its stored "
+        "diagnoses in --store are the history (the service's prognosis of the same asset "
+        "reads the same way)",
+    )
+    add_store(g)
     g.add_argument(
         "--unit",
         type=int,

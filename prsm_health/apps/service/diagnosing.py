@@ -310,10 +310,20 @@ def _windows(run: Run, cut: tuple) -> tuple | None:
     return None if is_check(run) else cut
 
 
-def check_asset_fields(asset_id, healthy, recording_id) -> None:
-    """``healthy`` and ``recording_id`` are about the asset's history: 422 without an asset."""
-    if asset_id is None and (healthy is not None or recording_id is not None):
-        given = "healthy" if healthy is not None else "recording_id"
+def check_asset_fields(asset_id, healthy, recording_id, operating_hours=None) -> None:
+    """``healthy``, ``recording_id`` and ``operating_hours`` are about the asset's history:
+    422 without an asset."""
+    given = [
+        name
+        for name, value in (
+            ("healthy", healthy),
+            ("recording_id", recording_id),
+            ("operating_hours", operating_hours),
+        )
+        if value is not None
+    ]
+    if asset_id is None and given:
+        given = given[0]
         raise HTTPError(
             422, f"{given} is about an asset's history: give asset_id with it (or leave it out)"
         )
@@ -437,10 +447,11 @@ def diagnose_upload(
     baseline: BaselineFor | None = None,
     healthy: bool | None = None,
     recording_id: str | None = None,
+    operating_hours: float | None = None,
 ) -> Answer:
     """``POST /v1/diagnose/file``: the whole-recording diagnosis, the per-window ones, what
     was read and the reader's notes; with an ``asset_id``, the diagnosis made with the asset's
-    ``baseline`` for the server to record."""
+    ``baseline`` for the server to record (at its ``operating_hours`` [h])."""
     run, notes = read_upload(upload, limits)
     check_run(run, limits, max_samples=limits.max_upload_samples, what=upload.filename or "upload")
     cut = split_windows(run, bundle.window)  # once: the diagnosis and the spectra share it
@@ -464,7 +475,12 @@ def diagnose_upload(
     if recording_id is None:  # the file's content, with its column map's
         recording_id = content_id(upload.path, upload.column_map)
     asset = AssetRequest(
-        asset_id, recording_id, source="file", filename=upload.filename, healthy=healthy
+        asset_id,
+        recording_id,
+        source="file",
+        filename=upload.filename,
+        healthy=healthy,
+        operating_hours=operating_hours,
     )
     spectra = _spectra(cut, bundle, diagnosis, asset, received_at)
     return Answer(diagnosis=diagnosis, asset=asset, spectra=spectra, upload=rest)

@@ -28,7 +28,8 @@ from .schemas import ASSET_ID_PATTERN, RECORDING_ID_PATTERN
 UPLOAD_SUFFIXES = (".mcap", ".parquet", ".csv")
 #: Largest column map (the ``map`` field) accepted [bytes]: a map is a few hundred bytes.
 MAX_MAP_BYTES = 64 * 1024
-#: Largest plain form field (``asset_id``, ``healthy``, ``recording_id``) [bytes].
+#: Largest plain form field (``asset_id``, ``healthy``, ``recording_id``,
+#: ``operating_hours``) [bytes].
 MAX_FIELD_BYTES = 1024
 
 
@@ -179,7 +180,7 @@ class Upload:
     (under a fixed name; the client's file name only gives the suffix), the column map
     (``map``, at most :data:`MAX_MAP_BYTES`) and small text fields in memory."""
 
-    FIELDS = ("file", "map", "asset_id", "healthy", "recording_id")
+    FIELDS = ("file", "map", "asset_id", "healthy", "recording_id", "operating_hours")
     #: python-multipart callbacks this class implements.
     CALLBACKS = (
         "on_part_begin",
@@ -237,7 +238,8 @@ class Upload:
             raise HTTPError(
                 422,
                 f"unknown form field {name!r}; expected 'file' (the recording), optional 'map' "
-                "(its column map, TOML), optional 'asset_id', 'healthy' and 'recording_id'",
+                "(its column map, TOML), optional 'asset_id', 'healthy', 'recording_id' and "
+                "'operating_hours'",
             )
         if (
             name in self.fields

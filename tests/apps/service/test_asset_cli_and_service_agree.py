@@ -2,7 +2,8 @@
 three as commissioned, three of the unit worn — through ``prsm-health diagnose --asset`` (the
 file store) and through the service's upload endpoint (its SQLite store, a real server on
 127.0.0.1) give the same baseline, evidence, posterior and change statistic after every
-recording, the same recording ids, and equal stored histories. A health check uploaded with
+recording, the same recording ids, equal stored histories, and the same prognosis
+(``prognose --asset`` against ``GET /v1/assets/{id}/prognosis``). A health check uploaded with
 an asset id is stored as a diagnosis row: ``GET /v1/assets/{id}`` answers 200 with it and the
 fleet list has the asset.
 
@@ -40,12 +41,20 @@ def checks(short_check_run, tmp_path_factory):
     ]
 
 
+#: The unit's operating hours at each check.
+HOURS = [0.0, 10.0, 20.0, 400.0, 500.0, 600.0]
+
+
 def _close(a, b, path="asset"):
     """``a`` equals ``b``, floats to 1e-12 relative; the first difference is named."""
     if isinstance(a, dict) and isinstance(b, dict):
         assert set(a) == set(b), f"{path}: keys {sorted(a)} != {sorted(b)}"
         for k in a:
             _close(a[k], b[k], f"{path}.{k}")
+    elif isinstance(a, list) and isinstance(b, list):
+        assert len(a) == len(b), f"{path}: {len(a)} != {len(b)} items"
+        for k, (x, y) in enumerate(zip(a, b)):
+            _close(x, y, f"{path}[{k}]")
     elif isinstance(a, float) or isinstance(b, float):
         assert b == pytest.approx(a, rel=1e-12, abs=1e-300), f"{path}: {a} != {b}"
     else:
@@ -62,6 +71,7 @@ def test_cli_and_service_keep_one_asset_the_same_way(checks, tmp_path, capsys):
     for i, path in enumerate(checks):
         args = ["diagnose", str(path), "--asset", "unit-9", "--store", str(store_dir)]
         args += ["--healthy"] if i < 3 else []
+        args += ["--operating-hours", str(HOURS[i])]
         assert main([*args, "--json"]) == 0
         cli.append(json.loads(capsys.readouterr().out))
 
@@ -73,7 +83,11 @@ def test_cli_and_service_keep_one_asset_the_same_way(checks, tmp_path, capsys):
                 r = c.post(
                     "/v1/diagnose/file",
                     files={"file": (path.name, path.read_bytes())},
-                    data={"asset_id": "unit-9", **({"healthy": "true"} if i < 3 else {})},
+                    data={
+                        "asset_id": "unit-9",
+                        "operating_hours": str(HOURS[i]),
+                        **({"healthy": "true"} if i < 3 else {}),
+                    },
                 )
                 assert r.status_code == 200, r.text
                 service.append(r.json()["diagnosis"])
@@ -84,6 +98,12 @@ def test_cli_and_service_keep_one_asset_the_same_way(checks, tmp_path, capsys):
             assert summary.json()["baseline"]["recordings"] == 3
             listed = [a["asset_id"] for a in c.get("/v1/assets").json()["assets"]]
             assert listed == ["unit-9"]
+            served_prognosis = c.get("/v1/assets/unit-9/prognosis")
+            assert served_prognosis.status_code == 200, served_prognosis.text
+
+    # the asset's prognosis from the CLI's store (prognose --asset) is the service's
+    assert main(["prognose", "--asset", "unit-9", "--store", str(store_dir), "--json"]) == 0
+    _close(json.loads(capsys.readouterr().out), served_prognosis.json(), "prognosis")
 
     # a check is read phase by phase in both paths, and the unit's state after each agrees
     assert all(d["check_phases"] for d in cli) and all(d["check_phases"] for d in service)

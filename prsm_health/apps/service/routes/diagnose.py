@@ -2,6 +2,8 @@
 and ``POST /v1/diagnose/file`` (multipart upload): admit the request, run the diagnosis in the
 worker pool, store it in the asset's history. Bodies are decoded where the diagnosis runs."""
 
+import math
+
 import anyio
 from fastapi import APIRouter, Request
 
@@ -162,6 +164,11 @@ _MULTIPART_BODY = {
                             "description": f"{RECORDING_ID_DESCRIPTION}; an upload's default: "
                             "the hash of the file (and of its column map)",
                         },
+                        "operating_hours": {
+                            "type": "string",
+                            "description": "the asset's operating hours at the recording [h] "
+                            "(a number ≥ 0): what its prognosis reads",
+                        },
                     },
                 }
             }
@@ -281,7 +288,8 @@ async def post_diagnose_file(
             asset_id = upload.fields.get("asset_id")
             healthy = form_healthy(upload.fields.get("healthy"))
             recording_id = upload.fields.get("recording_id")
-            check_asset_fields(asset_id, healthy, recording_id)
+            hours = form_operating_hours(upload.fields.get("operating_hours"))
+            check_asset_fields(asset_id, healthy, recording_id, hours)
             baseline = await load_baseline(store, bundle, asset_id)
             answer = await workers.diagnose(
                 diagnose_upload,
@@ -292,8 +300,26 @@ async def post_diagnose_file(
                 baseline,
                 healthy,
                 recording_id,
+                hours,
             )
     return json_response(await store_answer(store, bundle, answer, received_at))
+
+
+def form_operating_hours(text: str | None) -> float | None:
+    """The ``operating_hours`` form field of an upload [h]: a finite number in
+    [0, MAX_OPERATING_HOURS]."""
+    if text is None:
+        return None
+    try:
+        value = float(text.strip())
+    except ValueError:
+        value = math.nan
+    if not 0.0 <= value <= MAX_OPERATING_HOURS:  # NaN fails too
+        raise HTTPError(
+            422,
+            f"operating_hours = {text[:40]!r}: a number of hours in [0, {MAX_OPERATING_HOURS:g}]",
+        )
+    return value
 
 
 def form_healthy(text: str | None) -> bool | None:

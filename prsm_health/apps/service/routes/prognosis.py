@@ -1,6 +1,6 @@
 """``GET /v1/assets/{asset_id}/prognosis``: the asset's stored diagnoses with operating hours
-as a history (:func:`prsm_health.prognostics.history_of_readings`) → the library's prognosis
-(:func:`prsm_health.prognostics.prognose`) with the service's prognostics model."""
+→ the library's prognosis of them (:func:`prsm_health.prognostics.prognose_readings`, as
+``prognose --asset`` makes it) with the service's prognostics model."""
 
 from typing import Annotated, Literal
 
@@ -9,7 +9,7 @@ from fastapi import APIRouter, Query
 from fastapi import Path as PathParam
 
 from prsm_health.monitoring.sqlite_store import HistoryStore
-from prsm_health.prognostics import METHODS, HistoryError, history_of_readings, prognose
+from prsm_health.prognostics import METHODS, HistoryError, prognose_readings
 
 from ..responses import HTTPError, encode, json_response
 from ..schemas import ASSET_ID_PATTERN, Error, Prognosis
@@ -31,20 +31,13 @@ def asset_prognosis(store: HistoryStore, model, asset_id: str, method: str | Non
         raise HTTPError(503, NO_MODEL)
     if not store.has_asset(asset_id):
         raise HTTPError(404, f"no diagnoses stored for asset {asset_id!r}")
-    history, notes = history_of_readings(store.operating_history(asset_id))
-    if len(history) < 2:
-        raise HTTPError(
-            422,
-            f"asset {asset_id!r} has {len(history)} diagnosis(es) at distinct operating "
-            "hours; a prognosis needs at least 2 (send operating_hours with POST "
-            "/v1/diagnose)",
-        )
     try:
-        prognosis = prognose(history, model, method).as_dict()
+        prognosis, _ = prognose_readings(
+            store.operating_history(asset_id), model, method, asset=f"asset {asset_id!r}"
+        )
+        return prognosis.as_dict()
     except HistoryError as exc:
-        raise HTTPError(422, f"asset {asset_id!r}: {exc}") from None
-    prognosis["warnings"] = [*notes, *prognosis["warnings"]]
-    return prognosis
+        raise HTTPError(422, str(exc)) from None
 
 
 @router.get(
