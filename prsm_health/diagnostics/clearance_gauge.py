@@ -15,33 +15,38 @@ coupling torsion, thrust bearing), k a unit's factor on it (its real stiffnesses
 nominal ones), C the constant part (gearhead backlash, thrust-bearing play, the sensors' lag).
 
 - **Two loads** (the built-in check's ±25 % and ±10 % C_a): k = (L_1 − L_2)/(E_1 − E_2),
-  L_0 = L_1 − k·E_1 — the unit's stiffnesses drop out (measured: bearing 1.0–2.0e8 N/m,
-  coupling 1–3e3 N·m/rad, lubricant and friction move the reading ≤ 0.2 µm of b, against up to
-  4 µm from one reversal read through the nominal chain).
+  L_0 = L_1 − k·E_1 — the unit's stiffnesses drop out (measured, one factor at a time:
+  bearing 1.0–2.0e8 N/m, coupling 1–3e3 N·m/rad, friction ×1.5 and a degraded lubricant move
+  the reading by ≤ 0.4 µm of b, against up to 3 µm from one reversal through the nominal
+  chain). The torsion term takes the measured drive torque (:meth:`Gauge.chain`), so the
+  friction the load does not carry is in the chain as it is in the unit.
 - **One load**: k = 1, the nominal chain; the stiffness term of the budget says how far that
   can be off.
 
 b = (L_0 − C)/4. C is the actuator's: from its drive train and sensors (**nominal**: the
 datasheets' backlash, a thrust bearing's play, the sensors' filter delays), or — better —
 fixed at **commissioning** (:class:`Commissioning`): where a unit's as-built clearance b_c is
-known (measured at assembly), its first checks' L_0 give C = L_0 − 4·b_c, the unit's own, and
-every later reading is b_c + (L_0 − L_0,c)/4. Without it the budget carries the unknown plays.
+known (measured at assembly), its first checks fix its own stiffness factor k_c and C, and a
+later check reads its heavier reversal through that chain, b = (L_1 − k_c·E_1 − C)/4 (the
+extrapolation's lighter reversal weighs the rollers with the tighter gaps more, so reading
+through the unit's own k_c keeps less of the uneven-gap error: 0.47 against 0.65 µm on the
+study's fresh units). Without it the budget carries the unknown plays.
 
 **Temperature.** The housing temperature changes the oil's viscosity, so the friction torque
 and the torsion it winds up; that term is elastic (∝ the load) and the two-load extrapolation
-removes it (measured over 10–70 °C: ≤ 0.01 µm of b). With one reversal it is part of the
-stiffness term. No thermal-expansion correction is made: the simulator's thread geometry does
-not expand (docs/validation.md), and on hardware it is a constant of the unit over a check that
-commissioning at the service temperature absorbs.
+removes it, the measured torque carrying the rest (10 °C against 70 °C: ≤ 0.05 µm of b). With
+one reversal it is part of the stiffness term. No thermal-expansion correction is made: the
+simulator's thread geometry does not expand (docs/diagnostics.md), and on hardware it is a
+constant of the unit over a check that commissioning at the service temperature absorbs.
 
-**Budget and interval.** Each term's standard deviation in b (:meth:`GaugeReading.budget`):
+**Budget and interval.** Each term's standard deviation in b (:attr:`GaugeReading.budget`):
 the reversals' repeatability through the extrapolation's weights, the stiffness shape (the
 chain's form against a unit's), uneven gaps between rollers (the load-weighted gap the reversal
 reads is below the plain mean when gaps differ: one-sided, grows with b), the constant offsets
 when not commissioned, and the slope. Their root sum square, times a conformal factor
-(:data:`CONFORMAL_SCALE`: the 90 % quantile of |error|/sd on simulated units whose build is
-drawn from the documented ranges, ``tools/studies/clearance_gauge.py``), is the 90 % interval's
-half-width.
+(:data:`CONFORMAL_SCALE`, :data:`COMMISSIONED_SCALE`: the split-conformal 90 % quantile of
+|error|/sd on simulated units whose build is drawn from the documented ranges,
+``tools/studies/clearance_gauge.py``), is the 90 % interval's half-width.
 
 References
 ----------
@@ -88,11 +93,14 @@ STIFFNESS_FACTOR_SD = 0.12
 #: conformal factors were calibrated with this value.
 REVERSAL_REPEATABILITY = 0.3e-6
 #: Standard deviation [m of b] of the two-load extrapolation's stiffness-shape error across the
-#: documented builds (the chain's form against a unit's; measured by the study's factors).
+#: documented builds (the chain's form against a unit's): the one-factor runs spread over
+#: −0.29…+0.17 µm around the default unit for bearing 1–2e8 N/m and coupling 1–3e3 N·m/rad
+#: (``tools/studies/clearance_gauge.py --factors``).
 SHAPE_SD = 0.15e-6
 #: Standard deviation of the uneven-gap term per metre of b [-]: the reading falls below the
-#: mean gap by up to ≈ 6 % of b at a wear spread of 0.3 (measured by the study's factors); a
-#: wear spread drawn from [0, 0.3] gives about this share as its standard deviation.
+#: mean gap by ≈ 7 % of b at a wear spread of 0.3 (b = 20 µm, the one-factor runs); a wear
+#: spread drawn from [0, 0.3] (the error growing about as its square) gives about this share as
+#: its standard deviation.
 UNEVEN_GAP_SHARE = 0.025
 #: The same through the unit's own chain (commissioned: the heaviest reversal with k_c), per
 #: metre of clearance gained since commissioning [-]: the heavier reversal reads nearer the

@@ -114,8 +114,8 @@ def one_unit(task) -> dict:
     """Commission one unit and read its service checks."""
     from prsm_health.diagnostics.diagnosis import load_bundle
 
-    kind, index = task
-    seed = SEEDS[kind] + index
+    kind, index, base = task
+    seed = base + index
     unit = draw_unit(seed)
     gauge = Gauge.nominal(DESIGN, instrumentation="flight-ema")
     bundle = load_bundle()
@@ -228,6 +228,8 @@ def by_factor(units, key="commissioned") -> dict:
 
 def run_units(count: int, workers: int) -> list[dict]:
     tasks = [(kind, i) for kind in SEEDS for i in range(count)]
+    # the seeds travel with the task: a --fresh-seeds choice reaches the worker processes
+    tasks = [(kind, i, SEEDS[kind]) for kind, i in tasks]
     with ProcessPoolExecutor(workers) as pool:
         return list(tqdm(pool.map(one_unit, tasks), total=len(tasks), desc="units"))
 
@@ -371,6 +373,13 @@ def main() -> None:
     )
     parser.add_argument("--out", type=Path, default=Path("clearance_gauge.json"))
     parser.add_argument(
+        "--fresh-seeds",
+        type=int,
+        default=SEEDS["fresh"],
+        metavar="BASE",
+        help="the first seed of the fresh units (another set than the card's)",
+    )
+    parser.add_argument(
         "--record",
         type=Path,
         default=None,
@@ -388,6 +397,7 @@ def main() -> None:
     if args.record is not None:
         record(json.loads(args.record.read_text())["result"])
         return
+    SEEDS["fresh"] = args.fresh_seeds
     units = run_units(args.units, args.workers)
     result = report(units)
     args.out.write_text(json.dumps({"result": result, "units": units}, indent=1))
