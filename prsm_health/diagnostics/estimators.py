@@ -115,6 +115,17 @@ def _hgb_params(est) -> dict:
 # --------------------------------------------------------------------------------------------
 
 
+def conformal_quantile(scores, alpha: float) -> tuple[float, bool]:
+    """(the split-conformal quantile of ``scores``, whether it exists): the
+    ⌈(n+1)(1−alpha)⌉-th smallest score (Romano et al. 2019, eq. 7); when n is too small for
+    ``alpha`` the largest score, without a coverage guarantee (False). The tolerance keeps
+    (n+1)(1−alpha) = 90.000…1 from rounding up to the next order statistic."""
+    scores = np.sort(np.asarray(scores, dtype=float))
+    n = len(scores)
+    k = math.ceil((n + 1) * (1 - alpha) - 1e-9)
+    return float(scores[min(k, n) - 1]), k <= n
+
+
 def _calibration_units(groups: np.ndarray, n_cal: int, rng) -> tuple[np.ndarray, np.ndarray]:
     """(calibration, training) sample indices: whole groups, drawn in random order until the
     calibration part holds about ``n_cal`` samples (at least one group on each side)."""
@@ -379,11 +390,7 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
         self.width_floor_ = 1e-9 * max(float(np.ptp(ys)), 1.0)
         if self.conformity == "scaled":
             scores = scores / self._raw_width(lo, hi)
-        scores = np.sort(scores)
-        # Finite-sample quantile of [1] eq. 7; the tolerance keeps (n+1)(1-alpha) = 90.000…1
-        # from rounding up to the next order statistic.
-        k = math.ceil((n_cal + 1) * (1 - self.alpha) - 1e-9)
-        self.coverage_guaranteed_ = k <= n_cal
+        correction, self.coverage_guaranteed_ = conformal_quantile(scores, self.alpha)
         if not self.coverage_guaranteed_:
             needed = math.ceil(1 / self.alpha - 1 - 1e-9)
             warnings.warn(
@@ -393,7 +400,6 @@ class ClearanceEstimator(RegressorMixin, BaseEstimator):
                 UserWarning,
                 stacklevel=2,
             )
-        correction = float(scores[min(k, n_cal) - 1])
         self.conformal_correction_ = (
             correction / self.scale if self.conformity == "additive" else correction
         )

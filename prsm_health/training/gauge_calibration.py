@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from prsm_health.diagnostics.clearance_gauge import Commissioning
+from prsm_health.diagnostics.estimators import conformal_quantile
 
 #: The interval's level.
 LEVEL = 0.9
@@ -25,13 +26,11 @@ REALISED = ("clearance_screw_realised_mean", "clearance_nut_realised_mean")
 
 
 def conformal_factor(scores, level: float = LEVEL) -> float:
-    """The split-conformal quantile of ``scores``: the ⌈(n+1)·level⌉-th smallest (the largest
-    when n is too small for the level); NaN without scores."""
-    scores = np.sort(np.asarray([s for s in scores if math.isfinite(s)], float))
-    if len(scores) == 0:
-        return math.nan
-    rank = min(len(scores), math.ceil((len(scores) + 1) * level))
-    return float(scores[rank - 1])
+    """The split-conformal quantile of the finite ``scores`` at ``level``
+    (:func:`~prsm_health.diagnostics.estimators.conformal_quantile`; the largest when they are
+    too few for the level); NaN without any."""
+    finite = [s for s in scores if math.isfinite(s)]
+    return conformal_quantile(finite, 1.0 - level)[0] if finite else math.nan
 
 
 def realised_clearance(table) -> np.ndarray:
