@@ -23,15 +23,20 @@ def asset_baseline(store: AssetStore, bundle, asset_id: str) -> Baseline | None:
     fitted with the model's prior scale (its within-unit repeatability, or the spread of its
     training windows: :func:`~.asset.bundle_priors`); None until it has enough recordings. Only a health
     check is read against a baseline (:func:`~prsm_health.diagnostics.diagnosis.diagnose`)."""
+    return _check_baseline(store.load(asset_id).history, bundle)
+
+
+def _check_baseline(history, bundle) -> Baseline | None:
     prior_scale, _, names = bundle_priors(bundle, check=True)
-    return store.load(asset_id).history.baseline(prior_scale, names)
+    return history.baseline(prior_scale, names)
 
 
 def asset_reference(store: AssetStore, bundle, asset_id: str):
     """(baseline, commissioning) of an asset, what a recording of it is read against:
     :func:`asset_baseline` and its :meth:`~.asset.AssetHistory.commissioning` (None without an
-    as-built clearance)."""
-    return asset_baseline(store, bundle, asset_id), store.load(asset_id).history.commissioning()
+    as-built clearance), from one load of its history."""
+    history = store.load(asset_id).history
+    return _check_baseline(history, bundle), history.commissioning()
 
 
 def commission(store: AssetStore, asset_id: str, as_built_clearance: float) -> None:

@@ -89,7 +89,7 @@ from .check_roles import (
     role_shortfall,
 )
 from .features import extract_features, run_design
-from .lost_motion import SETTLED_SHARE, lost_motion_step, settled_lost_motion_step
+from .lost_motion import lost_motion_step, settled_lost_motion_step, settled_samples
 from .spectra import bandpass_rows, hilbert_envelope, welch_psd
 
 #: Band of the no-load spectral centroid [Hz]: around the nut's axial resonance on its threads
@@ -477,8 +477,8 @@ def reversal_steps(
         )
         amplitude = abs(c.speed) if is_number(c.speed) and c.speed != 0 else math.nan
         torque = math.nan
-        if "drive_torque" in channels:
-            settled = np.abs(speed) >= SETTLED_SHARE * float(np.percentile(np.abs(speed), 98))
+        if "drive_torque" in channels:  # over the samples the step was fitted on
+            settled, _ = settled_samples(speed)
             torque = float(np.mean(np.abs(np.asarray(channels["drive_torque"])[settled])))
         if math.isfinite(step) and math.isfinite(amplitude):
             out.append(ReversalStep(c.name, abs(float(c.load)), amplitude, step, shares, torque))

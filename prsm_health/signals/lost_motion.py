@@ -50,22 +50,32 @@ def lost_motion_step(position, angle, lead: float, side) -> float:
     return 2.0 * abs(step)
 
 
+def settled_samples(speed, min_share: float = SETTLED_SHARE) -> tuple[np.ndarray, float]:
+    """(which samples of a reversal are settled, its speed amplitude): |speed| ≥ ``min_share``
+    of the amplitude, the 98th percentile of |speed| (:data:`SETTLED_SHARE`); none when the
+    speed has no amplitude."""
+    speed = np.abs(np.asarray(speed, float))
+    amplitude = float(np.percentile(speed, 98)) if len(speed) else 0.0
+    if not amplitude > 0.0:
+        return np.zeros(speed.shape, dtype=bool), 0.0
+    return speed >= min_share * amplitude, amplitude
+
+
 def settled_lost_motion_step(
     position, angle, speed, lead: float, min_share: float = SETTLED_SHARE
 ) -> tuple[float, np.ndarray]:
-    """The lost-motion step over the *settled* samples of a reversal (|speed| ≥ ``min_share``
-    of its amplitude, the 98th percentile of |speed|; :data:`SETTLED_SHARE`), and the shares
-    |speed|/amplitude of those samples, clipped to 1 (the load follows the speed in a check's
-    reversal, so they are the shares of its load amplitude the elastic lag was read at:
-    :func:`~prsm_health.physics.lost_motion_chain.compliance_chain`'s ``load_shares``).
+    """The lost-motion step over the *settled* samples of a reversal (:func:`settled_samples`),
+    and the shares |speed|/amplitude of those samples, clipped to 1 (the load follows the speed
+    in a check's reversal, so they are the shares of its load amplitude the elastic lag was
+    read at: :func:`~prsm_health.physics.lost_motion_chain.compliance_chain`'s
+    ``load_shares``).
 
     Returns (NaN, empty) when the speed has no amplitude or the settled samples hold one side
     only."""
     speed = np.asarray(speed, float)
-    amplitude = float(np.percentile(np.abs(speed), 98)) if len(speed) else 0.0
+    settled, amplitude = settled_samples(speed, min_share)
     if not amplitude > 0.0:
         return math.nan, np.empty(0)
-    settled = np.abs(speed) >= min_share * amplitude
     step = lost_motion_step(
         np.asarray(position, float)[settled],
         np.asarray(angle, float)[settled],
