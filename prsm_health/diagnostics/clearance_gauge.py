@@ -64,6 +64,8 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.core.errors import ParameterError, require, require_range
@@ -223,8 +225,6 @@ class Commissioning:
         elastic_lost_motion)`` [m, -, m] of a :class:`GaugeReading` (the factor None with one
         reversal) — and its as-built clearance b_c [m]; readings with a NaN left out (none
         left: refused)."""
-        import numpy as np
-
         usable = [
             (float(z), 1.0 if k is None else float(k), float(e))
             for z, k, e in readings
