@@ -63,7 +63,9 @@ class HealthState:
         b_s = b_N = 10, 20, 30 µm.
     wear_spread : float [-]
         Uneven wear between rollers: roller i's thread clearances are scaled by
-        (1 + wear_spread·u_i), u_i uniform in [−1, 1] drawn from the run seed. 0 = even wear.
+        (1 + wear_spread·u_i), u_i in [−1, 1] drawn from the run seed with mean zero over the
+        rollers (:class:`~prsm_health.actuator.assembly.RollerDraws`: the unit's mean clearance
+        stays ``clearance_*``). 0 = even wear.
     friction_scale : float [-]
         Multiplies the thread friction coefficients (1: as the lubrication model gives them).
     lubricant_degradation : float [-]

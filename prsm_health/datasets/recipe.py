@@ -382,8 +382,10 @@ class Recipe:
         key = self.fingerprint
         if key not in _FLEETS:
             from prsm_health.physics.life import fleet_lives
+            from prsm_health.simulation.scenario import simulation_options
 
-            _FLEETS[key] = fleet_lives(self.prsm_design, self.life_spec, self.seed)
+            variation = simulation_options(self.options).variation  # the units' build
+            _FLEETS[key] = fleet_lives(self.prsm_design, self.life_spec, self.seed, variation)
         return _FLEETS[key]
 
     def _validate_units(self, check) -> None:

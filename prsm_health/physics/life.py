@@ -16,9 +16,15 @@ duty cycle, integrated over its age. What changes with age:
 
 Since the rates do not depend on the clearance itself, the integral is exact on the
 degradation grid: b(t) = b₀ + T_lube·∫₀^{t/T_lube} ḃ(d) dd while the lubricant ages, then
-linear. A unit **fails** at the first of: mean thread clearance (b_screw + b_nut)/2 reaching
-``failure_clearance`` (the lost-motion limit: the play the diagnosis estimates), or its spall
-reaching ``failure_spall_length``. The gear backlash is not worn in this model (the ring gear
+linear. A unit **fails** at the first of: its **installed clearance** reaching
+``failure_clearance`` (the lost-motion limit), or its spall reaching ``failure_spall_length``.
+The installed clearance is what a health check's zero-load lost motion reads (÷ 4): the mean
+thread half-clearance (b_screw + b_nut)/2 plus the play the assembly adds by taking up the
+rollers' pitch errors (:func:`~prsm_health.actuator.assembly.assembly_play`, a constant of the
+unit's build, ≈ 1 µm at grade-5 tolerances). Uneven wear between rollers moves wear between
+them and keeps the mean (:class:`~prsm_health.actuator.assembly.RollerDraws`). Before
+2026-12 the criterion and the ``clearance_mean_true`` label were the mean thread
+half-clearance alone, which no check can read; that is now ``clearance_thread_true``. The gear backlash is not worn in this model (the ring gear
 only synchronises the rollers; its load is the rolling-resistance torque, orders below the
 thread loads): it stays at its built value.
 
@@ -33,9 +39,10 @@ from dataclasses import asdict, dataclass, field, fields, replace
 
 import numpy as np
 
+from prsm_health.actuator.assembly import assembly_play
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.faults import Spall
-from prsm_health.actuator.states import HealthState
+from prsm_health.actuator.states import HealthState, ManufacturingVariation
 from prsm_health.core.errors import require, require_known_keys, require_positive, require_range
 from prsm_health.core.quantities import ForceSpec, parse_force
 
@@ -362,6 +369,7 @@ class UnitLife:
     failure_spall_length: float
     change_age: float | None = None  # [h], the duty's change (DutyCycle.change_age)
     change_load: float = 1.0
+    assembly_play: float = 0.0  # [m], the half-clearance its assembly adds (constant)
 
     def duty_change(self, age) -> np.ndarray:
         """The loads' factor at ``age`` from the duty's change (1 before it)."""
@@ -381,10 +389,15 @@ class UnitLife:
             self.initial_clearance + np.interp(age, self.ages, self.worn_nut),
         )
 
-    def clearance(self, age) -> np.ndarray:
-        """Mean thread half-clearance (b_screw + b_nut)/2 [m]: the failure criterion's."""
+    def thread_clearance(self, age) -> np.ndarray:
+        """Mean thread half-clearance (b_screw + b_nut)/2 [m] at ``age``."""
         screw, nut = self.clearances(age)
         return 0.5 * (screw + nut)
+
+    def clearance(self, age) -> np.ndarray:
+        """The installed clearance [m]: the mean thread half-clearance plus the assembly's
+        play — what a check's zero-load lost motion reads, and the failure criterion's."""
+        return self.thread_clearance(age) + self.assembly_play
 
     def spall_length(self, age) -> np.ndarray:
         """Spall length [m] at ``age`` (0 before it starts)."""
@@ -431,6 +444,7 @@ class UnitLife:
             "failure_age_hours": self.failure_age,
             "failure_mode": self.failure_mode,
             "clearance_mean_true": float(self.clearance(age)),
+            "clearance_thread_true": float(self.thread_clearance(age)),
             "spall_length_true": float(self.spall_length(age)),
             "duty_hours": float(np.interp(age, self.ages, self.duty_hours)),
             "duty_load": self.load_scale * float(self.duty_change(age)),
@@ -539,10 +553,13 @@ def unit_life(
     fleet_seed: int,
     geometry=None,
     ratings: dict | None = None,
+    variation: ManufacturingVariation | None = None,
 ) -> UnitLife:
     """Simulate one unit's life (deterministic in ``fleet_seed`` and ``unit_id``); the duty's
     loads given as shares are shares of ``ratings`` (default: the design's,
-    :func:`~prsm_health.physics.load_rating.load_ratings`)."""
+    :func:`~prsm_health.physics.load_rating.load_ratings`); the unit is built with
+    ``variation``'s tolerances (default :class:`ManufacturingVariation`'s), which set its
+    assembly's play."""
     geometry = geometry or PartGeometry.of(design)
     rng = np.random.default_rng([fleet_seed, unit_id, 0x4C494645])  # "LIFE"
     sc, wear = spec.scatter, spec.wear
@@ -577,9 +594,11 @@ def unit_life(
     # the rates from the duty's change on
     after = None if duty.change_age is None else unit_rates(load_scale * duty.change_load)
 
+    seed = int(np.random.SeedSequence([fleet_seed, unit_id, 0x554E4954]).generate_state(1)[0])
+    play = assembly_play(seed, design.n_rollers, variation or ManufacturingVariation())
     # Deterministic wear first (exact on the degradation grid), to size the age grid; then the
     # unit's wandering usage intensity along it.
-    expected = _expected_failure(rates, b0, t_lube, spec)
+    expected = _expected_failure(rates, b0 + play, t_lube, spec)
     span = min(spec.max_age, 4.0 * expected)
     while True:  # a unit whose usage ran low may need a longer grid (same draws otherwise)
         ages = np.linspace(0.0, span, _AGE_STEPS + 1)
@@ -595,9 +614,7 @@ def unit_life(
             worn[side] = np.concatenate([[0.0], np.cumsum(rate * usage)])
         life = UnitLife(
             unit_id=unit_id,
-            seed=int(
-                np.random.SeedSequence([fleet_seed, unit_id, 0x554E4954]).generate_state(1)[0]
-            ),
+            seed=seed,
             initial_clearance=float(b0),
             wear_spread=float(spread),
             load_scale=float(load_scale),
@@ -617,6 +634,7 @@ def unit_life(
             failure_spall_length=spec.failure_spall_length,
             change_age=duty.change_age,
             change_load=duty.change_load,
+            assembly_play=play,
         )
         wear_failure = _crossing(life, spec.failure_clearance)
         if math.isfinite(wear_failure) or span >= spec.max_age:
@@ -690,8 +708,8 @@ def _changed_spall_age(before: dict, after: dict, change_age: float, survival: f
 
 
 def _expected_failure(rates: dict, b0: float, t_lube: float, spec: LifeSpec) -> float:
-    """Age [h] at which the duty cycle's mean wear alone brings the mean clearance to the
-    failure threshold (max_age if it never does)."""
+    """Age [h] at which the duty cycle's mean wear alone brings the installed clearance (``b0``
+    at age 0) to the failure threshold (max_age if it never does)."""
     mean_rate = 0.5 * (rates["screw"] + rates["nut"])  # [m/h] on the degradation grid
     aged = _cumulative(mean_rate) * t_lube  # wear by the time the lubricant is at d
     needed = spec.failure_clearance - b0
@@ -719,7 +737,8 @@ def _usage_increments(rng, steps: np.ndarray, sigma: float, correlation: float) 
 
 
 def _crossing(life: UnitLife, threshold: float) -> float:
-    """First age at which the mean clearance reaches ``threshold`` (inf if not on the grid)."""
+    """First age at which the installed clearance reaches ``threshold`` (inf if not on the
+    grid)."""
     clearance = life.clearance(life.ages)
     above = np.flatnonzero(clearance >= threshold)
     if above.size == 0:
@@ -769,9 +788,18 @@ def _spall_on(surface: str, design: PRSMDesign, duty: DutyCycle, wear, rng) -> S
     )
 
 
-def fleet_lives(design: PRSMDesign, spec: LifeSpec, fleet_seed: int) -> list[UnitLife]:
-    """Every unit of the fleet (deterministic in ``fleet_seed``)."""
+def fleet_lives(
+    design: PRSMDesign,
+    spec: LifeSpec,
+    fleet_seed: int,
+    variation: ManufacturingVariation | None = None,
+) -> list[UnitLife]:
+    """Every unit of the fleet (deterministic in ``fleet_seed``), built with ``variation``'s
+    tolerances (default :class:`ManufacturingVariation`'s)."""
     geometry = PartGeometry.of(design)
     ratings = load_ratings(design)
     ratings = {"C_a": float(ratings.dynamic), "C_0a": float(ratings.static)}
-    return [unit_life(design, spec, u, fleet_seed, geometry, ratings) for u in range(spec.units)]
+    return [
+        unit_life(design, spec, u, fleet_seed, geometry, ratings, variation)
+        for u in range(spec.units)
+    ]

@@ -7,7 +7,9 @@ Time is in **operating hours** (the unit of every age in :mod:`prsm_health.progn
 everything else SI.
 
 States
-    ``b_screw``, ``b_nut`` [m]: the half-clearances of the two thread engagements;
+    ``b_screw``, ``b_nut`` [m]: the installed half-clearances of the two thread engagements
+    (threads plus the assembly's constant play: their mean is the life's installed clearance,
+    :meth:`~prsm_health.physics.life.UnitLife.clearance`; wear rates do not depend on them);
     ``degradation`` [-]: the lubricant's additive depletion d (0 new … 1 used up);
     ``usage`` [-]: the unit's usage intensity, a unit-variance Ornstein–Uhlenbeck process
     (correlation time ``usage_time``): the wear rate is multiplied by exp(σ·usage − σ²/2),

@@ -331,6 +331,11 @@ class Scenario:
         return simulate_scenario(self, progress=progress)
 
 
+def simulation_options(values) -> SimulationOptions:
+    """The :class:`SimulationOptions` of a scenario's or recipe's ``[options]`` table."""
+    return _group("options", SimulationOptions, values)
+
+
 def _group(name: str, kind: type, values) -> object:
     """One parameter group from its table; unknown keys name the table and list the allowed."""
     if isinstance(values, kind):

@@ -117,6 +117,27 @@ def test_labels_and_health_are_the_units_at_its_age(recipe):
         assert labels["screw_speed"] == r.point["speed"]
 
 
+def test_the_clearance_label_is_what_the_installed_unit_shows(recipe):
+    # the life's truth is the rollers' realised mean half-clearance the dynamics build (threads
+    # plus the assembly's take-up of pitch errors; uneven wear keeps the mean): exact up to
+    # float rounding, since both come from the unit's one variation stream
+    from prsm_health.simulation.dynamics.model import build_model, realised_clearances
+
+    fleet = recipe.fleet()
+    plays = []
+    for r in recipe.runs()[::SNAPSHOTS]:
+        unit, age = fleet[r.point["unit_id"]], r.point["age_hours"]
+        s = r.scenario()
+        model = build_model(s.design, s.health, s.profile, s.options, s.seed, s.drive_train)
+        real = realised_clearances(model)
+        mean = 0.5 * (real["clearance_screw_realised_mean"] + real["clearance_nut_realised_mean"])
+        assert mean == pytest.approx(float(unit.clearance(age)), abs=1e-15)
+        assert r.labels()["clearance_thread_true"] == float(unit.thread_clearance(age))
+        plays.append(unit.assembly_play)
+    # 2 µm pitch error σ per side: E|Δp|/2 over 7 rollers ≈ 1 µm, and it differs by unit
+    assert 0.3e-6 < np.mean(plays) < 2e-6 and np.ptp(plays) > 0
+
+
 def test_the_fleet_is_computed_once_per_process(recipe):
     assert recipe.fleet() is recipe.fleet()
     assert Recipe.from_dict(copy.deepcopy(LIFE_RECIPE)).fleet() is recipe.fleet()

@@ -142,7 +142,7 @@ def test_failure_age_without_usage_scatter_is_the_closed_form(exact_fleet):
         rate = _mean_wear_rate(spec, unit, d)
         worn = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(d))])
         worn *= unit.lubricant_life
-        needed = spec.failure_clearance - unit.initial_clearance
+        needed = spec.failure_clearance - unit.initial_clearance - unit.assembly_play
         if needed <= worn[-1]:
             expected = float(np.interp(needed, worn, d)) * unit.lubricant_life
         else:
@@ -153,7 +153,7 @@ def test_failure_age_without_usage_scatter_is_the_closed_form(exact_fleet):
         t = np.linspace(0.0, half, 20001)
         r = np.interp(np.minimum(t / unit.lubricant_life, 1.0), d, rate)
         worn_half = float(np.sum(0.5 * (r[1:] + r[:-1]) * np.diff(t)))
-        assert float(unit.clearance(half)) - unit.initial_clearance == pytest.approx(
+        assert float(unit.thread_clearance(half)) - unit.initial_clearance == pytest.approx(
             worn_half, rel=1e-4
         )
 

@@ -43,7 +43,8 @@ def tables():
 def _run_to_failure(tables, load=1.0, load_after=None, change_age=math.inf):
     model = PRSMAgeing(**tables)
     x = model.initialize()
-    x["b_screw"] = x["b_nut"] = 5e-6
+    # the installed clearance: the unit's threads plus its assembly's play
+    x["b_screw"] = x["b_nut"] = 5e-6 + unit_life(DESIGN, EXACT, 0, 1).assembly_play
     result = model.simulate_to_threshold(
         lambda t, x=None: model.InputContainer(
             {"load": load if t < change_age or load_after is None else load_after}

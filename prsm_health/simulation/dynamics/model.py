@@ -64,6 +64,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from prsm_health.actuator.assembly import RollerDraws, variation_stream
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.actuator.drive_train import DriveTrain
 from prsm_health.actuator.faults import FATIGUE
@@ -416,7 +417,7 @@ def build_model(
     p[L.P_LOAD_SIN_AMP], p[L.P_LOAD_SIN_FREQ] = amp, freq
     _drive_train_params(p, drive_train, design, k_axial, options.contact_restitution)
 
-    rng = np.random.default_rng([seed, 0x5052534D])  # "PRSM": variation stream of this seed
+    rng = variation_stream(seed)
     rollers = _roller_params(design, health, options.variation, orbit, rng)
     _rolling_params(rollers, design, options, rng, roller_load, tangents)
     _place_fatigue_spall(rollers, health, p, operating, rng)
@@ -503,28 +504,21 @@ def geared_motor_state(model: Model, y: np.ndarray) -> None:
 
 def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     n = design.n_rollers
-    # Always draw the same numbers in the same order, so switching one tolerance off leaves
-    # the others unchanged for a given seed.
-    z = rng.standard_normal((6, n))
-    wear = rng.uniform(-1.0, 1.0, n)
-    runout = np.abs(rng.standard_normal(n))
-    runout_phase = rng.uniform(0.0, 2 * math.pi, n)
+    draws = RollerDraws.draw(rng, n)
+    z = draws.normal
     psi = 2 * math.pi * np.arange(n) / n + variation.position_error * z[0]
     r = np.zeros((n, L.N_ROLLER_PARAMS))
     r[:, L.R_PSI] = psi
     r[:, L.R_COS_PSI] = np.cos(psi)
     r[:, L.R_SIN_PSI] = np.sin(psi)
     r[:, L.R_POCKET_R] = orbit + variation.eccentricity * z[1]
-    scale = 1.0 + health.wear_spread * wear
-    r[:, L.R_E_S] = variation.pitch_error * z[2]
-    r[:, L.R_E_N] = variation.pitch_error * z[3]
+    scale = 1.0 + health.wear_spread * draws.wear
+    r[:, L.R_E_S], r[:, L.R_E_N] = draws.pitch_errors(variation)
     r[:, L.R_E_G] = variation.transmission_error * z[4]
-    # As assembled, the clearance takes up each roller's pitch and transmission errors, so a
-    # new screw (b = 0) has no interference: a roller whose thread sits Δe off the others gets
-    # |Δe|/2 more play on each thread side, its gear |Δe_g| more backlash. Preload is not a
-    # clearance of zero but a parameter of its own.
-    pitch = r[:, L.R_E_S] + r[:, L.R_E_N]
-    take_up = 0.5 * np.abs(pitch - np.mean(pitch))
+    # As assembled, the clearance takes up each roller's pitch errors (RollerDraws.take_up)
+    # and its transmission error (|Δe_g| more backlash). Preload is not a clearance of zero
+    # but a parameter of its own.
+    take_up = draws.take_up(variation)
     # a preload is interference on both flanks: a negative half-clearance
     preload = health.effective_preload
     r[:, L.R_B_S] = health.clearance_screw * scale + take_up - preload
@@ -532,8 +526,8 @@ def _roller_params(design, health, variation, orbit, rng) -> np.ndarray:
     r[:, L.R_B_G] = health.clearance_gear + np.abs(r[:, L.R_E_G] - np.mean(r[:, L.R_E_G]))
     r[:, L.R_MESH_PHASE] = 0.0
     r[:, L.R_MESH_SCALE] = np.clip(1.0 + variation.mesh_stiffness_spread * z[5], 0.5, 1.5)
-    r[:, L.R_RUNOUT] = variation.roller_runout * runout
-    r[:, L.R_RUNOUT_PHASE] = runout_phase
+    r[:, L.R_RUNOUT] = variation.roller_runout * draws.runout
+    r[:, L.R_RUNOUT_PHASE] = draws.runout_phase
     for spall in health.spalls:
         if spall.location == "roller" and spall.roller != FATIGUE:
             require(
