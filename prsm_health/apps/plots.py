@@ -338,7 +338,7 @@ def plot_fleet_lives(lives, path: str | Path, *, test_units=(), snapshots: int =
         ages = np.linspace(0.0, unit.failure_age, 200)
         screw, nut = unit.clearances(ages)
         color = "tab:red" if unit.unit_id in test_units else "tab:blue"
-        ax_b.plot(ages, 0.5 * (screw + nut) * 1e6, color=color, lw=0.9, alpha=0.8)
+        ax_b.plot(ages, unit.clearance(ages) * 1e6, color=color, lw=0.9, alpha=0.8)
         if snapshots:
             at = unit.snapshot_ages(snapshots)
             ax_b.plot(at, unit.clearance(at) * 1e6, ".", color=color, ms=2.5)
@@ -350,10 +350,10 @@ def plot_fleet_lives(lives, path: str | Path, *, test_units=(), snapshots: int =
     threshold = lives[0].failure_clearance * 1e6
     ax_b.axhline(threshold, color="k", ls="--", lw=0.8)
     ax_b.set_title(
-        f"mean thread half-clearance (blue: train, red: test units; failure at {threshold:g} µm)",
+        f"installed clearance (blue: train, red: test units; failure at {threshold:g} µm)",
         fontsize=9,
     )
-    ax_s.set_title("screw side (purple) and nut side (green)", fontsize=9)
+    ax_s.set_title("thread half-clearances: screw side (purple), nut side (green)", fontsize=9)
     ax_d.set_title("lubricant degradation (additives used up at 1)", fontsize=9)
     for ax, label in ((ax_b, "µm"), (ax_s, "µm"), (ax_d, "-")):
         ax.set_xlabel("age [operating hours]")

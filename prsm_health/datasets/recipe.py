@@ -369,10 +369,10 @@ class Recipe:
 
     @property
     def life_spec(self):
-        """The parsed ``[life]`` table (:class:`~prsm_health.physics.life.LifeSpec`), None without one."""
+        """The parsed ``[life]`` table (:class:`~prsm_health.physics.life_spec.LifeSpec`), None without one."""
         if not self.life:
             return None
-        from prsm_health.physics.life import LifeSpec
+        from prsm_health.physics.life_spec import LifeSpec
 
         return LifeSpec.from_dict(self.life)
 

@@ -13,7 +13,7 @@ States
     ``degradation`` [-]: the lubricant's additive depletion d (0 new … 1 used up);
     ``usage`` [-]: the unit's usage intensity, a unit-variance Ornstein–Uhlenbeck process
     (correlation time ``usage_time``): the wear rate is multiplied by exp(σ·usage − σ²/2),
-    as in :class:`~prsm_health.physics.life.FleetScatter`;
+    as in :class:`~prsm_health.physics.life_spec.FleetScatter`;
     ``log_wear`` [-]: ln of the unit's wear-rate factor against the duty's (its wear
     coefficient, its own loads and temperature against the duty's), and
     ``log_lubricant_life`` [-]: ln of its lubricant life against the duty's — the unit's
@@ -57,12 +57,8 @@ import math
 import numpy as np
 from progpy import PrognosticsModel
 
-from prsm_health.physics.life import (
-    DEGRADATION_GRID,
-    LifeSpec,
-    lubricant_life_at,
-    wear_rates,
-)
+from prsm_health.physics.life import DEGRADATION_GRID, lubricant_life_at, wear_rates
+from prsm_health.physics.life_spec import LifeSpec
 from prsm_health.physics.load_rating import load_ratings
 from prsm_health.physics.wear import PartGeometry
 

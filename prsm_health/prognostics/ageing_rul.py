@@ -7,8 +7,8 @@ what it learnt from a training fleet — the diagnosis' calibration against the 
 and the prior of the units' two uncertain parameters — and predicts a unit's RUL:
 
 1. **Estimation** (progpy ``ParticleFilter``; Daigle & Goebel 2013's joint state–parameter
-   estimation): ``n_particles`` particles drawn from the prior (as-built clearance uniform on
-   the recipe's range, the usage at its stationary law, ``log_wear`` and
+   estimation): ``n_particles`` particles drawn from the prior (installed clearance uniform on
+   the training units' range, :func:`installed_range`; the usage at its stationary law, ``log_wear`` and
    ``log_lubricant_life`` Gaussian) start at age 0 and are propagated to each diagnosis,
    weighted by its likelihood — the diagnosis' 90 % interval, scaled by the calibration's
    ``noise_scale``, as the measurement's standard deviation — and resampled.
@@ -69,7 +69,7 @@ class AgeingRUL:
     tables : dict
         :func:`~prsm_health.prognostics.ageing_model.rate_tables` of the fleet recipe.
     initial_clearance : (float, float) [m]
-        The as-built half-clearance range (the recipe's ``life.scatter.initial_clearance``).
+        The range of installed clearances at age 0 (:func:`installed_range`).
     prior_mean, prior_cov
         Gaussian prior of (log_wear, log_lubricant_life).
     bias, gain, noise_scale
@@ -278,6 +278,7 @@ class AgeingRUL:
             horizon = 3.0 * float(histories["failure_age_hours"].max())
         _, z, sd = history_arrays(histories)
         bias, gain, scale = 0.0, 1.0, 1.0
+        initial = installed_range(histories, spec.scatter.initial_clearance)
         if "clearance_mean_true" in histories.columns:
             true = histories["clearance_mean_true"].to_numpy(float)
             gain, bias = np.polyfit(true, z, 1)
@@ -285,7 +286,7 @@ class AgeingRUL:
             scale = float(np.sqrt(np.mean(residual**2)))
         est = cls(
             tables,
-            initial_clearance=spec.scatter.initial_clearance,
+            initial_clearance=initial,
             bias=bias,
             gain=gain,
             noise_scale=scale,
@@ -332,6 +333,20 @@ class AgeingRUL:
     def from_dict(cls, d: dict) -> AgeingRUL:
         d = dict(d)
         return cls(d.pop("tables"), **d)
+
+
+def installed_range(histories, as_built: tuple) -> tuple[float, float]:
+    """The prior's range of installed clearances at age 0 [m]: the training units' true
+    installed clearance at their first diagnosis (the recipe's as-built threads plus each
+    unit's assembly play, :meth:`~prsm_health.physics.life.UnitLife.clearance`), widened by a
+    tenth of its span and 0.2 µm each side; the recipe's ``as_built`` range where the
+    histories carry no truth."""
+    if "clearance_mean_true" not in histories.columns:
+        return tuple(float(v) for v in as_built)
+    first = histories.sort_values("age_hours").groupby("unit_id")["clearance_mean_true"].first()
+    lo, hi = float(first.min()), float(first.max())
+    pad = 0.1 * (hi - lo) + 0.2e-6
+    return max(lo - pad, 0.0), hi + pad
 
 
 class PhysicsRUL(RULMethod):

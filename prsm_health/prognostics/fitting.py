@@ -235,12 +235,12 @@ def _methods(model: RULModel) -> tuple[str, ...]:
 
 
 def _life_spec(dataset):
-    """The fleet's ``[life]`` (:class:`~prsm_health.physics.life.LifeSpec`); None for a
+    """The fleet's ``[life]`` (:class:`~prsm_health.physics.life_spec.LifeSpec`); None for a
     dataset of no known design or without one (no physics method then)."""
     life = dataset.manifest.get("recipe", {}).get("life")
     if not life or dataset.design is None:
         return None
-    from prsm_health.physics.life import LifeSpec
+    from prsm_health.physics.life_spec import LifeSpec
 
     return LifeSpec.from_dict(life)
 

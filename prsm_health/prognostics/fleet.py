@@ -23,10 +23,17 @@ def fleet_histories(
     until_age: float | None = None,
     progress: bool = False,
     batch: int = 32,
+    commissioned: bool = True,
 ) -> pd.DataFrame:
     """Diagnose the snapshots of a fleet dataset (a life recipe's) in batches: one history row
     per age — where the recipe makes several recordings at one age (``[life] recordings``),
     their diagnoses combined (:func:`combine_recordings`).
+
+    Health-check snapshots are read as a maintainer's would be: each unit commissioned
+    (:class:`~prsm_health.diagnostics.clearance_gauge.Commissioning`) by its first check, at
+    age 0, with its installed clearance then (the ``clearance_mean_true`` label: the as-built
+    clearance its maker measures at acceptance), so its later checks read the clearance
+    through its own lost-motion chain.
 
     Parameters
     ----------
@@ -38,6 +45,9 @@ def fleet_histories(
         Only snapshots at ages ≤ this (what was known then).
     progress : bool
         A progress bar on stderr.
+    commissioned : bool
+        Commission each unit by its check at age 0 (health-check snapshots only; False: every
+        check read with the gauge's nominal chain).
 
     Returns
     -------
@@ -57,7 +67,7 @@ def fleet_histories(
         snapshot left after ``units`` and ``until_age``.
     """
     from prsm_health.datasets import Dataset
-    from prsm_health.diagnostics.diagnosis import diagnose_runs, load_bundle
+    from prsm_health.diagnostics.diagnosis import load_bundle
 
     dataset = dataset if isinstance(dataset, Dataset) else Dataset(dataset)
     labels = dataset.runs
@@ -83,18 +93,14 @@ def fleet_histories(
         )
     chosen = chosen.sort_values(["unit_id", "age_hours"])
     bundle = bundle or load_bundle()
-    ids = [int(i) for i in chosen["run_id"]]
-    diagnoses = []
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(ids), desc="diagnosing snapshots", unit="run")
-    for start in range(0, len(ids), batch):
-        runs = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
-        diagnoses.extend(diagnose_runs(runs, bundle))
-        if bar is not None:
-            bar.update(len(runs))
+        bar = tqdm(total=len(chosen), desc="diagnosing snapshots", unit="run")
+    diagnoses = []
+    for _, unit in chosen.groupby("unit_id", sort=True):
+        diagnoses.extend(_diagnose_unit(dataset, unit, bundle, batch, commissioned, bar))
     if bar is not None:
         bar.close()
     out = pd.DataFrame(
@@ -115,6 +121,29 @@ def fleet_histories(
         if column in chosen.columns:
             out[column] = chosen[column].to_numpy(float)
     return combine_recordings(out)
+
+
+def _diagnose_unit(dataset, unit: pd.DataFrame, bundle, batch: int, commissioned: bool, bar):
+    """The diagnoses of one unit's snapshots (its rows of the labels, sorted by age)."""
+    from prsm_health.diagnostics.check_model import is_check
+    from prsm_health.diagnostics.clearance_gauge import Commissioning
+    from prsm_health.diagnostics.diagnosis import diagnose_runs
+
+    ids = [int(i) for i in unit["run_id"]]
+    commissioning = None
+    first = dataset.run(ids[0], truth=False)
+    ages = unit["age_hours"].to_numpy(float)
+    if commissioned and bundle.check is not None and is_check(first) and ages[0] == 0.0:
+        built = diagnose_runs([first], bundle)[0]
+        as_built = float(unit["clearance_mean_true"].iloc[0])
+        commissioning = Commissioning.from_indicators([built.indicators], as_built)
+    out = []
+    for start in range(0, len(ids), batch):
+        runs = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
+        out.extend(diagnose_runs(runs, bundle, commissioning=commissioning))
+        if bar is not None:
+            bar.update(len(runs))
+    return out
 
 
 def combine_recordings(table: pd.DataFrame) -> pd.DataFrame:

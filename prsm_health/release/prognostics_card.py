@@ -29,6 +29,25 @@ _METRICS_HEADER = (
 )
 
 
+def _indicator_words(fleet: dict) -> str:
+    """What the model's health indicator is, for the fleet it was trained on."""
+    if fleet["check"]:
+        return (
+            "the clearance a health check measures from its reversals' lost motion (the "
+            "clearance gauge, each unit commissioned by its first check), with its 90 % interval"
+        )
+    return "the diagnosed clearance of in-service windows (mean of screw and nut half-clearances)"
+
+
+def _indicator_errors(indicator: dict) -> str:
+    """The fleet's diagnosed clearance against the truth, in words."""
+    return (
+        f"bias {indicator['bias'] * 1e6:+.2f} µm, sd {indicator['sd'] * 1e6:.2f} µm, unit bias sd "
+        f"{indicator['unit_bias_sd'] * 1e6:.2f} µm, 90 % intervals covering "
+        f"{indicator['coverage']:.2f}"
+    )
+
+
 def _metrics_table(summary: dict) -> str:
     return table(
         _METRICS_HEADER,
@@ -113,22 +132,27 @@ def prognostics_card(metrics: dict) -> str:
         "`GET /v1/assets/{id}/prognosis`: remaining useful life [h] with a 90 % interval from a "
         "history of diagnoses of one asset over its operating hours, for a paper-01 PRSM "
         "measured by the `flight-ema` instrumentation and diagnosed by the default model "
-        "(`models/default.skops`). Health indicator: the diagnosed clearance (mean of screw and "
-        f"nut half-clearances). Default method: degradation model `{model['form']}` form with "
-        "Bayesian updating (Gebraeel et al. 2005); baseline: similarity (Wang et al. 2008); "
-        "and `physics` (`--method physics`): the PRSM's ageing as a NASA progpy model — "
+        f"(`models/default.skops`). Health indicator: {_indicator_words(fleet)}. Methods: "
+        f"the degradation model (`{model['form']}` form with Bayesian updating, Gebraeel et "
+        "al. 2005); the similarity baseline (Wang et al. 2008); "
+        "and `physics`: the PRSM's ageing as a NASA progpy model — "
         "Archard wear of the thread contacts speeding up as the lubricant depletes, the unit's "
         "wear and lubricant-life factors estimated by progpy's particle filter on the "
-        "diagnoses, progpy's Monte Carlo prediction to the wear limit (docs/prognostics.md). "
-        "The default is the method with the best α–λ accuracy after half of life over every "
-        "unit of the fleet (cross-validated, below).",
+        "diagnoses (each weighted by its own 90 % interval as the measurement's noise, the "
+        "logged duty as input), progpy's Monte Carlo prediction to the wear limit "
+        f"(docs/prognostics.md). Default method: **`{model['method']}`**, the one with the best "
+        "α–λ accuracy after half of life over every unit of the fleet (cross-validated, below).",
         "",
-        f"**Data.** `datasets/fleet.toml`: {fleet['units']} units × {fleet['snapshots']} ages × "
-        f"{fleet['recordings']} recordings of {fleet['duration']:g} s ({generation['runs']} runs"
+        f"**Data.** `datasets/{fleet['recipe']}.toml`: {fleet['units']} units × "
+        f"{fleet['snapshots']} ages × {fleet['recordings']} "
+        f"{'health checks' if fleet['check'] else 'recordings'} of {fleet['duration']:g} s "
+        f"({generation['runs']} runs"
         f"; {generated}). Each unit wears by Archard wear of its thread contacts, "
         "faster as its lubricant's additives deplete, with unit-to-unit scatter of build, wear "
         "coefficient, lubricant life, temperature, loads and a wandering usage intensity "
-        "(docs/prognostics.md); it fails when its true mean half-clearance reaches "
+        "(docs/prognostics.md); it fails when its installed clearance (the threads' mean "
+        "half-clearance plus its assembly's play: what a check's zero-load lost motion reads) "
+        "reaches "
         f"{fleet['failure_clearance'] * 1e6:g} µm or a spall grows "
         f"{fleet['failure_spall_length'] * 1e3:g} mm long. Lives {lives[0]:.0f}–{lives[1]:.0f} h; "
         "failure modes "
@@ -166,15 +190,16 @@ def prognostics_card(metrics: dict) -> str:
         "§6.3), and monotonicity of the predicted RUL through progpy "
         "(`prsm_health.prognostics.metrics`).",
         "",
-        "### Per held-out unit (degradation model, after half of life)",
+        f"### Per held-out unit (default method `{model['method']}`, after half of life)",
         "",
         _per_unit_table(metrics["per_unit"]),
         "",
         "### What limits it: usage variability and indicator noise",
         "",
         "The life model's own trajectories (60 units, 40 fitted, 20 scored; no dynamics), "
-        "observed with Gaussian errors of σ (the shipped diagnosis: bias ≈ +2.4 µm, learnt "
-        "into the threshold, and scatter ≈ 2 µm); cells: α–λ accuracy degradation / "
+        "observed with Gaussian errors of σ (this fleet's diagnoses: "
+        f"{_indicator_errors(metrics['indicator'])}; an in-service window's ≈ 2 µm); cells: "
+        "α–λ accuracy degradation / "
         "similarity — 90 % coverage degradation / similarity, after half of life.",
         "",
         _sensitivity_table(metrics["sensitivity"]),

@@ -3,8 +3,10 @@
 How the shipped RUL model is built and judged, as functions a user can call to rebuild and
 check it for their own fleet recipe:
 
-1. :func:`diagnosed_fleet` — generates the fleet recipe (``datasets/fleet.toml``: 20 units ×
-   30 snapshots, resumable) and diagnoses every snapshot with the shipped diagnosis model, as
+1. :func:`diagnosed_fleet` — generates the fleet recipe (``datasets/fleet-check.toml``: 20
+   units × 10 health checks over their lives, resumable) and diagnoses every check with the
+   shipped diagnosis model — the clearance measured from the check's lost motion, each unit
+   commissioned by its first check (:func:`~prsm_health.prognostics.fleet_histories`) — as
    the histories a user's fleet would give (cached beside the dataset as
    ``<dataset>-diagnoses.parquet``);
 2. :func:`train_prognostics_model` — fits the model with
@@ -53,7 +55,7 @@ from prsm_health.prognostics.metrics import evaluate_units
 from prsm_health.release.prognostics_card import write_prognostics_card
 
 #: The fleet recipe of the shipped model (repository layout, like :data:`DEFAULT_PROGNOSTICS_MODEL`).
-FLEET_RECIPE = DEFAULT_PROGNOSTICS_MODEL.parents[1] / "datasets" / "fleet.toml"
+FLEET_RECIPE = DEFAULT_PROGNOSTICS_MODEL.parents[1] / "datasets" / "fleet-check.toml"
 #: α of the α–λ accuracy and of the prognostic horizon.
 ALPHA = 0.2
 #: Folds over the units of the cross-validated score (and of the default method's choice).
@@ -63,7 +65,8 @@ LIFE_BINS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
 #: Sensitivity study: usage variability and health-indicator noise (life model only, no
 #: dynamics): 60 units each, 40 to fit, 20 to score.
 USAGE_LEVELS = (0.0, 0.15, 0.3)
-NOISE_LEVELS = (0.0, 1e-6, 2e-6)  # m, 1σ of a diagnosis' error (the shipped one: ≈ 2 µm)
+#: m, 1σ of a diagnosis' error: a commissioned check ≈ 0.3–0.5 µm, an in-service window ≈ 2 µm
+NOISE_LEVELS = (0.0, 0.3e-6, 1e-6, 2e-6)
 #: The figures the card links, drawn by ``prsm_health.apps.plots.plot_prognostics``.
 FIGURES = ("prognostics_rul.png", "prognostics_indicator.png")
 
@@ -84,7 +87,8 @@ class PrognosticsModelResult:
 
 
 def fleet_recipe(path: str | Path = FLEET_RECIPE) -> Recipe:
-    """The fleet recipe of the prognostics model (default: the shipped ``datasets/fleet.toml``)."""
+    """The fleet recipe of the prognostics model (default: the shipped
+    ``datasets/fleet-check.toml``)."""
     return load_recipe(path)
 
 
@@ -226,6 +230,22 @@ def sensitivity(recipe: Recipe, *, alpha: float = ALPHA) -> dict:
     return {"usage": list(USAGE_LEVELS), "noise": list(NOISE_LEVELS), "cells": cells}
 
 
+def indicator_errors(histories: pd.DataFrame) -> dict:
+    """How the fleet's diagnosed clearance reads the true installed clearance, every snapshot:
+    ``bias``, ``sd`` [m] of the error, ``unit_bias_sd`` [m] (sd of the units' mean errors),
+    ``coverage`` of the 90 % intervals."""
+    error = histories["clearance"] - histories["clearance_mean_true"]
+    inside = (histories["clearance_lower"] <= histories["clearance_mean_true"]) & (
+        histories["clearance_mean_true"] <= histories["clearance_upper"]
+    )
+    return {
+        "bias": float(error.mean()),
+        "sd": float(error.std()),
+        "unit_bias_sd": float(error.groupby(histories["unit_id"]).mean().std()),
+        "coverage": float(inside.mean()),
+    }
+
+
 def _plain(value):
     """``value`` as plain JSON: numpy scalars as Python numbers, a NaN (a score of no
     prediction, an empty bin) as None — the card prints it as missing."""
@@ -274,8 +294,8 @@ def prognostics_metrics(
     -------
     dict
         ``alpha``, ``model``, ``fleet``, ``held_out``, ``cross_validated`` (``folds``,
-        ``summary``, ``accuracy_by_age``), ``per_unit`` (the held-out units, degradation
-        model), ``sensitivity`` and ``figures``.
+        ``summary``, ``accuracy_by_age``), ``indicator`` (:func:`indicator_errors`),
+        ``per_unit`` (the held-out units, the default method), ``sensitivity`` and ``figures``.
     """
     predictions, summary = held_out
     cv_predictions, cv_summary = cross_validated
@@ -286,6 +306,8 @@ def prognostics_metrics(
         "alpha": alpha,
         "model": {"form": model.form_, "threshold": float(model.threshold), "method": model.method},
         "fleet": {
+            "recipe": recipe.name,
+            "check": bool(recipe.profile.get("check")),
             "units": spec.units,
             "snapshots": spec.snapshots,
             "recordings": spec.recordings,
@@ -307,10 +329,12 @@ def prognostics_metrics(
             "summary": cv_summary,
             "accuracy_by_age": accuracy_by_age(cv_predictions, alpha=alpha),
         },
+        "indicator": indicator_errors(histories),
         "per_unit": per_unit_scores(
             predictions,
             lives["failure_age_hours"].to_dict(),
             lives["failure_mode"].to_dict(),
+            method=model.method,
             alpha=alpha,
         ),
         "sensitivity": limits,

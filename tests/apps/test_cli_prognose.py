@@ -21,6 +21,7 @@ from prsm_health.datasets import Recipe, generate
 from prsm_health.diagnostics.diagnosis import DEFAULT_MODEL
 from prsm_health.prognostics import (
     METHODS,
+    Prognosis,
     RULModel,
     fleet_histories,
     load_prognostics_model,
@@ -110,7 +111,13 @@ def test_json_is_the_prognosis_as_dict(capsys, model_file, history, kind):
     assert code == 0
     expected = prognose(read_history(history[kind]), load_prognostics_model(model_file))
     assert json.loads(out) == json.loads(json.dumps(expected.as_dict()))
-    assert set(json.loads(out)) == {"rul_hours", "health_indicator", "model", "warnings"}
+    assert set(json.loads(out)) == {
+        "rul_hours",
+        "health_indicator",
+        "model",
+        "warnings",
+        "headline",
+    }
 
 
 def test_method_option(capsys, model_file, history):
@@ -133,9 +140,10 @@ def test_human_summary(capsys, model_file, history):
     p = prognose(history["table"], load_prognostics_model(model_file))
     rul, hi = p.rul_hours, p.health_indicator
     lines = {line.split("  ")[0]: line for line in out.splitlines()}
-    interval = f"{hours(rul['estimate'])} [{hours(rul['lower'])}, {hours(rul['upper'])}]"
-    assert interval in lines["RUL"]
-    assert "h (median, 90 % interval)" in lines["RUL"]
+    first = out.splitlines()[0]  # what a maintainer reads
+    assert first.startswith("prognosis ") and first.endswith(f"  {p.headline.text}")
+    assert p.headline.state == "remaining" and f"{rul['estimate']:.0f} h [" in lines["RUL"]
+    assert lines["RUL"].endswith(f"{p.headline.short} (median, 90 % interval)")
     assert (
         f"{1e6 * hi['current']:.1f} [" in lines["clearance now"] and "µm" in lines["clearance now"]
     )
@@ -143,6 +151,42 @@ def test_human_summary(capsys, model_file, history):
     assert p.model["name"] in lines["method"]
     assert "12 from 0 to" in lines["diagnoses"]
     assert "true RUL" not in out  # only a fleet dataset has the truth
+
+
+def test_at_the_limit_by_its_trend_never_reads_0_h(capsys, model_file, history, monkeypatch):
+    # the fitted trend has reached the threshold (median RUL 0) while the latest clearance is
+    # still below it: the table and the JSON say so with the interval, the reading and the
+    # threshold, never "0 h"
+    from prsm_health.apps.cli import prognose as command
+
+    table = history["table"]
+    indicator = {
+        "name": "clearance",
+        "unit": "m",
+        "threshold": 32.7e-6,
+        "ages_hours": table["age_hours"].tolist(),
+        "values": table["clearance"].tolist(),
+        "lower": table["clearance_lower"].tolist(),
+        "upper": table["clearance_upper"].tolist(),
+        "current": 31.2e-6,
+    }
+    at_limit = Prognosis(
+        {"estimate": 0.0, "lower": 0.0, "upper": 242.0},
+        indicator,
+        {"name": "degradation-linear", "design": "paper01", "units_trained": 10, "version": "1"},
+    )
+    monkeypatch.setattr(command, "prognose_history", lambda *args: at_limit)
+    code, out, err = run(capsys, "prognose", history["csv"], "--model", model_file)
+    assert code == 0 and err == ""
+    lines = {line.split("  ")[0]: line for line in out.splitlines()}
+    headline = lines["prognosis"]
+    assert "at the limit by its trend" in headline and "< 1 h" in headline
+    assert "up to 242 h" in headline and "31.2 µm" in headline and "32.7 µm" in headline
+    assert "< 1 h, up to 242 h" in lines["RUL"]
+    assert " 0 h" not in out and "0.000" not in out and "nan" not in out
+    code, out, _ = run(capsys, "prognose", history["csv"], "--model", model_file, "--json")
+    assert json.loads(out)["headline"] == at_limit.headline.to_json()
+    assert json.loads(out)["headline"]["state"] == "at_limit"
 
 
 def _write(path, table):

@@ -10,7 +10,8 @@ from scipy import stats
 
 from prsm_health.actuator.design import preset
 from prsm_health.core.errors import ParameterError
-from prsm_health.physics.life import FleetScatter, LifeSpec, fleet_lives, unit_life
+from prsm_health.physics.life import fleet_lives, unit_life
+from prsm_health.physics.life_spec import FleetScatter, LifeSpec
 from prsm_health.physics.load_rating import load_ratings
 from prsm_health.physics.lubrication import asperity_share, stribeck_curve
 from prsm_health.physics.wear import (

@@ -11,7 +11,8 @@ import pandas as pd
 import pytest
 
 from prsm_health.actuator.design import preset
-from prsm_health.physics.life import FleetScatter, LifeSpec, fleet_lives, unit_life
+from prsm_health.physics.life import fleet_lives, unit_life
+from prsm_health.physics.life_spec import FleetScatter, LifeSpec
 
 pytest.importorskip("progpy")
 

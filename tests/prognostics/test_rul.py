@@ -307,7 +307,7 @@ def test_prognosis_json_contract(fleet_model, held_out):
         p = prognose(history, fleet_model, method=method)
         assert isinstance(p, Prognosis)
         d = json.loads(json.dumps(p.as_dict(), allow_nan=False))
-        assert set(d) == {"rul_hours", "health_indicator", "model", "warnings"}
+        assert set(d) == {"rul_hours", "health_indicator", "model", "warnings", "headline"}
         assert set(d["rul_hours"]) == {"estimate", "lower", "upper"}
         assert 0 <= d["rul_hours"]["lower"] <= d["rul_hours"]["estimate"] <= d["rul_hours"]["upper"]
         hi = d["health_indicator"]

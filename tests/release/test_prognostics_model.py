@@ -41,9 +41,10 @@ def predictions(unit, life, ages, errors, method="degradation", half_width=10.0)
 
 
 def test_fleet_recipe_is_the_shipped_fleet():
-    assert FLEET_RECIPE.name == "fleet.toml"
+    assert FLEET_RECIPE.name == "fleet-check.toml"
     recipe = fleet_recipe()
-    assert recipe.name == "fleet" and recipe.life_spec.units == 20
+    assert recipe.name == "fleet-check" and recipe.life_spec.units == 20
+    assert recipe.profile["check"] == "health-check"  # checks, read by the clearance gauge
 
 
 def test_accuracy_by_age_bins_each_method_by_life_fraction():
@@ -94,9 +95,13 @@ def test_the_metrics_are_json_and_render_the_card():
             "failure_age_hours": [100.0, 200.0, 300.0],
             "failure_mode": ["wear", "wear", "spall"],
             "split": ["train", "test", "test"],
+            "clearance": [10e-6, 21e-6, 30e-6],
+            "clearance_lower": [9e-6, 20e-6, 29.5e-6],
+            "clearance_upper": [11e-6, 22e-6, 30.5e-6],
+            "clearance_mean_true": [10.5e-6, 20e-6, 31e-6],  # errors −0.5, +1, −1 µm
         }
     )
-    model = types.SimpleNamespace(form_="linear", threshold=3.25e-5, method="similarity")
+    model = types.SimpleNamespace(form_="linear", threshold=3.25e-5, method="degradation")
     generation = {"runs": 180, "resumed_runs": 0, "workers": 3, "seconds": 95.2}
     limits = {
         "usage": [0.0],
@@ -114,8 +119,14 @@ def test_the_metrics_are_json_and_render_the_card():
     assert [r["unit"] for r in stored["per_unit"]] == [1, 2]
     assert stored["figures"] == list(FIGURES)
     card = prognostics_card(stored)
-    assert "degradation model `linear` form" in card
-    assert "(1200 runs" not in card and "(180 runs; generated in 95 s on 3 workers)" in card
+    assert "degradation model (`linear` form" in card
+    assert "Default method: **`degradation`**" in card
+    assert "default method `degradation`, after half of life" in card
+    # the indicator's errors from the histories: mean −1/6 µm, two of three intervals cover
+    assert stored["indicator"]["coverage"] == pytest.approx(2 / 3)
+    assert "bias -0.17 µm" in card and "covering 0.67" in card
+    assert "health checks of 2.62 s" in card and "`datasets/fleet-check.toml`" in card
+    assert "(180 runs; generated in 95 s on 3 workers)" in card
     assert "scored on the 2 held-out units ([1, 2])" in card
     assert "Lives 100–300 h; failure modes wear 2, spall 1." in card
     assert "32.50 µm" in card

@@ -39,7 +39,7 @@ def stepping_life(design, spec, unit, geometry) -> float:
     """The loop a user would write: step the age by 1 h, ask the film at the current
     degradation, add the wear (no usage variation); returns the failure age [h]."""
     duty, wear = spec.duty.resolved(load_ratings(design)), spec.wear
-    b = unit.initial_clearance
+    b = unit.initial_clearance + unit.assembly_play  # the installed clearance fails
     age = 0.0
     contacts = [
         (

@@ -1,6 +1,7 @@
 """What limits a RUL's α–λ accuracy? (docs/prognostics.md, "Below the 0.8 … and why")
 
-Three measurements on the shipped fleet recipe (datasets/fleet.toml ``[life]``), α = 0.2, the
+Three measurements on the shipped fleet recipe (``--recipe``, default datasets/fleet-check.toml
+``[life]``, its ``snapshots`` checks per life unless ``--snapshots``), α = 0.2, the
 share of predictions after half of life within ±α of the true RUL:
 
 ``oracle``
@@ -55,12 +56,13 @@ from prsm_health.prognostics.history import duty_arrays, history_arrays
 from prsm_health.prognostics.metrics import evaluate_units, pooled_scores
 
 ALPHA = 0.2
-SNAPSHOTS = 30
 STEP = 5.0  # h, the oracle's integration step
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--recipe", default="datasets/fleet-check.toml")
+    parser.add_argument("--snapshots", type=int, help="ages per life (default the recipe's)")
     sub = parser.add_subparsers(dest="study", required=True)
     oracle = sub.add_parser("oracle")
     oracle.add_argument("--units", type=int, default=12)
@@ -72,9 +74,11 @@ def main(argv=None) -> None:
     ukf = sub.add_parser("ukf")
     ukf.add_argument("diagnoses")
     args = parser.parse_args(argv)
-    recipe = load_recipe("datasets/fleet.toml")
+    recipe = load_recipe(args.recipe)
     design = preset(recipe.design)
     spec = recipe.life_spec
+    if args.snapshots:
+        spec = replace(spec, snapshots=args.snapshots)
     tables = rate_tables(design, spec)
     if args.study == "oracle":
         run_oracle(design, spec, tables, args.units)
@@ -129,8 +133,9 @@ def run_oracle(design, spec, tables, n_units: int) -> None:
         life = math.log(unit.lubricant_life / tables["lubricant_life"])
         load = unit.load_scale
         start = {
-            "b_screw": unit.initial_clearance,
-            "b_nut": unit.initial_clearance,
+            # installed half-clearances: the threads' plus the assembly's play (the life's truth)
+            "b_screw": unit.initial_clearance + unit.assembly_play,
+            "b_nut": unit.initial_clearance + unit.assembly_play,
             "degradation": 0.0,
             "usage": 0.0,
             "log_wear": 0.0,
@@ -143,11 +148,11 @@ def run_oracle(design, spec, tables, n_units: int) -> None:
             end = _time_to_limit(model, state, 0.0, 4 * unit.failure_age, load, None, logged=unit)
             low, high = (mid, high) if end[0] > unit.failure_age else (low, mid)
         wear = 0.5 * (low + high)
-        for age in unit.snapshot_ages(SNAPSHOTS):
+        for age in unit.snapshot_ages(spec.snapshots):
             if age < 0.5 * unit.failure_age:
                 continue
             rul = unit.failure_age - age
-            screw, nut = (float(v) for v in unit.clearances(age))
+            screw, nut = (float(v) + unit.assembly_play for v in unit.clearances(age))
             recent = np.diff(np.interp([age - 50.0, age], unit.ages, unit.duty_hours))[0] / 50.0
             state = {
                 **start,
@@ -175,10 +180,10 @@ def run_noise(design, spec, tables, levels) -> None:
     test_lives = fleet_lives(design, replace(spec, units=12), 12)
     for noise in levels:
         train = simulated_histories(
-            train_lives, SNAPSHOTS, noise, np.random.default_rng(1), min_half_width=0.2e-6
+            train_lives, spec.snapshots, noise, np.random.default_rng(1), min_half_width=0.2e-6
         )
         test = simulated_histories(
-            test_lives, SNAPSHOTS, noise, np.random.default_rng(2), min_half_width=0.2e-6
+            test_lives, spec.snapshots, noise, np.random.default_rng(2), min_half_width=0.2e-6
         )
         failure = train.groupby("unit_id")["failure_age_hours"].first().to_dict()
         model = RULModel(threshold=spec.failure_clearance).fit(
@@ -235,14 +240,14 @@ def run_ideal(design, spec, tables, levels, draws: int) -> None:
     for noise in levels:
         train = simulated_histories(
             fleet_lives(design, replace(spec, units=14), 11),
-            SNAPSHOTS,
+            spec.snapshots,
             noise,
             np.random.default_rng(1),
             min_half_width=0.2e-6,
         )
         fitted = AgeingRUL.fit(tables, spec, train)
         test = simulated_histories(
-            test_lives, SNAPSHOTS, noise, np.random.default_rng(2), min_half_width=0.2e-6
+            test_lives, spec.snapshots, noise, np.random.default_rng(2), min_half_width=0.2e-6
         )
         rng = np.random.default_rng(0)
         hits = []

@@ -106,20 +106,17 @@ def _prognose_asset(args) -> int:
 
 
 def _prognosis_rows(args, prognosis, history, true_rul) -> list:
-    rul, hi, m = prognosis.rul_hours, prognosis.health_indicator, prognosis.model
+    hi, m = prognosis.health_indicator, prognosis.model
     latest = history.iloc[-1]  # the latest diagnosis, with its own (maybe uneven) interval
     ages = hi["ages_hours"]
     source = f"{args.source}, unit {args.unit}" if args.unit is not None else args.source
     if args.asset is not None:
         source = f"asset {args.asset} ({args.store})"
     rows = [
+        ("prognosis", prognosis.headline.text, ""),  # what a maintainer reads, one rule
         ("history", source, ""),
         ("diagnoses", f"{len(ages)} from {hours(ages[0])} to {hours(ages[-1])}", "h"),
-        (
-            "RUL",
-            f"{hours(rul['estimate'])} [{hours(rul['lower'])}, {hours(rul['upper'])}]",
-            "h (median, 90 % interval)",
-        ),
+        ("RUL", prognosis.headline.short, "(median, 90 % interval)"),
     ]
     if true_rul is not None:
         rows.append(("true RUL", hours(true_rul), "h (the simulator's truth, dataset labels)"))

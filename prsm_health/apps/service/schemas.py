@@ -254,6 +254,7 @@ class History(BaseModel):
 _PROGNOSIS: dict[str, type[BaseModel]] = {}
 Prognosis = contract_model(prognosis.Prognosis, _PROGNOSIS)
 RulHours = _PROGNOSIS["RulHours"]
+Headline = _PROGNOSIS["Headline"]
 
 
 class CheckReading(BaseModel):
@@ -311,11 +312,14 @@ class LatestDiagnosis(BaseModel):
 
 
 class PrognosisBrief(BaseModel):
-    """The asset's prognosis in brief (``rul_hours``, ``method``, ``threshold``,
+    """The asset's prognosis in brief (``rul_hours``, ``headline``, ``method``, ``threshold``,
     ``current``, ``warnings``), or why there is none (``error`` and the ``status`` that
     ``GET /v1/assets/{asset_id}/prognosis`` answers)."""
 
     rul_hours: RulHours | None = None
+    headline: Headline | None = Field(  # type: ignore[valid-type]
+        None, description="what a maintainer reads: the prognosis' headline"
+    )
     method: str | None = Field(None, description="the prognostics method used")
     threshold: float | None = Field(None, description="failure threshold of the clearance [m]")
     current: float | None = Field(None, description="latest clearance estimate used [m]")

@@ -251,7 +251,7 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
     press1 = page.locator("#fleet tbody tr", has_text="press-1")
     cells = press1.locator("td").all_text_contents()
     brief = next(a for a in assets if a["asset_id"] == "press-1")["prognosis"]
-    assert cells[3].startswith(f"{brief['rul_hours']['estimate']:.0f} (")  # RUL [h]
+    assert cells[3].startswith(brief["headline"]["short"])  # the RUL as the library words it
     assert "µ" not in cells[2] and "(" in cells[2] and cells[4] == "3"
     press2 = page.locator("#fleet tbody tr", has_text="press-2").locator("td").all_text_contents()
     assert press2[3].startswith("–") and "at least 2" in press2[3]  # no RUL, and why
@@ -293,7 +293,9 @@ def test_dashboard_in_chromium(service, browser, tmp_path):
     assert len(spectra["envelope"]["amplitude"]) > 100
     defects = page.locator("#defects tbody th").all_text_contents()
     assert {"screw_flank", "nut_flank", "roller_flank", "gear_mesh"} <= set(defects)
-    assert page.locator("#rul").text_content().endswith(" h")
+    headline = watch.json["v1/assets/press-1?prognosis=true"]["prognosis"]["headline"]
+    assert page.locator("#rul").text_content() == headline["text"]  # the library's one line
+    assert f"rul-{headline['state']}" in page.locator("#rul").get_attribute("class").split()
     assert page.locator("#check").is_hidden()  # its recordings are no health check
     assert "Over operating hours" in page.locator("#trend-note").text_content()
     assert watch.errors == [] and watch.dialogs == []

@@ -104,7 +104,7 @@ def model_file(tmp_path_factory):
     model = RULModel(n_samples=2000).fit(pd.concat(parts, ignore_index=True), lives)
     # the physics method (progpy ageing model) of the default fleet recipe's [life], small
     from prsm_health.actuator.design import preset
-    from prsm_health.physics.life import LifeSpec
+    from prsm_health.physics.life_spec import LifeSpec
     from prsm_health.prognostics.ageing_model import rate_tables
     from prsm_health.prognostics.ageing_rul import AgeingRUL
 
@@ -367,6 +367,48 @@ def test_an_asset_with_check_snapshots_gets_a_rul_that_survives_a_restart(
             assert again.json() == answer
 
 
+# ----------------------------------------------------------------------------- the headline
+def test_the_headline_is_in_the_answer_and_in_the_brief(app, model, monkeypatch):
+    # what a maintainer reads, made by the library's one rule: in the prognosis answer (in its
+    # generated schema) and in the asset's brief, which the dashboard shows
+    from prsm_health.apps.service.routes import prognosis as route
+    from prsm_health.apps.service.schemas import AssetSummary
+
+    store = app.state.store
+    table, _ = _store_unit(store, "press-headline", n_points=12, seed=11)
+    r = _request(app, "GET", "/v1/assets/press-headline/prognosis")
+    assert r.status_code == 200, r.text
+    answer = r.json()
+    expected = prognose(table, model)
+    assert answer["headline"] == expected.headline.to_json()
+    assert answer["headline"]["state"] == "remaining"
+    assert (
+        answer["headline"]["text"].startswith("RUL ")
+        and "µm threshold" in answer["headline"]["text"]
+    )
+    assert PrognosisSchema.model_validate(answer).model_dump() == answer
+    summary = _request(app, "GET", "/v1/assets/press-headline?prognosis=true").json()
+    assert summary["prognosis"]["headline"] == answer["headline"]
+    assert AssetSummary.model_validate(summary).model_dump(exclude_unset=True) == summary
+
+    # the trend has reached the threshold, the latest reading has not: never "0 h"
+    at_limit = dataclasses.replace(
+        expected,
+        rul_hours={"estimate": 0.0, "lower": 0.0, "upper": 242.0},
+        health_indicator=expected.health_indicator.to_json()
+        | {"current": 31.2e-6, "threshold": 32.7e-6},
+    )
+    monkeypatch.setattr(route, "prognose_readings", lambda *args, **kwargs: (at_limit, None))
+    answer = _request(app, "GET", "/v1/assets/press-headline/prognosis").json()
+    brief = _request(app, "GET", "/v1/assets?prognosis=true").json()["assets"]
+    brief = next(a["prognosis"] for a in brief if a["asset_id"] == "press-headline")
+    for headline in (answer["headline"], brief["headline"]):
+        assert headline["state"] == "at_limit"
+        assert headline["text"].startswith("at the limit by its trend: RUL < 1 h median")
+        assert "31.2 µm, below the 32.7 µm threshold" in headline["text"]
+        assert headline["short"] == "at the limit: < 1 h, up to 242 h"
+
+
 # ----------------------------------------------------------------------------- errors
 def test_prognosis_errors(app, bundle):
     store = app.state.store
@@ -467,11 +509,13 @@ def test_openapi_documents_the_route(app):
     # generated from the library's declaration: its fields, with their meanings
     declared = {f.name: f for f in dataclasses.fields(prognostics.Prognosis)}
     properties = schemas["Prognosis"]["properties"]
-    assert (
-        set(properties) == set(declared) == {"rul_hours", "health_indicator", "model", "warnings"}
-    )
+    assert set(properties) == set(declared)
+    assert set(declared) == {"rul_hours", "health_indicator", "model", "warnings", "headline"}
     for name, f in declared.items():
         assert properties[name]["description"] == f.metadata["description"]
+    headline = {f.name: f for f in dataclasses.fields(prognostics.prognosis.Headline)}
+    assert set(schemas["Headline"]["properties"]) == set(headline) == {"state", "text", "short"}
+    assert schemas["Headline"]["required"] == ["state", "text", "short"]
     assert "operating_hours" in schemas["DiagnoseRequest"]["properties"]
     assert "operating_hours" in schemas["HistoryEntry"]["properties"]
     diagnose = doc["paths"]["/v1/diagnose"]["post"]

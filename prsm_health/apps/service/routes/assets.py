@@ -30,8 +30,8 @@ from .prognosis import asset_prognosis
 router = APIRouter()
 
 _PROGNOSIS = Query(
-    description="add each asset's prognosis in brief (RUL and interval), or why there is none "
-    "(a prognosis per asset: slower for many assets)"
+    description="add each asset's prognosis in brief (RUL and interval, its headline), or why "
+    "there is none (a prognosis per asset: slower for many assets)"
 )
 
 
@@ -44,6 +44,7 @@ def prognosis_brief(store: HistoryStore, model, asset_id: str) -> dict:
         return {"error": exc.message, "status": exc.status}
     return {
         "rul_hours": p["rul_hours"],
+        "headline": p["headline"],
         "method": p["model"]["name"],
         "threshold": p["health_indicator"]["threshold"],
         "current": p["health_indicator"]["current"],

@@ -96,13 +96,17 @@ function showCheck(check, status) {
   document.querySelector("#check-phases tbody").replaceChildren(...rows);
 }
 
+// The prognosis' headline, as the library's one rule words it (Prognosis.headline: the median
+// RUL with its 90 % interval, the latest clearance and the threshold; never "0 h" while the
+// clearance is below the threshold), coloured by its state.
 function showPrognosis(prognosis) {
   const rul = document.getElementById("rul");
   const detail = document.getElementById("rul-detail");
-  if (prognosis && prognosis.rul_hours) {
-    rul.textContent = PH.rulText(prognosis.rul_hours) + " h";
-    detail.textContent = `Median and 90 % interval (${prognosis.method}); failure threshold ` +
-      `${PH.um(prognosis.threshold)} µm, latest clearance ${PH.um(prognosis.current)} µm.`;
+  if (prognosis && prognosis.headline) {
+    rul.textContent = prognosis.headline.text;
+    rul.classList.add(`rul-${prognosis.headline.state}`);
+    detail.textContent = `Median and 90 % interval of the remaining useful life, by the ` +
+      `${prognosis.method} method.`;
     PH.fill(document.getElementById("rul-warnings"), prognosis.warnings || []);
   } else {
     rul.textContent = "–";

@@ -49,10 +49,6 @@ const PH = (() => {
     return `${um(c.estimate)} (${um(c.lower)} – ${um(c.upper)})`;
   }
 
-  function rulText(r) {
-    return `${hours(r.estimate)} (${hours(r.lower)} – ${hours(r.upper)})`;
-  }
-
   function time(iso) {  // stored as UTC ISO-8601
     return iso ? iso.slice(0, 19).replace("T", " ") : "–";
   }
@@ -140,6 +136,6 @@ const PH = (() => {
     else fn();
   }
 
-  return {el, assetHref, getJSON, finite, um, hours, clearanceText, rulText, time, topClass,
+  return {el, assetHref, getJSON, finite, um, hours, clearanceText, time, topClass,
     classText, fill, define, plot, markers, palette, ready};
 })();

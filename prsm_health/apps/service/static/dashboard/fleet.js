@@ -1,4 +1,6 @@
-// The fleet overview (/): one row per asset from GET /v1/assets?prognosis=true.
+// The fleet overview (/): one row per asset from GET /v1/assets?prognosis=true, most recently
+// seen first; the RUL column's header button sorts the rows by RUL (which unit to overhaul
+// first), again for the reverse.
 "use strict";
 
 PH.ready(async () => {
@@ -6,6 +8,7 @@ PH.ready(async () => {
   const tbody = document.querySelector("#fleet tbody");
   try {
     const page = await PH.getJSON("/v1/assets?prognosis=true&limit=200");
+    const rows = [];
     for (const asset of page.assets) {
       const name = PH.el("th", null, {scope: "row"});
       name.append(PH.el("a", asset.asset_id, {href: PH.assetHref(asset.asset_id)}));
@@ -20,8 +23,10 @@ PH.ready(async () => {
         PH.el("td", PH.time(asset.last_received_at)),
         evidenceCell(asset.baseline, asset.evidence),
       );
+      rows.push({row, urgency: urgency(asset.prognosis)});
       tbody.append(row);
     }
+    sortable(tbody, rows);
     if (page.total === 0) {
       status.textContent = "No diagnosis is stored yet: send recordings with an asset id " +
         "(Diagnose a recording, or POST /v1/diagnose).";
@@ -49,15 +54,54 @@ function statusCell(status) {
   return cell;
 }
 
+// The RUL in brief as the library's one rule words it (the prognosis' headline: median and
+// 90 % interval, never "0 h" while the clearance is below the threshold); the whole headline
+// (with the latest clearance and the threshold) below it when the limit is near or reached.
 function rulCell(prognosis) {
   const cell = PH.el("td", null, {class: "num"});
-  if (prognosis && prognosis.rul_hours) {
-    cell.textContent = PH.rulText(prognosis.rul_hours);
+  const headline = prognosis && prognosis.headline;
+  if (headline) {
+    cell.append(PH.el("span", headline.short, {class: `rul-${headline.state}`, title: headline.text}));
+    if (headline.state === "at_limit" || headline.state === "threshold_reached") {
+      cell.append(PH.el("span", headline.text, {class: "why"}));
+    }
   } else {
     cell.textContent = "–";
     if (prognosis && prognosis.error) cell.append(PH.el("span", prognosis.error, {class: "why"}));
   }
   return cell;
+}
+
+// Where an asset sorts by RUL: [group, median RUL]. Group 0: the threshold is reached (the
+// headline's state); 1: a median RUL; 2: no prognosis, or none with a finite median.
+function urgency(prognosis) {
+  const headline = prognosis && prognosis.headline;
+  if (!headline || headline.state === "unknown") return [2, 0];
+  if (headline.state === "threshold_reached") return [0, 0];
+  return [1, prognosis.rul_hours.estimate];
+}
+
+// The RUL column's header button: ascending (most urgent first: the threshold reached, then
+// the smallest median RUL), again descending; assets without a prognosis last either way, ties
+// in the order the service listed them (most recently seen first).
+function sortable(tbody, rows) {
+  const button = document.getElementById("sort-rul");
+  const column = document.getElementById("rul-column");
+  const mark = button.querySelector(".sort-mark");
+  rows.forEach((r, i) => { r.seen = i; });
+  button.addEventListener("click", () => {
+    const ascending = column.getAttribute("aria-sort") !== "ascending";
+    const sign = ascending ? 1 : -1;
+    rows.sort((a, b) => {
+      const [ga, ra] = a.urgency;
+      const [gb, rb] = b.urgency;
+      if ((ga === 2) !== (gb === 2)) return ga === 2 ? 1 : -1;
+      return sign * (ga - gb || ra - rb) || a.seen - b.seen;
+    });
+    tbody.append(...rows.map((r) => r.row));
+    column.setAttribute("aria-sort", ascending ? "ascending" : "descending");
+    mark.textContent = ascending ? "▲" : "▼";
+  });
 }
 
 // The asset against its own baseline: the class its accumulated evidence names (or the most
