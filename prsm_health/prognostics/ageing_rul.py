@@ -42,6 +42,13 @@ BROAD_PRIOR_SD = (1.0, 0.7)
 #: Random-walk rate of the parameter particles in the filter [1/√h] (they would otherwise
 #: collapse onto a few values after resampling; 0.005·√1000 h ≈ 0.16 in ln per 1000 h).
 PARAMETER_DRIFT = 0.005
+#: Particles of the filter and, of them, samples of the prediction. On the health-check fleet
+#: (10 checks per life, 4-fold over 20 units) 1000 particles and 300 samples scored α–λ after
+#: half of life 0.85 / 0.84 (10 / 20 checks) against 0.81 / 0.77 with 300 particles — the
+#: parameter posterior of a short, precise history is narrow, and 300 particles resolve it
+#: coarsely (docs/prognostics.md).
+N_PARTICLES = 1000
+N_SAMPLES = 300
 #: Longest step [h] the filter propagates its particles by between diagnoses (the lubricant's
 #: depletion, which sets the wear rate, changes by ≤ 50/T_lube ≈ 1 % per step).
 FILTER_STEP = 50.0
@@ -93,8 +100,8 @@ class AgeingRUL:
         gain: float = 1.0,
         noise_scale: float = 1.0,
         horizon: float = 1e5,
-        n_particles: int = 300,
-        n_samples: int = 100,
+        n_particles: int = N_PARTICLES,
+        n_samples: int = N_SAMPLES,
         seed: int = 0,
     ):
         self.tables = {
@@ -264,8 +271,8 @@ class AgeingRUL:
         *,
         seed: int = 0,
         horizon: float | None = None,
-        n_particles: int = 300,
-        n_samples: int = 100,
+        n_particles: int = N_PARTICLES,
+        n_samples: int = N_SAMPLES,
     ):
         """Calibration and empirical-Bayes prior from training units (module docstring).
 

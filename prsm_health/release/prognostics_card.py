@@ -145,7 +145,8 @@ def prognostics_card(metrics: dict) -> str:
         "",
         f"**Data.** `datasets/{fleet['recipe']}.toml`: {fleet['units']} units × "
         f"{fleet['snapshots']} ages × {fleet['recordings']} "
-        f"{'health checks' if fleet['check'] else 'recordings'} of {fleet['duration']:g} s "
+        f"{'health check' if fleet['check'] else 'recording'}{'s' if fleet['recordings'] > 1 else ''}"
+        f" of {fleet['duration']:g} s "
         f"({generation['runs']} runs"
         f"; {generated}). Each unit wears by Archard wear of its thread contacts, "
         "faster as its lubricant's additives deplete, with unit-to-unit scatter of build, wear "
@@ -183,6 +184,10 @@ def prognostics_card(metrics: dict) -> str:
         "unit-to-unit bias.",
         "",
         _accuracy_by_age_table(cross["accuracy_by_age"]),
+        "",
+        "Between 50 and 80 % of life, pooled: "
+        + ", ".join(f"{m} {fixed(v, 3)}" for m, v in cross["alpha_lambda_50_80"].items())
+        + ".",
         "",
         "Prognostic horizon: *stay* from the first prediction after which every one stays "
         "within ±α·life of the true RUL, *first entry* from the first one inside "
@@ -223,5 +228,16 @@ def prognostics_card(metrics: dict) -> str:
         f"own fleet recipe and `{TOOL}` run on it.",
         "- The health indicator is the clearance alone; lubricant degradation and spall "
         "probabilities of the diagnosis are not used.",
+        *(
+            [
+                "- Its accuracy is that of commissioned health checks: an asset needs its "
+                "as-built clearance (`diagnose --asset ID --as-built-clearance B`, or the "
+                "service's `PUT /v1/assets/{id}/commissioning`) and its checks; without "
+                "commissioning a check reads ≈ 1 µm (sd) off, and in-service windows ≈ 2 µm — "
+                "the limits table above shows what that costs."
+            ]
+            if fleet["check"]
+            else []
+        ),
     ]
     return "\n".join(lines) + "\n"

@@ -294,7 +294,8 @@ def prognostics_metrics(
     -------
     dict
         ``alpha``, ``model``, ``fleet``, ``held_out``, ``cross_validated`` (``folds``,
-        ``summary``, ``accuracy_by_age``), ``indicator`` (:func:`indicator_errors`),
+        ``summary``, ``accuracy_by_age``, ``alpha_lambda_50_80``: α–λ accuracy pooled between 50
+        and 80 % of life), ``indicator`` (:func:`indicator_errors`),
         ``per_unit`` (the held-out units, the default method), ``sensitivity`` and ``figures``.
     """
     predictions, summary = held_out
@@ -328,6 +329,12 @@ def prognostics_metrics(
             "folds": FOLDS,
             "summary": cv_summary,
             "accuracy_by_age": accuracy_by_age(cv_predictions, alpha=alpha),
+            "alpha_lambda_50_80": {
+                m: v[0]
+                for m, v in accuracy_by_age(cv_predictions, alpha=alpha, bins=(0.5, 0.8))[
+                    "methods"
+                ].items()
+            },
         },
         "indicator": indicator_errors(histories),
         "per_unit": per_unit_scores(

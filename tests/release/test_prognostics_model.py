@@ -125,7 +125,8 @@ def test_the_metrics_are_json_and_render_the_card():
     # the indicator's errors from the histories: mean −1/6 µm, two of three intervals cover
     assert stored["indicator"]["coverage"] == pytest.approx(2 / 3)
     assert "bias -0.17 µm" in card and "covering 0.67" in card
-    assert "health checks of 2.62 s" in card and "`datasets/fleet-check.toml`" in card
+    assert "× 10 ages × 1 health check of 2.62 s" in card and "`datasets/fleet-check.toml`" in card
+    assert "Between 50 and 80 % of life, pooled: degradation –" in card  # no prediction there
     assert "(180 runs; generated in 95 s on 3 workers)" in card
     assert "scored on the 2 held-out units ([1, 2])" in card
     assert "Lives 100–300 h; failure modes wear 2, spall 1." in card

@@ -399,6 +399,7 @@ def test_the_headline_is_in_the_answer_and_in_the_brief(app, model, monkeypatch)
         | {"current": 31.2e-6, "threshold": 32.7e-6},
     )
     monkeypatch.setattr(route, "prognose_readings", lambda *args, **kwargs: (at_limit, None))
+    monkeypatch.setattr(route, "_MADE", type(route._MADE)())  # the real one is remembered
     answer = _request(app, "GET", "/v1/assets/press-headline/prognosis").json()
     brief = _request(app, "GET", "/v1/assets?prognosis=true").json()["assets"]
     brief = next(a["prognosis"] for a in brief if a["asset_id"] == "press-headline")
@@ -407,6 +408,39 @@ def test_the_headline_is_in_the_answer_and_in_the_brief(app, model, monkeypatch)
         assert headline["text"].startswith("at the limit by its trend: RUL < 1 h median")
         assert "31.2 µm, below the 32.7 µm threshold" in headline["text"]
         assert headline["short"] == "at the limit: < 1 h, up to 242 h"
+
+
+def test_a_prognosis_is_made_once_per_readings(app, model, monkeypatch):
+    # the physics method runs a particle filter: the fleet page and the asset page ask the same
+    # asset's prognosis again and again; a new reading makes a new one
+    from prsm_health.apps.service.routes import prognosis as route
+
+    made = []
+    real = route.prognose_readings
+
+    def counting(*args, **kwargs):
+        made.append(args[0][-1])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(route, "prognose_readings", counting)
+    monkeypatch.setattr(route, "_MADE", type(route._MADE)())
+    store = app.state.store
+    _store_unit(store, "press-remembered", n_points=6, seed=12)
+    first = _request(app, "GET", "/v1/assets/press-remembered/prognosis").json()
+    again = _request(app, "GET", "/v1/assets/press-remembered/prognosis").json()
+    brief = _request(app, "GET", "/v1/assets/press-remembered?prognosis=true").json()
+    assert again == first and brief["prognosis"]["rul_hours"] == first["rul_hours"]
+    assert len(made) == 1
+    other = _request(app, "GET", "/v1/assets/press-remembered/prognosis?method=similarity")
+    assert other.status_code == 200 and len(made) == 2  # another method, another prognosis
+    store.add(
+        "press-remembered",
+        [_diagnosis(12e-6, 11e-6, 13e-6)],
+        received_at=_stamp(50),
+        operating_hours=5000.0,
+    )
+    newer = _request(app, "GET", "/v1/assets/press-remembered/prognosis").json()
+    assert len(made) == 3 and newer["health_indicator"]["ages_hours"][-1] == 5000.0
 
 
 # ----------------------------------------------------------------------------- errors
