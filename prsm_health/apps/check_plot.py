@@ -16,12 +16,14 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
-from prsm_health.diagnostics.check_verdicts import check_verdicts
+from prsm_health.diagnostics.check_verdicts import CLEARANCE_ROLE, check_verdicts
 from prsm_health.physics.kinematics import speed_ratios
 from prsm_health.signals.check_averages import high_load_averages
 from prsm_health.signals.check_indicators import CENTROID_BAND, CENTROID_SEGMENT, SNR_PERIODS
 from prsm_health.signals.features import run_design
 from prsm_health.signals.spectra import welch_psd
+
+from .not_observable import not_observable_text
 
 #: What each role's panel is called.
 ROLE_TITLES = {
@@ -41,10 +43,11 @@ SHOWN_READINGS = {
 _MICRO = {"m": (1e6, "µm")}
 
 
-def panel_title(verdict: dict) -> str:
+def panel_title(verdict: dict, diagnosis: dict | None = None) -> str:
     """``<role>: phase '<name>' — read`` (or ``not read`` and why), and on a second line the
     targets the phase shows: the clearance interval (the reversal) and its classes'
-    probabilities."""
+    probabilities — "not observable" instead where ``diagnosis`` (its JSON) says the model
+    could not see them (:mod:`prsm_health.apps.not_observable`)."""
     head = ROLE_TITLES[verdict["role"]]
     if verdict["phase"] is None:
         return f"{head}: not read — the check has no {verdict['condition']}"
@@ -52,12 +55,20 @@ def panel_title(verdict: dict) -> str:
     lines = [f"{head}: phase '{verdict['phase']}' — {state}"]
     targets = []
     c = verdict["clearance"]
-    if c is not None and c.get("estimate") is not None:
+    diagnosis = diagnosis or {}
+    hidden = not_observable_text(diagnosis, "clearance")
+    if verdict["role"] == CLEARANCE_ROLE and hidden:
+        targets.append(f"clearance {hidden}")
+    elif c is not None and c.get("estimate") is not None:
         targets.append(
             f"clearance {1e6 * c['estimate']:.1f} µm [{1e6 * c['lower']:.1f}, "
             f"{1e6 * c['upper']:.1f}]"
         )
-    targets += [f"P({k}) {p:.2f}" for k, p in verdict["classes"].items()]
+    hidden = not_observable_text(diagnosis, "fault")
+    if hidden and verdict["classes"]:
+        targets.append(f"{', '.join(verdict['classes'])}: {hidden}")
+    else:
+        targets += [f"P({k}) {p:.2f}" for k, p in verdict["classes"].items()]
     if targets:
         lines.append(", ".join(targets))
     return "\n".join(lines)
@@ -125,7 +136,7 @@ def check_figure(run: Run, diagnosis, *, design=None, reference: Run | None = No
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5))
     for ax, verdict in zip(axes.flat, verdicts):
         role = verdict["role"]
-        ax.set_title(panel_title(verdict), fontsize=9, loc="left")
+        ax.set_title(panel_title(verdict, result), fontsize=9, loc="left")
         names = (verdict["phase"] or "").split(" / ")
         if verdict["phase"] is None or any(n not in phases for n in names):
             ax.text(0.5, 0.5, "not read", ha="center", va="center", transform=ax.transAxes)

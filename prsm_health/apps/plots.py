@@ -146,6 +146,9 @@ def plot_diagnosis(result, path: str | Path) -> Path:
 
     Each window is drawn over its own span (start to end), the last one included; the
     recording's overall estimate and interval are the dashed line and the band behind them.
+    Where a target is not observable (:mod:`prsm_health.apps.not_observable`) its numbers are
+    no reading: the clearance estimate is a hollow grey marker in a hatched grey interval, the
+    class probabilities are left out (a grey span), each labelled "not observable".
 
     Parameters
     ----------
@@ -153,10 +156,28 @@ def plot_diagnosis(result, path: str | Path) -> Path:
         A recording diagnosis (:func:`prsm_health.diagnostics.diagnosis.diagnose`).
     path : str or Path
     """
+    fig = diagnosis_figure(result)
+    import matplotlib.pyplot as plt  # after diagnosis_figure chose the Agg backend
+
+    fig.tight_layout()
+    path = Path(path)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+#: How a not-observable clearance interval is drawn (grey, hatched: no reading).
+_HIDDEN = {"facecolor": "none", "edgecolor": "0.6", "hatch": "///", "lw": 0.0}
+
+
+def diagnosis_figure(result):
+    """The matplotlib figure of :func:`plot_diagnosis`."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from .not_observable import NOT_OBSERVABLE, not_observable_text, observable
 
     def um(value):
         return np.nan if value is None else 1e6 * value
@@ -166,61 +187,111 @@ def plot_diagnosis(result, path: str | Path) -> Path:
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     overall = result.clearance
     t0, t1 = spans[0][0], spans[-1][1]
-    a1.axhspan(
-        um(overall["lower"]),
-        um(overall["upper"]),
-        color="tab:gray",
-        alpha=0.15,
-        label="recording: 90 % interval",
-    )
-    a1.hlines(
-        um(overall["estimate"]),
-        t0,
-        t1,
-        colors="tab:gray",
-        linestyles="--",
-        label="recording: estimate",
-    )
-    for k, ((a, b), w) in enumerate(zip(spans, wins)):
+    if observable(result, "clearance"):
+        a1.axhspan(
+            um(overall["lower"]),
+            um(overall["upper"]),
+            color="tab:gray",
+            alpha=0.15,
+            label="recording: 90 % interval",
+        )
+        a1.hlines(
+            um(overall["estimate"]),
+            t0,
+            t1,
+            colors="tab:gray",
+            linestyles="--",
+            label="recording: estimate",
+        )
+    labelled = set()
+    for (a, b), w in zip(spans, wins):
         c = w.clearance
+        seen = observable(w, "clearance")
+        if seen:
+            a1.fill_between(
+                [a, b],
+                um(c["lower"]),
+                um(c["upper"]),
+                color="tab:blue",
+                alpha=0.3,
+                label=None if "seen" in labelled else "window: 90 % interval",
+            )
+            a1.hlines(
+                um(c["estimate"]),
+                a,
+                b,
+                colors="tab:blue",
+                lw=2,
+                label=None if "seen" in labelled else "window: estimate",
+            )
+            labelled.add("seen")
+            continue
         a1.fill_between(
             [a, b],
             um(c["lower"]),
             um(c["upper"]),
-            color="tab:blue",
-            alpha=0.3,
-            label="window: 90 % interval" if k == 0 else None,
+            **_HIDDEN,
+            label=None if "hidden" in labelled else f"window {NOT_OBSERVABLE}: interval",
         )
-        a1.hlines(
-            um(c["estimate"]),
-            a,
-            b,
-            colors="tab:blue",
-            lw=2,
-            label="window: estimate" if k == 0 else None,
+        a1.plot(
+            [(a + b) / 2],
+            [um(c["estimate"])],
+            "o",
+            mfc="none",
+            mec="0.5",
+            label=None if "hidden" in labelled else f"window {NOT_OBSERVABLE}: estimate",
+        )
+        labelled.add("hidden")
+    if "seen" not in labelled:
+        box = {"facecolor": "white", "edgecolor": "none"}
+        a1.text(
+            0.5,
+            0.5,
+            f"clearance {NOT_OBSERVABLE}",
+            transform=a1.transAxes,
+            ha="center",
+            va="center",
+            color="0.4",
+            bbox=box,
         )
     a1.set_ylabel("clearance [µm]")
     a1.legend(fontsize=8, loc="best")
+    told = [(span, w) for span, w in zip(spans, wins) if observable(w, "fault")]
     for i, cls in enumerate(result.class_probabilities):
-        for k, ((a, b), w) in enumerate(zip(spans, wins)):
+        for k, ((a, b), w) in enumerate(told):
             probability = w.class_probabilities.get(cls, 0.0)
             a2.hlines(probability, a, b, lw=2, colors=f"C{i}", label=cls if k == 0 else None)
+    hidden = [(a, b) for (a, b), w in zip(spans, wins) if not observable(w, "fault")]
+    if not result.class_probabilities:  # no fault model: nothing hidden
+        hidden = []
+    for k, (a, b) in enumerate(hidden):
+        label = f"class {NOT_OBSERVABLE} (no probabilities)" if k == 0 else None
+        a2.axvspan(a, b, color="0.85", alpha=0.6, lw=0, label=label)
+    if hidden and len(hidden) == len(wins):
+        a2.text(
+            0.5,
+            0.5,
+            f"class {NOT_OBSERVABLE}",
+            transform=a2.transAxes,
+            ha="center",
+            va="center",
+            color="0.4",
+        )
     a2.set_ylabel("class probability [-]")
     a2.set_xlabel("recording time [s] (one segment per window)")
     a2.set_ylim(-0.02, 1.02)
-    a2.legend(fontsize=8, loc="best")
+    if a2.get_legend_handles_labels()[0]:
+        a2.legend(fontsize=8, loc="best")
     a2.set_xlim(t0, t1 if t1 > t0 else t0 + 1.0)
+    clearance = not_observable_text(result, "clearance") or (
+        f"{um(overall['estimate']):.1f} µm [{um(overall['lower']):.1f}, {um(overall['upper']):.1f}]"
+    )
     fig.suptitle(
-        f"{result.fault_class}  clearance {um(overall['estimate']):.1f} µm "
-        f"[{um(overall['lower']):.1f}, {um(overall['upper']):.1f}]  "
-        f"{len(wins)} window(s)  model {result.model['name']}",
+        f"{result.fault_class}  clearance {clearance}  {len(wins)} window(s)  "
+        f"model {result.model['name']}",
         fontsize=10,
     )
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return fig
 
 
 def plot_evaluation(report: dict, records, directory: str | Path) -> list[Path]:

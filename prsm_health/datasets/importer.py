@@ -250,7 +250,9 @@ def import_recordings(
             ),
             "package": {"name": "prsm_health", "version": __version__},
             "sample_rate": runs[0].sample_rate,
-            "duration": min(r.duration for r in runs),
+            # the training window: n samples span n sample periods (a window of the first to the
+            # last sample's time would cut the last sample off every recording in `diagnose`)
+            "duration": min(len(r) / r.sample_rate for r in runs),
             "channels": {"time": "s", **{c: CHANNEL_UNITS[c] for c in channels}},
             "truth": {},
             "derived_channels": derived,

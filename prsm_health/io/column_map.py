@@ -89,6 +89,20 @@ UNITS: dict[str, tuple[str, float]] = {
 }
 #: Unit spelling → offset added after the factor (temperatures in Celsius → kelvin).
 OFFSETS = {"degC": 273.15, "°C": 273.15}
+
+
+def unit_slips(declared: str) -> dict[float, str]:
+    """What a column declared in ``declared`` becomes if it is really in another unit of the
+    same quantity: factor (SI values ÷ their true size) → that unit's first spelling; for the
+    unit checks (:mod:`prsm_health.signals.unit_checks`) to name the likely unit."""
+    quantity, scale = UNITS[declared]
+    slips: dict[float, str] = {}
+    for unit, (q, factor) in UNITS.items():
+        if q == quantity and factor != scale:
+            slips.setdefault(scale / factor, unit)
+    return slips
+
+
 MAP_KEYS = ("columns", "units", "sample_rate", "design", "lead", "torque_constant")
 #: Largest accepted deviation of a time step from the median step (a fraction of it).
 UNIFORM_TOLERANCE = 0.01

@@ -1,6 +1,8 @@
 """The one recording reader: a file or its bytes (MCAP, Parquet, CSV, Arrow IPC), through a
 column map when given one, with the derivable channels added (:mod:`.derived`), and the
-reader's warnings collected as sentences (:class:`Recording`).
+reader's warnings collected as sentences (:class:`Recording`) — with one line per channel whose
+declared unit the actuator's physics doubts (:mod:`prsm_health.signals.unit_checks`), naming
+the file's column and the likely unit, so import, ``diagnose`` and the service all say it.
 
 :func:`read_with_warnings` does the work; :func:`prsm_health.io.read_recording` and
 :func:`prsm_health.io.read_recording_bytes` are it for callers that want the run only (the
@@ -15,10 +17,12 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from prsm_health.core.channels import UNITS as CHANNEL_UNITS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
+from prsm_health.signals.unit_checks import unit_mismatches
 
-from .column_map import ColumnMap, apply_column_map, load_column_map
+from .column_map import UNITS, ColumnMap, apply_column_map, load_column_map, unit_slips
 from .derived import derive_channels
 
 #: File suffix → format.
@@ -120,7 +124,32 @@ def read_with_warnings(
             categories.append(w.category)
         else:  # not about the recording (a library's deprecation): passed on as it came
             warnings.warn_explicit(text, w.category, w.filename, w.lineno)
+    notes = _unit_notes(run, spec if fmt in MAPPED_FORMATS else None, where)
+    texts += notes
+    categories += [UserWarning] * len(notes)
     return Recording(run, tuple(texts), derived, tuple(categories))
+
+
+def _unit_notes(run: Run, spec: ColumnMap | None, where: str) -> list[str]:
+    """One sentence per channel whose declared unit looks off by a unit slip, naming the
+    file's column, its declared unit and the likely one (``spec``: the map applied, if any)."""
+    declared = {}  # channel → (file column, its unit); drive_torque may come from a current
+    for name in run.channels:
+        if spec is None:
+            declared[name] = (name, CHANNEL_UNITS.get(name))
+        else:
+            key = "motor_current" if name == "drive_torque" else name
+            key = key if key in spec.columns else name
+            if key in spec.columns:
+                column = spec.columns[key]
+                declared[name] = (column, spec.units[column])
+    slips = {name: unit_slips(unit) for name, (_, unit) in declared.items() if unit in UNITS}
+    notes = []
+    for m in unit_mismatches(run, slips=slips):
+        column, unit = declared.get(m.channel, (None, None))
+        likely = slips.get(m.channel, {}).get(m.factor)
+        notes.append(f"{where}: {m.sentence(column, unit, likely)}")
+    return notes
 
 
 def _read(source, fmt: str, where: str, spec: ColumnMap | None) -> tuple[Run, str | None]:

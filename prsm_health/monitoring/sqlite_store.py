@@ -375,7 +375,8 @@ class HistoryStore(AssetTables):
         (how many of them have operating hours), ``operating_hours`` (the largest sent [h] or
         None), ``first_received_at``, ``last_received_at``, ``latest`` (the latest stored
         diagnosis in brief: receive time, source, file name, window, operating hours,
-        clearance, fault class, class probabilities, warnings, model and, of a health check,
+        clearance, fault class, class probabilities, warnings, model, observability, undecided
+        (null when the diagnosis names a class) and, of a health check,
         ``check``: its phases' verdicts, :func:`~prsm_health.diagnostics.check_verdicts.check_verdicts`),
         ``spectra_received_at`` (when its stored spectra came, or None), ``baseline``,
         ``evidence`` and ``status`` (:func:`~.status.asset_status`); None when nothing is
@@ -397,6 +398,8 @@ class HistoryStore(AssetTables):
                 " fault_class, class_probabilities,"
                 " json_extract(diagnosis, '$.warnings') AS warnings,"
                 " json_extract(diagnosis, '$.model') AS model,"
+                " json_extract(diagnosis, '$.observability') AS observability,"
+                " json_extract(diagnosis, '$.undecided') AS undecided,"
                 # the whole diagnosis of a check only: its phases' verdicts are read from it
                 " CASE WHEN json_extract(diagnosis, '$.check_phases') IS NOT NULL"
                 " THEN diagnosis END AS check_diagnosis FROM diagnoses WHERE asset_id = ?"
@@ -433,6 +436,9 @@ class HistoryStore(AssetTables):
                 "class_probabilities": json.loads(latest["class_probabilities"]),
                 "warnings": json.loads(warnings) if warnings else [],
                 "model": json.loads(model) if model else None,
+                # what the pages need to show a target the model could not see as such
+                "observability": _json_or_none(latest["observability"]),
+                "undecided": _json_or_none(latest["undecided"]),
                 "check": check_verdicts(json.loads(check)) if check else None,
             },
             "spectra_received_at": None if spectra is None else spectra[0],
@@ -451,6 +457,11 @@ class HistoryStore(AssetTables):
     def close(self) -> None:
         with self._lock:
             self._conn.close()
+
+
+def _json_or_none(text: str | None):
+    """A JSON value read by ``json_extract`` (None where the diagnosis has no such field)."""
+    return None if text is None else json.loads(text)
 
 
 def _provenance(row: Mapping) -> dict:

@@ -31,6 +31,7 @@ from sklearn.utils import check_random_state
 
 from prsm_health.core.errors import PRSMHealthError, require
 from prsm_health.core.operating_point import OperatingPoint
+from prsm_health.monitoring.asset import OBSERVABLE_SHARE
 
 __all__ = [
     "SparseFeatureError",
@@ -396,32 +397,38 @@ def cross_validated_metrics(
 # --------------------------------------------------------------------------------------------
 
 
-def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = False) -> tuple:
-    """Diagnose every run of a dataset split as one window and score it against its labels.
+def evaluate_model(
+    bundle, dataset, *, split: str = "test", progress: bool = False, batch: int = 32
+) -> tuple:
+    """Diagnose every run of a dataset split as ``diagnose`` diagnoses a recording, and score
+    it against its labels.
 
-    The runs go through :func:`prsm_health.diagnostics.diagnosis.diagnose_indicators`, as a recording
-    would: observability gates, the OOD score, ``cannot_tell``. Clearance metrics are computed
-    over all runs and over those whose clearance the diagnosis called observable. Fault metrics
-    are ``macro_f1_all`` (every run; ``cannot_tell`` counted as a miss) and ``macro_f1_named``
-    (only the runs the diagnosis named a class for). Neither is the ``macro_f1_classifier`` of
-    ``prsm-health train`` — the classifier alone on every run, no gates, never ``cannot_tell``
-    — so on one split the three differ.
+    Each run goes through :func:`prsm_health.diagnostics.diagnosis.diagnose_runs` — the one
+    diagnosis path of ``diagnose``, the service and replay: cut into the model's windows (a
+    health check read phase by phase), observability gates, the OOD score, ``cannot_tell``,
+    the windows combined. Clearance metrics are computed over all runs and over those whose
+    clearance the diagnosis called observable. Fault metrics are ``macro_f1_all`` (every run;
+    ``cannot_tell`` counted as a miss) and ``macro_f1_named`` (only the runs the diagnosis named
+    a class for). Neither is the ``macro_f1_classifier`` of ``prsm-health train`` — the
+    classifier alone on every window, no gates, never ``cannot_tell`` — so on one split the
+    three differ.
 
     Parameters
     ----------
     bundle : ModelBundle
     dataset : Dataset (generated or imported)
     split : {"test", "train", "all"}
+    batch : int
+        Runs diagnosed per call.
 
     Returns
     -------
     (report, records)
-        ``report``: JSON-serialisable metrics; ``records``: one row per run (labels, estimate,
-        bounds, class, top probability, observability, OOD score) for plots and sensitivity
-        tables.
+        ``report``: JSON-serialisable metrics; ``records``: one row per run (its labels, the
+        estimate, bounds, class, top probability, observability, OOD score, windows) for plots
+        and sensitivity tables.
     """
-    from prsm_health.diagnostics.diagnosis import diagnose_indicators
-    from prsm_health.signals.features import dataset_features
+    from prsm_health.diagnostics.diagnosis import diagnose_runs
 
     require(split in ("test", "train", "all"), "split", split, "must be test, train or all")
     runs = dataset.runs if split == "all" else dataset.runs[dataset.runs["split"] == split]
@@ -432,13 +439,21 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
         reason = bundle.refuses(OperatingPoint.from_labels(labels))
         if reason is not None:
             raise PRSMHealthError(f"{dataset.path}: {reason}")
-    table = dataset_features(dataset, runs["run_id"], progress=progress)
-    rows = [{k: row[k] for k in bundle.feature_names} | _extra(row) for _, row in table.iterrows()]
-    designs = table["design"] if "design" in table else [None] * len(table)
-    results = [
-        diagnose_indicators([r], bundle, [dataset.channels], d)[0] for r, d in zip(rows, designs)
-    ]
-    records = table.copy()
+    ids = [int(i) for i in runs["run_id"]]
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(ids), unit="run", desc="diagnosing")
+    results = []
+    for start in range(0, len(ids), batch):
+        chunk = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
+        results.extend(diagnose_runs(chunk, bundle))
+        if bar is not None:
+            bar.update(len(chunk))
+    if bar is not None:
+        bar.close()
+    records = runs.reset_index(drop=True).copy()
     records["estimate"] = [_num(r.clearance["estimate"]) for r in results]
     records["lower"] = [_num(r.clearance["lower"]) for r in results]
     records["upper"] = [_num(r.clearance["upper"]) for r in results]
@@ -447,9 +462,14 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
     records["top_probability"] = [
         max(r.class_probabilities.values()) if r.class_probabilities else np.nan for r in results
     ]
-    records["clearance_observable"] = [bool(r.observability["clearance"]) for r in results]
-    records["fault_observable"] = [bool(r.observability["fault"]) for r in results]
+    # a recording's observability is the share of its windows that saw the target: observable
+    # when most did, the rule the asset's evidence reads it by
+    for target in ("clearance", "fault"):
+        records[f"{target}_observable"] = [
+            float(r.observability[target]) >= OBSERVABLE_SHARE for r in results
+        ]
     records["ood_score"] = [_num(r.ood_score) for r in results]
+    records["windows"] = [max(len(r.windows), 1) for r in results]
     report = {
         "dataset": str(dataset.path),
         "model": bundle.reference(),
@@ -466,11 +486,6 @@ def evaluate_model(bundle, dataset, *, split: str = "test", progress: bool = Fal
     if bundle.fault is not None and "fault_class" in records:
         report["fault"] = fault_report(records)
     return report, records
-
-
-def _extra(row) -> dict:
-    # the indicators the gates read even when the model does not use them
-    return {k: row[k] for k in ("reversal",) if k in row}
 
 
 def _num(value) -> float:

@@ -244,7 +244,9 @@ def test_import_train_evaluate_round_trip_beats_statistics(tmp_path):
     import_recordings(files, tmp_path / "labels.csv", tmp_path / "map.toml", tmp_path / "ds")
     train(tmp_path / "ds", tmp_path / "m.skops", target="fault", cv=3, progress=False)
     ds = Dataset(tmp_path / "ds")
-    report, _ = evaluate_model(load_bundle(tmp_path / "m.skops"), ds)
+    bundle = load_bundle(tmp_path / "m.skops")
+    report, _ = evaluate_model(bundle, ds)
+    _evaluate_is_diagnose(bundle, tmp_path / "long")
     stats = []
     for name in ds.runs["recording"]:
         frame = pd.read_csv(tmp_path / name)
@@ -264,6 +266,40 @@ def test_import_train_evaluate_round_trip_beats_statistics(tmp_path):
     )
     assert report["fault"]["macro_f1_all"] >= baseline - 0.1, (report["fault"], baseline)
     assert report["fault"]["cannot_tell_fraction"] == 0.0  # every recording reverses
+
+
+def _evaluate_is_diagnose(bundle, root):
+    # One diagnosis path: `evaluate` reads each imported recording as `diagnose FILE --map`
+    # does — recordings 3× the model's training window (60 s against 20 s) cut into its windows,
+    # not read as one window of their whole length; the same estimate, class, OOD score and
+    # observability, to the last bit (the same code on the same samples).
+    from prsm_health.diagnostics.diagnosis import diagnose
+    from prsm_health.io import read_recording
+    from prsm_health.training.evaluation import evaluate_model
+
+    root.mkdir()
+    rows = []
+    for k, (backlash, cls) in enumerate([(5e-6, "healthy"), (60e-6, "wear"), (5e-6, "healthy")]):
+        _recording(backlash, 0.05, seed=300 + k, n=1500).to_csv(root / f"l{k}.csv", index=False)
+        rows.append({"recording": f"l{k}.csv", "fault_class": cls, "clearance": backlash / 2})
+    pd.DataFrame(rows).to_csv(root / "labels.csv", index=False)
+    (root / "map.toml").write_text(MAP)
+    files = [root / r["recording"] for r in rows]
+    import_recordings(files, root / "labels.csv", root / "map.toml", root / "ds")
+    _, records = evaluate_model(bundle, Dataset(root / "ds"), split="all")
+    assert (records["windows"] == 3).all()
+    for _, row in records.iterrows():
+        run = read_recording(root / row["recording"], column_map=root / "map.toml")
+        d = diagnose(run, bundle)
+        assert len(d.windows) == row["windows"]
+        assert d.fault_class == row["predicted_class"]
+        assert _same(d.clearance["estimate"], row["estimate"])
+        assert _same(d.ood_score, row["ood_score"])
+        assert (d.observability["fault"] >= 0.5) == row["fault_observable"]
+
+
+def _same(a, b) -> bool:
+    return (a is None and math.isnan(b)) or a == b or (math.isnan(a) and math.isnan(b))
 
 
 def test_read_recording_with_the_map_is_what_the_import_stores(rig):

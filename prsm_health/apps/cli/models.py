@@ -20,6 +20,7 @@ from prsm_health.training.evaluation import evaluate_model
 from prsm_health.training.train import train as train_model
 
 from ..check_plot import plot_check_result
+from ..not_observable import not_observable_text
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
 from .models_options import DEFAULT_CV
@@ -245,18 +246,23 @@ def _modified(file: str) -> str:
 def diagnosis_rows(file: str, result) -> list:
     """The table of ``diagnose``: a recording's :class:`Diagnosis` in words."""
     c = result.clearance
+    clearance = (
+        f"{um(c['estimate'])} [{um(c['lower'])}, {um(c['upper'])}]",
+        "µm (90 % interval)",
+    )
+    hidden = not_observable_text(result, "clearance")
     rows = [
         ("file", file, ""),
         ("fault class", result.fault_class, ""),
         ("class set", ", ".join(result.class_set), "  not ruled out (90 %)"),
-        (
-            "clearance",
-            f"{um(c['estimate'])} [{um(c['lower'])}, {um(c['upper'])}]",
-            "µm (90 % interval)",
-        ),
+        ("clearance", *((hidden, "") if hidden else clearance)),
     ]
     rows += measured_rows(getattr(result, "measured_clearance", None))
-    rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
+    hidden = not_observable_text(result, "fault")
+    if hidden and result.class_probabilities:  # one row, not a P(…) per class
+        rows.append(("class probabilities", hidden, ""))
+    else:
+        rows += [(f"P({k})", v, "") for k, v in result.class_probabilities.items()]
     u = getattr(result, "undecided", None)
     if u is not None:
         told = ", ".join(u.missing or u.candidates)
@@ -366,11 +372,9 @@ def _replay_line(entry) -> str:
     if "diagnosis" in entry:
         d = entry["diagnosis"]
         c = d["clearance"]
-        return (
-            head
-            + f"{d['fault_class']:<12} clearance {um(c['estimate'])} µm "
-            + f"[{um(c['lower'])}, {um(c['upper'])}]"
-        )
+        shown = not_observable_text(d, "clearance")
+        shown = shown or f"{um(c['estimate'])} µm [{um(c['lower'])}, {um(c['upper'])}]"
+        return head + f"{d['fault_class']:<12} clearance {shown}"
     ax = entry["statistics"].get("nut_axial_accel", {})
     return (
         head

@@ -209,6 +209,8 @@ _CONTRACT: dict[str, type[BaseModel]] = {}
 Diagnosis = contract_model(contract.Diagnosis, _CONTRACT)
 ClearanceInterval = _CONTRACT["ClearanceInterval"]
 WindowSpan = _CONTRACT["WindowSpan"]
+Observability = _CONTRACT["Observability"]
+Undecided = _CONTRACT["Undecided"]
 AssetState = _CONTRACT["AssetState"]
 
 
@@ -306,6 +308,14 @@ class LatestDiagnosis(BaseModel):
     class_probabilities: dict[str, float]
     warnings: list[str]
     model: dict | None = Field(description="name, version, design of the diagnosing model")
+    observability: Observability | None = Field(  # type: ignore[valid-type]
+        None,
+        description="per target, whether the model could see it (the diagnosis' own); where "
+        "not, the pages show 'not observable' instead of its numbers",
+    )
+    undecided: Undecided | None = Field(  # type: ignore[valid-type]
+        None, description="why the class is cannot_tell (the diagnosis' own; null otherwise)"
+    )
     check: list[CheckVerdict] | None = Field(
         None, description="a health check: each role's phase, readings and verdict"
     )

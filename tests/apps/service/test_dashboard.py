@@ -298,6 +298,21 @@ def test_a_version_2_database_gets_the_spectra_table_on_open(bundle, bodies, tmp
 
 
 # ----------------------------------------------------------------------------- assets
+def test_the_latest_says_what_the_model_could_not_see(tmp_path):
+    # the pages show a target the model could not see as "not observable" (common.js)
+    store = HistoryStore(tmp_path / "history.sqlite")
+    undecided = {"kind": "not_observable", "missing": ["a load or motion reversal"]}
+    hidden = {"observability": {"clearance": 0.0, "fault": False}, "undecided": undecided}
+    store.add("hidden", [{**_diagnosis(30e-6, "cannot_tell"), **hidden}])
+    store.add("old", [_diagnosis()])  # stored before observability was kept
+    latest = store.asset_summary("hidden")["latest"]
+    assert latest["observability"] == hidden["observability"]
+    assert latest["undecided"] == undecided
+    old = store.asset_summary("old")["latest"]
+    assert old["observability"] is None and old["undecided"] is None
+    store.close()
+
+
 def test_assets_list_and_summary(bundle, tmp_path):
     app = _app(bundle, tmp_path, limits=ServiceLimits(max_history=3))
     store = app.state.store

@@ -18,7 +18,7 @@ PH.ready(async () => {
       PH.getJSON(base + "/evidence?limit=1000"),
     ]);
     showLatest(summary.latest);
-    showCheck(summary.latest.check, summary.status);
+    showCheck(summary.latest, summary.status);
     showPrognosis(summary.prognosis);
     showEvidence(summary, evidence);
     const axis = xAxis(history.diagnoses);
@@ -53,8 +53,8 @@ function showLatest(latest) {
     : "";
   const model = latest.model ? `${latest.model.name} ${latest.model.version} (${latest.model.design})` : "–";
   PH.define(document.getElementById("latest"), [
-    ["Fault class (probability)", PH.classText(latest)],
-    ["Clearance [µm] (90 % interval)", PH.clearanceText(latest.clearance)],
+    ["Fault class (probability)", PH.classText(latest), PH.observableClass(latest, "fault")],
+    ["Clearance [µm] (90 % interval)", PH.clearanceText(latest), PH.observableClass(latest, "clearance")],
     ["Operating hours [h]", PH.hours(latest.operating_hours)],
     ["Received (UTC)", PH.time(latest.received_at)],
     ["Recording", source(latest) + span],
@@ -72,7 +72,8 @@ function readingText(r) {
   return `${name} = ${(factor * r.value).toPrecision(4)} ${unit}`.trimEnd() + z;
 }
 
-function showCheck(check, status) {
+function showCheck(latest, status) {
+  const check = latest.check;
   if (!check) return;  // the latest recording is no health check
   document.getElementById("check").hidden = false;
   document.getElementById("check-note").textContent = "Each role of the check read in the " +
@@ -85,12 +86,21 @@ function showCheck(check, status) {
       : v.read ? "read" : "not read (see the warnings)";
     const readings = PH.el("td");
     for (const r of v.readings) readings.append(PH.el("span", readingText(r), {class: "reading"}));
-    const shows = [];
-    if (v.clearance && PH.finite(v.clearance.estimate)) shows.push(`clearance ${PH.clearanceText(v.clearance)} µm`);
-    for (const [name, p] of Object.entries(v.classes)) shows.push(`P(${name}) ${p.toFixed(2)}`);
+    const shows = [];  // [text, class]: what the model could not see greyed
+    const hiddenClearance = PH.notObservableText(latest, "clearance");
+    const hiddenClasses = PH.notObservableText(latest, "fault");
+    if (v.role === "reversal" && hiddenClearance) shows.push([`clearance ${hiddenClearance}`, "not-observable"]);
+    else if (v.clearance && PH.finite(v.clearance.estimate)) shows.push([`clearance ${PH.clearanceText(v)} µm`, ""]);
+    const classes = Object.entries(v.classes);
+    if (hiddenClasses && classes.length) {
+      shows.push([`${classes.map(([name]) => name).join(", ")}: ${hiddenClasses}`, "not-observable"]);
+    } else {
+      for (const [name, p] of classes) shows.push([`P(${name}) ${p.toFixed(2)}`, ""]);
+    }
+    const cell = PH.el("td", shows.length ? null : "–");
+    shows.forEach(([text, cls], i) => cell.append(PH.el("span", (i ? ", " : "") + text, {class: cls})));
     row.append(PH.el("th", v.role.replace("_", " "), {scope: "row"}), PH.el("td", v.phase ?? "–"),
-      PH.el("td", verdict, {class: v.read ? "" : "not-read"}), readings,
-      PH.el("td", shows.join(", ") || "–"));
+      PH.el("td", verdict, {class: v.read ? "" : "not-read"}), readings, cell);
     return row;
   });
   document.querySelector("#check-phases tbody").replaceChildren(...rows);
@@ -278,21 +288,31 @@ function axisOptions(axis, yLabel) {
   return options;
 }
 
+// The clearance where the model saw it in blue; where not (PH.observable), the estimate a hollow
+// grey point in a grey interval: shown for context, never read as the unit's clearance.
 function clearancePlot(axis, prognosis) {
   const value = (v) => (PH.finite(v) ? v * 1e6 : null);
   const clearance = (e) => e.diagnosis.clearance || {};
+  const seen = axis.rows.map((e) => PH.observable(e.diagnosis, "clearance"));
+  const column = (key, shown) => axis.rows.map((e, i) => (seen[i] === shown ? value(clearance(e)[key]) : null));
   const data = [
     axis.xs,
-    axis.rows.map((e) => value(clearance(e).estimate)),
-    axis.rows.map((e) => value(clearance(e).lower)),
-    axis.rows.map((e) => value(clearance(e).upper)),
+    column("estimate", true), column("lower", true), column("upper", true),
+    column("estimate", false), column("lower", false), column("upper", false),
   ];
   const blue = PH.palette[0];
+  const grey = "#9aa0a6";
   const series = [
     {label: axis.label},
     {label: "clearance [µm]", stroke: blue, width: 2, points: {show: true, size: 6}},
     {label: "90 % lower", stroke: "rgba(31,119,180,0.6)", dash: [4, 4]},
     {label: "90 % upper", stroke: "rgba(31,119,180,0.6)", dash: [4, 4]},
+    {label: `${PH.NOT_OBSERVABLE}: estimate`, stroke: grey, paths: onlyPoints,
+      points: {show: true, size: 8, stroke: grey, fill: "#fff"}},
+    {label: `${PH.NOT_OBSERVABLE}: interval lower`, stroke: grey, dash: [2, 3],
+      points: {show: true, size: 4, stroke: grey, fill: grey}},
+    {label: `${PH.NOT_OBSERVABLE}: interval upper`, stroke: grey, dash: [2, 3],
+      points: {show: true, size: 4, stroke: grey, fill: grey}},
   ];
   if (prognosis && PH.finite(prognosis.threshold)) {
     data.push(axis.xs.map(() => prognosis.threshold * 1e6));
@@ -300,23 +320,36 @@ function clearancePlot(axis, prognosis) {
   }
   const options = Object.assign(axisOptions(axis, "clearance [µm]"), {
     series,
-    bands: [{series: [3, 2], fill: "rgba(31,119,180,0.15)"}],
+    bands: [{series: [3, 2], fill: "rgba(31,119,180,0.15)"}, {series: [6, 5], fill: "rgba(154,160,166,0.15)"}],
   });
+  const hidden = seen.filter((s) => !s).length;
+  if (hidden) {
+    document.getElementById("trend-note").textContent += ` ${hidden} diagnosis(es) could not ` +
+      `see the clearance (${PH.NOT_OBSERVABLE}): their estimate is a hollow grey point in a ` +
+      "grey interval, not a reading.";
+  }
   PH.plot(document.getElementById("clearance-plot"), options, data);
 }
 
+// The class probabilities of the diagnoses that could see the fault; the others have none.
 function classPlot(axis) {
   const names = [...new Set(axis.rows.flatMap((e) => Object.keys(e.diagnosis.class_probabilities || {})))].sort();
+  const seen = axis.rows.map((e) => PH.observable(e.diagnosis, "fault"));
   const data = [axis.xs];
   const series = [{label: axis.label}];
   names.forEach((name, i) => {
-    data.push(axis.rows.map((e) => {
+    data.push(axis.rows.map((e, k) => {
       const p = (e.diagnosis.class_probabilities || {})[name];
-      return PH.finite(p) ? p : null;
+      return seen[k] && PH.finite(p) ? p : null;
     }));
     series.push({label: name, stroke: PH.palette[i % PH.palette.length], width: 1.5,
       points: {show: true, size: 5}});
   });
+  const hidden = seen.filter((s) => !s).length;
+  document.getElementById("class-note").textContent = hidden
+    ? `${hidden} diagnosis(es) could not see the fault class (${PH.NOT_OBSERVABLE}): no ` +
+      "probabilities are drawn for them."
+    : "";
   const options = Object.assign(axisOptions(axis, "probability"), {series});
   options.scales.y = {range: [0, 1]};
   PH.plot(document.getElementById("class-plot"), options, data);

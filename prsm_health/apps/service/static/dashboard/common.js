@@ -44,7 +44,41 @@ const PH = (() => {
   const um = (v) => (finite(v) ? (v * 1e6).toFixed(2) : "–");
   const hours = (v) => (finite(v) ? (Math.abs(v) >= 100 ? v.toFixed(0) : v.toPrecision(3)) : "–");
 
-  function clearanceText(c) {
+  // A target the model could not see is shown as "not observable", never as a number: the
+  // rule of prsm_health/apps/not_observable.py, on the same JSON fields. Observable: seen in
+  // the window, or in any window of a recording (a share > 0), or a clearance a health check
+  // measured; a diagnosis without observability (stored before it was kept) as it was.
+  const NOT_OBSERVABLE = "not observable";
+
+  function observable(diagnosis, target) {
+    if (target === "clearance" && diagnosis.measured_clearance) return true;
+    const seen = (diagnosis.observability || {})[target];
+    return seen === undefined || seen === null || Boolean(seen);
+  }
+
+  // The text instead of the target's numbers (the clearance with its interval as context),
+  // with why where the diagnosis says (undecided.missing); null where it is observable.
+  function notObservableText(diagnosis, target) {
+    if (!diagnosis || observable(diagnosis, target)) return null;
+    const u = diagnosis.undecided;
+    const missing = u && u.kind === "not_observable" ? u.missing || [] : [];
+    let text = missing.length ? `${NOT_OBSERVABLE} — needs ${missing.join(", ")}` : NOT_OBSERVABLE;
+    const c = diagnosis.clearance || {};
+    if (target === "clearance" && finite(c.lower) && finite(c.upper)) {
+      text += ` (interval ${(c.lower * 1e6).toFixed(1)}–${(c.upper * 1e6).toFixed(1)} µm)`;
+    }
+    return text;
+  }
+
+  // The class "not-observable" (greyed) for a target the model could not see, else "".
+  function observableClass(diagnosis, target) {
+    return diagnosis && !observable(diagnosis, target) ? "not-observable" : "";
+  }
+
+  function clearanceText(diagnosis) {
+    const hidden = notObservableText(diagnosis, "clearance");
+    if (hidden) return hidden;
+    const c = diagnosis && diagnosis.clearance;
     if (!c || !finite(c.estimate)) return "–";
     return `${um(c.estimate)} (${um(c.lower)} – ${um(c.upper)})`;
   }
@@ -64,6 +98,8 @@ const PH = (() => {
   function classText(diagnosis) {
     const probabilities = diagnosis.class_probabilities || {};
     const name = diagnosis.fault_class;
+    const hidden = notObservableText(diagnosis, "fault");
+    if (name && hidden && Object.keys(probabilities).length) return `${name} (${hidden})`;
     if (name && finite(probabilities[name])) return `${name} (${probabilities[name].toFixed(2)})`;
     const top = topClass(probabilities);
     if (!name) return "–";
@@ -74,9 +110,10 @@ const PH = (() => {
     list.replaceChildren(...items.map((text) => el("li", text)));
   }
 
+  // Terms and values; a third item gives the value's class (e.g. "not-observable").
   function define(dl, pairs) {
     dl.replaceChildren();
-    for (const [term, value] of pairs) dl.append(el("dt", term), el("dd", value));
+    for (const [term, value, cls] of pairs) dl.append(el("dt", term), el("dd", value, cls ? {class: cls} : {}));
   }
 
   function plot(container, options, data) {
@@ -136,6 +173,7 @@ const PH = (() => {
     else fn();
   }
 
-  return {el, assetHref, getJSON, finite, um, hours, clearanceText, time, topClass,
-    classText, fill, define, plot, markers, palette, ready};
+  return {el, assetHref, getJSON, finite, um, hours, NOT_OBSERVABLE, observable, notObservableText,
+    observableClass, clearanceText, time, topClass, classText, fill, define, plot, markers, palette,
+    ready};
 })();

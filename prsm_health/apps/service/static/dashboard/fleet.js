@@ -16,8 +16,9 @@ PH.ready(async () => {
       row.append(
         name,
         statusCell(asset.status),
-        PH.el("td", PH.classText(asset.latest)),
-        PH.el("td", PH.clearanceText(asset.latest.clearance), {class: "num"}),
+        PH.el("td", PH.classText(asset.latest), {class: PH.observableClass(asset.latest, "fault")}),
+        PH.el("td", PH.clearanceText(asset.latest),
+          {class: `num ${PH.observableClass(asset.latest, "clearance")}`.trim()}),
         rulCell(asset.prognosis),
         PH.el("td", asset.diagnoses, {class: "num"}),
         PH.el("td", PH.time(asset.last_received_at)),

@@ -71,9 +71,9 @@ function show(answer, assetId) {
   const diagnosis = answer.diagnosis || answer;  // an upload wraps it with its windows
   const windows = answer.recording ? answer.windows.length : (diagnosis.windows || []).length || 1;
   PH.define(document.getElementById("diagnosis"), [
-    ["Fault class (probability)", PH.classText(diagnosis)],
+    ["Fault class (probability)", PH.classText(diagnosis), PH.observableClass(diagnosis, "fault")],
     ["Classes not ruled out", (diagnosis.class_set || []).join(", ") || "–"],
-    ["Clearance [µm] (90 % interval)", PH.clearanceText(diagnosis.clearance)],
+    ["Clearance [µm] (90 % interval)", PH.clearanceText(diagnosis), PH.observableClass(diagnosis, "clearance")],
     ["Windows", String(windows)],
     ...assetRows(diagnosis.asset),
     ["Model", `${diagnosis.model.name} ${diagnosis.model.version} (${diagnosis.model.design})`],

@@ -1,0 +1,65 @@
+"""What a diagnosis shows of a target the model could not see: one rule for the CLI's tables,
+replay's lines and the figures (the dashboard applies the same rule to the same JSON fields in
+``static/dashboard/common.js``: ``PH.observable``, ``PH.notObservableText``).
+
+A Diagnosis carries its numbers whether or not the recording let the model see the target
+(``observability``): where it did not, the clearance interval is the whole trained range and
+the class probabilities are those of a window the classes do not differ in. Printed like the
+others they read as a reading ("clearance 4.7 [0.1, 39.3] µm", "P(spall) 0.42"), so they are
+shown as "not observable", with why where the diagnosis says (``undecided.missing``) and the
+clearance interval only as context, marked.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from prsm_health.diagnostics import contract
+
+#: What is shown instead of a target's numbers.
+NOT_OBSERVABLE = "not observable"
+
+
+def part(diagnosis, name: str):
+    """A field of a Diagnosis, of its JSON, or of an object with its fields (None if absent)."""
+    if isinstance(diagnosis, Mapping):
+        return diagnosis.get(name)
+    return getattr(diagnosis, name, None)
+
+
+def observable(diagnosis, target: str) -> bool:
+    """Whether a diagnosis' ``target`` (``clearance`` or ``fault``) is shown as numbers.
+
+    Yes where the model saw it: in the window, or in any window of a recording (the
+    recording's value is then of those windows alone); and a clearance a health check measured
+    by physics. A diagnosis without ``observability`` (an answer stored before it was kept)
+    is shown as it was."""
+    if target == "clearance" and part(diagnosis, "measured_clearance"):
+        return True
+    seen = (part(diagnosis, "observability") or {}).get(target)
+    return seen is None or bool(seen)
+
+
+def why(diagnosis) -> str:
+    """Why the recording could not show its targets, in a few words: the conditions it lacked
+    (``undecided.missing``), or "" where the diagnosis names none (its warnings say why)."""
+    undecided = part(diagnosis, "undecided")
+    if undecided is None or part(undecided, "kind") != contract.NOT_OBSERVABLE:
+        return ""
+    missing = part(undecided, "missing") or []
+    return f"needs {', '.join(missing)}" if missing else ""
+
+
+def not_observable_text(diagnosis, target: str) -> str | None:
+    """The text shown instead of ``target``'s numbers (the clearance with its interval as
+    context, marked); None where it is observable: then the numbers are shown."""
+    if observable(diagnosis, target):
+        return None
+    reason = why(diagnosis)
+    text = f"{NOT_OBSERVABLE} — {reason}" if reason else NOT_OBSERVABLE
+    if target == "clearance":
+        c = part(diagnosis, "clearance") or {}
+        lower, upper = c.get("lower"), c.get("upper")
+        if lower is not None and upper is not None:
+            text += f" (interval {1e6 * lower:.1f}–{1e6 * upper:.1f} µm)"
+    return text
