@@ -1,6 +1,8 @@
-"""numba kernel of the out-of-distribution guard (:class:`prsm_health.diagnostics.estimators.
+"""numba kernels of the out-of-distribution guard (:class:`prsm_health.diagnostics.estimators.
 DistributionGuard`): the mean distance of each row to its nearest training rows in one pass,
-instead of numpy's seven arrays of (rows × training rows × indicators) per chunk of rows.
+instead of numpy's seven arrays of (rows × training rows × indicators) per chunk of rows; and
+each training row's nearest one at another level of an operating factor (the guard's
+interpolation).
 
 numpy's arithmetic is kept: float32 differences, their squares summed in float32 one indicator
 after the other (the order numpy's broadcast arrays took for the shipped model's guard, whose
@@ -16,34 +18,58 @@ from numba import njit
 
 
 @njit(cache=True)
+def row_distance(z, i, reference, j, penalty2):
+    """The distance of row z[i] to row reference[j] (float32, NaN where missing): the RMS over
+    the indicators either row has of their differences, √``penalty2`` for one that only one
+    row has; float32 squares summed one indicator after the other, the rest in float64."""
+    one = 0
+    used = 0
+    squares = np.float32(0.0)
+    for f in range(z.shape[1]):
+        a = z[i, f]
+        b = reference[j, f]
+        a_ok = np.isfinite(a)
+        b_ok = np.isfinite(b)
+        if a_ok and b_ok:
+            d = a - b
+            squares += d * d
+        if a_ok != b_ok:
+            one += 1
+        if a_ok or b_ok:
+            used += 1
+    total = np.float64(squares) + penalty2 * one
+    return np.sqrt(total / max(used, 1))
+
+
+@njit(cache=True)
+def nearest_across(z, values, gap, penalty2, out):
+    """out[i] = the index of the row of z nearest to z[i] (:func:`row_distance`) among those
+    whose ``values`` differ from values[i] by more than ``gap`` — the nearest window at
+    another level of an operating factor; −1 where there is none."""
+    for i in range(z.shape[0]):
+        best = np.inf
+        out[i] = -1
+        for j in range(z.shape[0]):
+            if not abs(values[j] - values[i]) > gap:  # NaN values: never a level apart
+                continue
+            distance = row_distance(z, i, z, j, penalty2)
+            if distance < best:
+                best = distance
+                out[i] = j
+
+
+@njit(cache=True)
 def neighbour_distances(z, reference, penalty2, neighbours, leave_out_offset, out):
     """out[i] = the mean of the ``neighbours`` smallest distances of row z[i] to the rows of
     ``reference`` (float32, NaN where an indicator is missing): the RMS over the indicators
     either row has of their differences, √``penalty2`` for one that only one row has. Row i is
     not its own neighbour when ``leave_out_offset`` ≥ 0 (z[i] is reference[leave_out_offset
     + i]); NaN when fewer than ``neighbours`` distances are numbers."""
-    features = z.shape[1]
     nearest = np.empty(neighbours)
     for i in range(z.shape[0]):
         found = 0  # nearest[:found] ascending
         for j in range(reference.shape[0]):
-            one = 0
-            used = 0
-            squares = np.float32(0.0)
-            for f in range(features):
-                a = z[i, f]
-                b = reference[j, f]
-                a_ok = np.isfinite(a)
-                b_ok = np.isfinite(b)
-                if a_ok and b_ok:
-                    d = a - b
-                    squares += d * d
-                if a_ok != b_ok:
-                    one += 1
-                if a_ok or b_ok:
-                    used += 1
-            total = np.float64(squares) + penalty2 * one
-            distance = np.sqrt(total / max(used, 1))
+            distance = row_distance(z, i, reference, j, penalty2)
             if leave_out_offset >= 0 and j == leave_out_offset + i:
                 distance = np.inf
             if np.isnan(distance):

@@ -75,6 +75,13 @@ _OOD_NOTE = "indicators unlike the training windows"
 #: clearance is not observable in that window (the shipped model's held-out intervals are
 #: 10 µm wide on average, a quarter of its 40 µm range: models/default.metrics.json).
 WHOLE_RANGE_SHARE = 0.9
+#: The recipe's sweep key of each operating indicator (what to sweep to cover a recording).
+REGIME_SWEEP = {
+    "speed_mean": "speed",
+    "load_mean": "load",
+    "load_range": "load_amplitude",
+    "drive_torque_mean": "load",
+}
 #: Words for the operating indicators in warnings.
 REGIME_WORDS = {
     "speed_mean": "speed",
@@ -317,15 +324,28 @@ def _window_gates(
             "trained range: clearance is not observable in this window (its indicators do not "
             "narrow it); the interval is the whole trained range"
         )
+    outside = False
     for name, (lo, hi) in bundle.regime.items():
         value = row.get(name)
         if value is not None and np.isfinite(value):
+            if lo >= 0.0 > value or hi <= 0.0 < value:
+                # a factor trained on one sign only: the mechanism runs the same the other way
+                # round (its mirror image), so the magnitude is what must be in range
+                value = -value
             slack = 0.05 * max(hi - lo, abs(hi), abs(lo))  # the range of a few hundred windows
             if not lo - slack <= value <= hi + slack:
+                # between the trained levels the guard interpolates; beyond them the model
+                # would extrapolate, confidently wrong at worst: it says so and does not tell
+                outside = True
+                word, unit = REGIME_WORDS.get(name, name), FEATURES[name]
                 notes.append(
-                    f"recording outside the trained {REGIME_WORDS.get(name, name)} range: "
-                    f"{value:.4g} vs {lo:.4g} … {hi:.4g} {FEATURES[name]}"
+                    f"recording outside the trained {word} range: {value:.4g} vs {lo:.4g} … "
+                    f"{hi:.4g} {unit} — the model does not extrapolate: record within it, or "
+                    f"train on a recipe whose [sweep] {REGIME_SWEEP.get(name, name)} covers "
+                    f"{value:.3g} {unit}"
                 )
+                conditions.append(f"a {word} within the trained {lo:.3g} … {hi:.3g} {unit}")
+    clearance_ok = clearance_ok and not outside
     if design is not None and design != bundle.design_name:
         notes.append(
             f"recording of design {design!r}, model trained on {bundle.design_name!r}: its "
@@ -337,7 +357,7 @@ def _window_gates(
     if bundle.fault is not None and not fault_ok:
         notes.append(
             "fault class: cannot tell"
-            if ood_high
+            if ood_high or outside
             else "fault class: cannot tell — wear classes differ by clearance, which this window "
             "does not show"
         )

@@ -787,6 +787,13 @@ def class_sets(proba, thresholds) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 
 
+#: Two training rows are at different levels of an operating factor when they differ by more
+#: than this share of its training span (a grid's neighbouring speeds, 80 and 100 rad/s of a
+#: 40–120 sweep, differ by a quarter; a random sweep's nearest windows by less, and their
+#: midpoints then only fill in where windows already are).
+LEVEL_GAP = 0.05
+
+
 class DistributionGuard(BaseEstimator):
     """How far a row of indicators lies from the training rows: an out-of-distribution score.
 
@@ -801,6 +808,17 @@ class DistributionGuard(BaseEstimator):
     ≤ 1 for all but a fraction ``1 − quantile`` of windows like the training ones, ≫ 1 for a
     window unlike any of them.
 
+    **Between the levels of an operating factor** (``factors``: the columns of continuous
+    factors such as speed and load) a dataset swept on a grid has no window, and its indicators
+    (mesh frequency, band energies, torque) move with the factor: a window at 90 rad/s of a
+    model trained at 80 and 100 would score as unlike both. So each training row is paired
+    with its nearest row at another level of each factor (differing by more than
+    :data:`LEVEL_GAP` of the factor's training span) and their midpoint joins the rows a window
+    is compared with — a linear interpolation of the indicators between neighbouring levels.
+    The threshold stays that of the training rows among themselves, so a window like them
+    scores as before or lower, and a window outside the factors' span or unlike any pair as
+    before.
+
     Parameters
     ----------
     n_neighbors : int, default 5
@@ -808,6 +826,9 @@ class DistributionGuard(BaseEstimator):
         Training quantile that scores 1, in (0, 1).
     missing_penalty : float, default 5.0
         Distance [robust standard deviations] of a present to an absent indicator, ≥ 0.
+    factors : sequence of int, default ()
+        Columns of the continuous operating factors to interpolate between (none: no
+        interpolation, the guard as it was).
 
     References
     ----------
@@ -815,10 +836,11 @@ class DistributionGuard(BaseEstimator):
        large data sets", SIGMOD 2000 (distance to the k-th nearest neighbour as outlier score).
     """
 
-    def __init__(self, n_neighbors=5, quantile=0.99, missing_penalty=5.0):
+    def __init__(self, n_neighbors=5, quantile=0.99, missing_penalty=5.0, factors=()):
         self.n_neighbors = n_neighbors
         self.quantile = quantile
         self.missing_penalty = missing_penalty
+        self.factors = factors
 
     def fit(self, X, y=None):
         require(
@@ -844,7 +866,44 @@ class DistributionGuard(BaseEstimator):
         self.reference_ = self._scaled(X)
         raw = self._raw(self.reference_, leave_out_self=True)
         self.threshold_ = float(np.quantile(raw, self.quantile))
+        between = self._between(X)
+        self.n_between_ = len(between)
+        self.reference_ = np.concatenate([self.reference_, between])
         return self
+
+    def _between(self, X) -> np.ndarray:
+        """The midpoints (scaled) of each training row and its nearest row at another level of
+        each factor, each pair once; an indicator missing in either is missing in theirs."""
+        from ._kernels import nearest_across
+
+        Z = self.reference_
+        pairs = set()
+        for column in self.factors:
+            require(
+                isinstance(column, (int, np.integer)) and 0 <= column < X.shape[1],
+                "factors",
+                column,
+                f"must be column indices below {X.shape[1]}",
+            )
+            values = X[:, column].astype(np.float64)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN factor
+                span = float(np.nanmax(values) - np.nanmin(values)) if len(values) else 0.0
+            if not span > 0:
+                continue
+            partner = np.empty(len(Z), np.int64)
+            nearest_across(
+                np.ascontiguousarray(Z, np.float32),
+                np.ascontiguousarray(values),
+                LEVEL_GAP * span,
+                float(self.missing_penalty**2),
+                partner,
+            )
+            pairs |= {(min(i, j), max(i, j)) for i, j in enumerate(partner) if j >= 0}
+        if not pairs:
+            return np.empty((0, Z.shape[1]), np.float32)
+        first, second = (np.array(side) for side in zip(*sorted(pairs)))
+        return (0.5 * (Z[first] + Z[second])).astype(np.float32)  # NaN where either is
 
     def _scaled(self, X) -> np.ndarray:
         return ((X - self.center_) / self.scale_).astype(np.float32)

@@ -26,7 +26,14 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError, require
 from prsm_health.core.jsonable import dumps
+from prsm_health.signals.channel_statistics import dataset_statistics
 from prsm_health.signals.features import FEATURES, GROUPS, dataset_features
+
+from .plain_baseline import baseline_verdict, plain_baseline_cv
+
+#: The operating indicators the out-of-distribution guard interpolates between (continuous
+#: factors a dataset may sweep on a grid; ``reversal`` is a yes/no, not a level).
+GUARD_FACTORS = tuple(n for n in GROUPS["operating"] if n != "reversal")
 
 TARGETS = ("clearance", "fault", "both")
 MODEL_SUFFIX = ".skops"
@@ -570,8 +577,10 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         "indicators_absent": absent,
     }
     bundle: dict = {"feature_names": features, "clearance": None, "fault": None}
-    # How far a window's indicators lie from the training windows (diagnosis: OOD score).
-    bundle["guard"] = DistributionGuard().fit(x_train)
+    # How far a window's indicators lie from the training windows (diagnosis: OOD score),
+    # interpolated between the levels of the continuous operating factors
+    factors = [i for i, name in enumerate(features) if name in GUARD_FACTORS]
+    bundle["guard"] = DistributionGuard(factors=factors).fit(x_train)
 
     if target in ("clearance", "both"):
         y = clearance_target(train_rows)
@@ -627,6 +636,11 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
             metrics["fault_cv"] = _classifier_alone(
                 cross_validated_metrics(make_classifier, x_train, labels, groups=groups, cv=cv)
             )
+        with _collect_warnings("plain baseline CV", notes):
+            stats = dataset_statistics(ds, train_rows["run_id"])
+            baseline = plain_baseline_cv(stats, labels, groups, cv, random_state)
+        metrics["fault_plain_baseline_cv"] = baseline
+        notes += baseline_verdict(metrics["fault_cv"]["macro_f1_classifier"], baseline)
         with _collect_warnings("fault model", notes), sparse():
             classifier = make_classifier().fit(x_train, labels)
         bundle["fault"] = classifier

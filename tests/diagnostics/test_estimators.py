@@ -600,6 +600,8 @@ def test_distribution_guard_bad_parameters():
             DistributionGuard(**params).fit(x)
     with pytest.raises(ParameterError, match="more than 5 rows"):
         DistributionGuard().fit(np.zeros((5, 2)))
+    with pytest.raises(ParameterError, match="factors"):
+        DistributionGuard(factors=[2]).fit(np.arange(20.0).reshape(10, 2))
 
 
 def test_classifier_class_sets_hold_the_classes_it_cannot_separate():
@@ -673,3 +675,32 @@ def test_clearance_estimator_fits_two_samples_with_residual_quantiles():
             np.arange(4.0).reshape(2, 2), [1e-6, 2e-6]
         )
     assert np.all(np.isfinite(est.predict(np.arange(4.0).reshape(2, 2))))
+
+
+def test_guard_interpolates_between_the_levels_of_an_operating_factor():
+    # A dataset swept on a grid: speed at two levels, 80 and 100, and four indicators that move
+    # with it (a mesh frequency ∝ speed, band energies, a torque) plus noise. A window at 90 has
+    # indicators between the two clusters: unlike either (the gap is ≈ 10 noise sds), yet what
+    # the mechanism does between them. Interpolating between neighbouring levels takes it in;
+    # a window beyond the levels (120), or between them but unlike any pair, stays out.
+    rng = np.random.default_rng(3)
+    slopes = np.array([1.0, 0.5, -0.8, 0.3])
+
+    def windows(speed, n):
+        trend = np.outer(np.full(n, speed), slopes)
+        return np.column_stack([np.full(n, speed), trend + rng.normal(0.0, 1.0, (n, 4))])
+
+    train = np.vstack([windows(80.0, 150), windows(100.0, 150)])
+    plain = DistributionGuard().fit(train)
+    between = DistributionGuard(factors=[0]).fit(train)
+    assert between.n_between_ > 0 and plain.threshold_ == between.threshold_
+    middle = windows(90.0, 200)
+    assert np.median(plain.score(middle)) > 2.0  # the gap the grid left
+    assert np.mean(between.score(middle) <= 1.5) > 0.95  # interpolated: in distribution
+    assert np.median(between.score(windows(120.0, 50))) > 2.0  # beyond the levels: out
+    odd = windows(90.0, 50)
+    odd[:, 2] += 8.0  # between the levels, but one indicator unlike any window
+    assert np.median(between.score(odd)) > 1.5
+    # windows like the training ones score as before or lower (more rows to be near)
+    same = windows(80.0, 100)
+    assert np.all(between.score(same) <= plain.score(same) + 1e-12)

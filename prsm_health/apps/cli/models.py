@@ -139,6 +139,8 @@ def training_rows(metrics: dict) -> list:
             rows.append(
                 (f"{label} {F1_CLASSIFIER}", scaled(metrics[key].get("macro_f1_classifier")), "")
             )
+    if baseline := metrics.get("fault_plain_baseline_cv"):  # the same folds, plain statistics
+        rows.append(("fault CV plain baseline macro-F1", scaled(baseline.get("macro_f1")), ""))
     return rows
 
 
