@@ -11,62 +11,27 @@ for one asset replaced by such a prognosis.
 """
 
 import dataclasses
-import math
 import os
 import re
 
 import numpy as np
-import pandas as pd
 import pytest
 from live_server import LiveServer
+from synthetic_units import Z90, fitted_model, unit
 from test_dashboard_browser import CHROMIUM, CHROMIUM_ARGS, Watch, _loaded
 
 from prsm_health.apps.service import create_app
 from prsm_health.apps.service.routes import prognosis as prognosis_route
 from prsm_health.diagnostics.diagnosis import load_bundle
-from prsm_health.prognostics import RULModel
 
 pytestmark = pytest.mark.skipif(
     os.environ.get("PRSM_HEALTH_SKIP_BROWSER") == "1", reason="PRSM_HEALTH_SKIP_BROWSER=1"
 )
 
-Z90 = 1.6448536269514722
-THRESHOLD, PHI0 = 30e-6, 8e-6
 #: Most urgent first: the threshold reached, at the limit by its trend, then by median RUL;
 #: the asset without a prognosis last.
 URGENT_FIRST = ["worn-out", "edge", "old", "middle", "young"]
 NO_PROGNOSIS = "new-one"
-
-
-def _unit(rng, n_points=20):
-    """Ages [h], clearance estimates and sd [m] of one unit, and its life [h]."""
-    ln_theta = math.log(2e-6) + 0.15 * rng.standard_normal()
-    beta = 2.4e-4 * (1 + 0.15 * rng.standard_normal())
-    life = (math.log(THRESHOLD - PHI0) - ln_theta) / beta
-    ages = np.linspace(0.0, life, n_points, endpoint=False)
-    sd = rng.uniform(0.2e-6, 0.5e-6, n_points)
-    estimate = PHI0 + np.exp(ln_theta + beta * ages) + sd * rng.standard_normal(n_points)
-    return ages, estimate, sd, life
-
-
-def _model() -> RULModel:
-    rng = np.random.default_rng(0)
-    parts, lives = [], {}
-    for uid in range(10):
-        ages, estimate, sd, life = _unit(rng)
-        parts.append(
-            pd.DataFrame(
-                {
-                    "unit_id": uid,
-                    "age_hours": ages,
-                    "clearance": estimate,
-                    "clearance_lower": estimate - Z90 * sd,
-                    "clearance_upper": estimate + Z90 * sd,
-                }
-            )
-        )
-        lives[uid] = life
-    return RULModel(n_samples=2000).fit(pd.concat(parts, ignore_index=True), lives)
 
 
 def _store(store, asset: str, points) -> None:
@@ -87,7 +52,7 @@ def _store(store, asset: str, points) -> None:
 
 def _life_so_far(seed: int, fraction: float, n_points=12):
     """The first ``fraction`` of a unit's life, ``n_points`` diagnoses."""
-    ages, estimate, sd, _ = _unit(np.random.default_rng(seed), round(n_points / fraction))
+    ages, estimate, sd, _ = unit(np.random.default_rng(seed), round(n_points / fraction))
     return list(zip(ages[:n_points].tolist(), estimate[:n_points].tolist(), sd[:n_points].tolist()))
 
 
@@ -111,7 +76,7 @@ def test_fleet_page_sorts_by_rul_most_urgent_first(chromium_path, tmp_path, monk
         tmp_path / "history.sqlite",
         bundle=load_bundle(),
         warmup=False,
-        prognostics_model=_model(),
+        prognostics_model=fitted_model(),
     )
     store = app.state.store
     # stored in an order unlike the urgency (the page lists the most recently seen first)

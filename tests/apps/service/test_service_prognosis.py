@@ -11,7 +11,6 @@ same database file; error answers use in-process ASGI calls.
 
 import dataclasses
 import json
-import math
 import os
 import signal
 import socket
@@ -28,6 +27,7 @@ import pytest
 import schemathesis
 from hypothesis import HealthCheck, settings
 from live_server import LiveServer
+from synthetic_units import Z90, fitted_model, unit
 
 from prsm_health import prognostics
 from prsm_health.apps.cli import main
@@ -40,9 +40,6 @@ from prsm_health.io.parquet import write_run_parquet
 from prsm_health.prognostics import RULModel, history_of_readings, prognose, save_prognostics_model
 
 TOKEN = "prognosis-token-81c2"
-Z90 = 1.6448536269514722
-THRESHOLD = 30e-6
-PHI0 = 8e-6
 
 # The schema of version 1 (before operating_hours), verbatim: what existing databases hold.
 V1_SCHEMA = """
@@ -71,37 +68,9 @@ CREATE INDEX IF NOT EXISTS diagnoses_asset_time ON diagnoses (asset_id, received
 
 
 # ----------------------------------------------------------------------------- synthetic fleet
-def _unit(rng, n_points):
-    """Ages [h], clearance estimates and measurement sd [m] of one unit, and its life [h]:
-    S(t) = PHI0 + exp(ln theta + beta t) + noise, failing at THRESHOLD."""
-    ln_theta = math.log(2e-6) + 0.15 * rng.standard_normal()
-    beta = 2.4e-4 * (1 + 0.15 * rng.standard_normal())
-    life = (math.log(THRESHOLD - PHI0) - ln_theta) / beta
-    ages = np.linspace(0.0, life, n_points, endpoint=False)
-    sd = rng.uniform(0.2e-6, 0.5e-6, n_points)
-    estimate = PHI0 + np.exp(ln_theta + beta * ages) + sd * rng.standard_normal(n_points)
-    return ages, estimate, sd, life
-
-
 @pytest.fixture(scope="module")
 def model_file(tmp_path_factory):
-    rng = np.random.default_rng(0)
-    parts, lives = [], {}
-    for uid in range(10):
-        ages, estimate, sd, life = _unit(rng, 20)
-        parts.append(
-            pd.DataFrame(
-                {
-                    "unit_id": uid,
-                    "age_hours": ages,
-                    "clearance": estimate,
-                    "clearance_lower": estimate - Z90 * sd,
-                    "clearance_upper": estimate + Z90 * sd,
-                }
-            )
-        )
-        lives[uid] = life
-    model = RULModel(n_samples=2000).fit(pd.concat(parts, ignore_index=True), lives)
+    model = fitted_model()
     # the physics method (progpy ageing model) of the default fleet recipe's [life], small
     from prsm_health.actuator.design import preset
     from prsm_health.physics.life_spec import LifeSpec
@@ -139,7 +108,7 @@ def _stamp(i: int) -> str:
 def _store_unit(store, asset, n_points=30, seed=7, design="paper01"):
     """A unit's diagnoses at growing operating hours, stored as the service would: the first
     60 % of its life (30 diagnoses), one a day."""
-    ages, estimate, sd, life = _unit(np.random.default_rng(seed), round(n_points / 0.6))
+    ages, estimate, sd, life = unit(np.random.default_rng(seed), round(n_points / 0.6))
     ages, estimate, sd = ages[:n_points], estimate[:n_points], sd[:n_points]
     for i, (t, c, s) in enumerate(zip(ages, estimate, sd)):
         store.add(
