@@ -51,6 +51,7 @@ from prsm_health.physics.kinematics import defect_frequencies, speed_ratios
 
 from .envelope_analysis import defect_lines_batch
 from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
+from .generic_indicators import GENERIC, NEEDS_ANY, generic_indicators
 from .kernels import hysteresis_crossings, moment_sums, screw_power_sums
 from .lost_motion import lost_motion_spread
 from .percentiles import percentiles
@@ -137,6 +138,7 @@ def _feature_table() -> dict[str, str]:
             "housing_temperature_mean": "K",
         }
     )
+    units.update(GENERIC)  # any recording's (signals.generic_indicators)
     return units
 
 
@@ -154,7 +156,7 @@ TRUTH_FEATURES: dict[str, dict[str, str]] = {
 #: Indicator groups for importance and ablation studies.
 GROUPS = {
     "mesh": [k for k in FEATURES if "_mesh_" in k] + ["mesh_frequency"],
-    "axial_frequency": [k for k in FEATURES if k.startswith("axial_")],
+    "axial_frequency": [k for k in FEATURES if k.startswith("axial_") and k not in GENERIC],
     "classic": [
         k
         for k in FEATURES
@@ -163,10 +165,11 @@ GROUPS = {
     ],
     "gear": [k for k in FEATURES if "_tsa_" in k],
     "envelope": [k for k in FEATURES if "_env_" in k or "_sk_" in k],
-    "torque": [k for k in FEATURES if "torque" in k] + ["efficiency"],
+    "torque": [k for k in FEATURES if "torque" in k and k not in GENERIC] + ["efficiency"],
     "lost_motion": ["lost_motion"],
     "torque_rattle": ["torque_rattle_rate"],
     "operating": ["speed_mean", "load_mean", "load_range", "reversal", "housing_temperature_mean"],
+    "generic": list(GENERIC),
 }
 
 
@@ -198,6 +201,7 @@ GROUP_CHANNELS: dict[str, Needs] = {
     "lost_motion": Needs(("nut_position", "screw_angle")),
     "torque_rattle": Needs(("drive_torque",)),
     "operating": Needs(any_of=("screw_speed", "axial_load", "drive_torque", "housing_temperature")),
+    "generic": Needs(any_of=NEEDS_ANY),
 }
 
 
@@ -491,6 +495,7 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
     nut_per_rad = ratios.nut if ratios is not None else (lead / (2 * math.pi) if lead else None)
     for run, row in zip(runs, rows):
         _torque_and_reversals(run, nut_per_rad, row)
+        row.update(generic_indicators(run, nut_per_rad))
     return rows
 
 
