@@ -42,20 +42,27 @@ def row_distance(z, i, reference, j, penalty2):
 
 
 @njit(cache=True)
-def nearest_across(z, values, gap, penalty2, out):
-    """out[i] = the index of the row of z nearest to z[i] (:func:`row_distance`) among those
-    whose ``values`` differ from values[i] by more than ``gap`` — the nearest window at
-    another level of an operating factor; −1 where there is none."""
+def nearest_across(z, values, gaps, penalty2, out):
+    """out[i, k] = the index of the row of z nearest to z[i] (:func:`row_distance`) among those
+    whose factor k (``values[:, k]``) differs from row i's by more than ``gaps[k]`` — the
+    nearest window at another level of that operating factor; −1 where there is none. Each
+    pair's distance is computed once for all the factors."""
+    factors = values.shape[1]
+    best = np.empty(factors)
     for i in range(z.shape[0]):
-        best = np.inf
-        out[i] = -1
+        for k in range(factors):
+            best[k] = np.inf
+            out[i, k] = -1
         for j in range(z.shape[0]):
-            if not abs(values[j] - values[i]) > gap:  # NaN values: never a level apart
-                continue
-            distance = row_distance(z, i, z, j, penalty2)
-            if distance < best:
-                best = distance
-                out[i] = j
+            distance = -1.0  # not computed yet
+            for k in range(factors):
+                if not abs(values[j, k] - values[i, k]) > gaps[k]:  # NaN: never a level apart
+                    continue
+                if distance < 0.0:
+                    distance = row_distance(z, i, z, j, penalty2)
+                if distance < best[k]:
+                    best[k] = distance
+                    out[i, k] = j
 
 
 @njit(cache=True)

@@ -75,19 +75,13 @@ _OOD_NOTE = "indicators unlike the training windows"
 #: clearance is not observable in that window (the shipped model's held-out intervals are
 #: 10 µm wide on average, a quarter of its 40 µm range: models/default.metrics.json).
 WHOLE_RANGE_SHARE = 0.9
-#: The recipe's sweep key of each operating indicator (what to sweep to cover a recording).
-REGIME_SWEEP = {
-    "speed_mean": "speed",
-    "load_mean": "load",
-    "load_range": "load_amplitude",
-    "drive_torque_mean": "load",
-}
-#: Words for the operating indicators in warnings.
-REGIME_WORDS = {
-    "speed_mean": "speed",
-    "load_mean": "mean load",
-    "load_range": "load swing",
-    "drive_torque_mean": "mean drive torque (load)",
+#: Each operating indicator a model records the range of: its words in warnings, and the
+#: recipe's sweep key that covers it (what to sweep for a recording outside the range).
+REGIME = {
+    "speed_mean": ("speed", "speed"),
+    "load_mean": ("mean load", "load"),
+    "load_range": ("load swing", "load_amplitude"),
+    "drive_torque_mean": ("mean drive torque (load)", "load"),
 }
 
 
@@ -337,11 +331,11 @@ def _window_gates(
                 # between the trained levels the guard interpolates; beyond them the model
                 # would extrapolate, confidently wrong at worst: it says so and does not tell
                 outside = True
-                word, unit = REGIME_WORDS.get(name, name), FEATURES[name]
+                (word, sweep), unit = REGIME.get(name, (name, name)), FEATURES[name]
                 notes.append(
                     f"recording outside the trained {word} range: {value:.4g} vs {lo:.4g} … "
                     f"{hi:.4g} {unit} — the model does not extrapolate: record within it, or "
-                    f"train on a recipe whose [sweep] {REGIME_SWEEP.get(name, name)} covers "
+                    f"train on a recipe whose [sweep] {sweep} covers "
                     f"{value:.3g} {unit}"
                 )
                 conditions.append(f"a {word} within the trained {lo:.3g} … {hi:.3g} {unit}")

@@ -877,29 +877,32 @@ class DistributionGuard(BaseEstimator):
         from ._kernels import nearest_across
 
         Z = self.reference_
-        pairs = set()
-        for column in self.factors:
+        columns = list(self.factors)
+        for column in columns:
             require(
                 isinstance(column, (int, np.integer)) and 0 <= column < X.shape[1],
                 "factors",
                 column,
                 f"must be column indices below {X.shape[1]}",
             )
-            values = X[:, column].astype(np.float64)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN factor
-                span = float(np.nanmax(values) - np.nanmin(values)) if len(values) else 0.0
-            if not span > 0:
-                continue
-            partner = np.empty(len(Z), np.int64)
-            nearest_across(
-                np.ascontiguousarray(Z, np.float32),
-                np.ascontiguousarray(values),
-                LEVEL_GAP * span,
-                float(self.missing_penalty**2),
-                partner,
-            )
-            pairs |= {(min(i, j), max(i, j)) for i, j in enumerate(partner) if j >= 0}
+        values = X[:, columns].astype(np.float64)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN factor
+            span = np.nanmax(values, axis=0) - np.nanmin(values, axis=0)
+        spread = span > 0  # a factor at one level (or all NaN) has no other level
+        if not spread.any():
+            return np.empty((0, Z.shape[1]), np.float32)
+        partner = np.empty((len(Z), int(spread.sum())), np.int64)
+        nearest_across(
+            np.ascontiguousarray(Z, np.float32),
+            np.ascontiguousarray(values[:, spread]),
+            np.ascontiguousarray(LEVEL_GAP * span[spread]),
+            float(self.missing_penalty**2),
+            partner,
+        )
+        rows, factor = np.nonzero(partner >= 0)
+        mates = partner[rows, factor]
+        pairs = set(zip(np.minimum(rows, mates).tolist(), np.maximum(rows, mates).tolist()))
         if not pairs:
             return np.empty((0, Z.shape[1]), np.float32)
         first, second = (np.array(side) for side in zip(*sorted(pairs)))

@@ -139,7 +139,10 @@ def _diagnose_unit(dataset, unit: pd.DataFrame, bundle, batch: int, commissioned
         commissioning = Commissioning.from_indicators([built.indicators], as_built)
     out = []
     for start in range(0, len(ids), batch):
-        runs = [dataset.run(i, truth=False) for i in ids[start : start + batch]]
+        runs = [
+            first if i == ids[0] else dataset.run(i, truth=False)
+            for i in ids[start : start + batch]
+        ]
         out.extend(diagnose_runs(runs, bundle, commissioning=commissioning))
         if bar is not None:
             bar.update(len(runs))

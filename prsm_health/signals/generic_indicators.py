@@ -16,6 +16,7 @@ lag). No mean of a position or an angle: where the stroke sits says nothing of t
 from __future__ import annotations
 
 import numpy as np
+from scipy.signal import detrend
 
 from prsm_health.core.run import Run
 
@@ -87,9 +88,7 @@ def generic_indicators(run: Run, nut_per_rad: float | None) -> dict[str, float]:
         out["torque_per_load"] = float(np.polyfit(load, torque, 1)[0])
     position, angle = ch.get("nut_position"), ch.get("screw_angle")
     if position is not None and angle is not None and nut_per_rad:
-        error = position - nut_per_rad * angle
-        t = np.arange(len(error))
-        error = error - np.polyval(np.polyfit(t, error, 1), t)  # offset and lead error out
+        error = detrend(position - nut_per_rad * angle)  # offset and lead error out
         low, high = np.percentile(error, [1.0, 99.0])
         out["following_error_std"] = float(np.std(error))
         out["following_error_range"] = float(high - low)
@@ -98,9 +97,7 @@ def generic_indicators(run: Run, nut_per_rad: float | None) -> dict[str, float]:
 
 def _band_shares(channel: str, x: np.ndarray) -> dict[str, float]:
     """Shares of the detrended signal's power in :data:`BANDS` of [0, Nyquist] (periodogram)."""
-    t = np.arange(len(x))
-    detrended = x - np.polyval(np.polyfit(t, x, 1), t)
-    power = np.abs(np.fft.rfft(detrended)) ** 2
+    power = np.abs(np.fft.rfft(detrend(x))) ** 2
     share = np.arange(len(power)) / max(len(power) - 1, 1)  # frequency as a share of Nyquist
     total = float(np.sum(power[1:]))
     out = {}
