@@ -74,6 +74,14 @@ class Dataset:
         """The measured channels the dataset's runs have, in contract order."""
         return tuple(c for c in CHANNEL_NAMES if c in self.manifest["channels"])
 
+    @property
+    def indicator_groups(self) -> dict[str, str]:
+        """Each indicator group → ``"usable"`` with this dataset's channels and sample rate, or
+        why not (:func:`~prsm_health.signals.features.usable_groups`)."""
+        from prsm_health.signals.features import usable_groups
+
+        return usable_groups(self.channels, self.sample_rate)
+
     def __len__(self) -> int:
         return len(self.runs)
 

@@ -95,6 +95,9 @@ class ModelBundle:
     metadata: dict
     guard: object | None = None
     check: dict | None = None
+    #: The indicators the fault classifier reads, when not ``feature_names`` (a shipped plain
+    #: baseline reads the channel statistics: training.fault_candidates).
+    fault_features: list[str] | None = None
     design: PRSMDesign | None = field(init=False)
 
     def __post_init__(self):
@@ -220,6 +223,7 @@ def load_bundle(
         metadata,
         model.get("guard"),
         check,
+        model.get("fault_features"),
     )
 
 
@@ -256,19 +260,25 @@ def _threadpools():
 
 
 def diagnose_indicators(
-    rows: list[dict], bundle: ModelBundle, channels: list | None = None, design: str | None = None
+    rows: list[dict],
+    bundle: ModelBundle,
+    channels: list | None = None,
+    design: str | None = None,
+    rates: list | None = None,
 ) -> list[Diagnosis]:
     """One :class:`Diagnosis` per row of indicators (one row per window).
 
     ``channels``: the measured channels of each row's window (default: the model's, i.e. none
-    missing); ``design``: the recording's design name, if it has one.
+    missing); ``design``: the recording's design name, if it has one; ``rates``: each
+    window's sample rate [Hz] (default unknown), for the groups a rate leaves out.
     """
     x = _matrix(rows, bundle.feature_names)
     channels = channels or [bundle.channels or ()] * len(rows)
+    rates = rates or [None] * len(rows)
     # A few rows per call: OpenMP threads in the boosted trees only add spin-wait latency, and
     # under load (the service, parallel replays) oversubscribe the cores.
     with _threadpools().limit(limits=1, user_api="openmp"):
-        return _predict(rows, x, bundle, channels, design)
+        return _predict(rows, x, bundle, channels, design, rates)
 
 
 def _window_gates(
@@ -411,7 +421,7 @@ def ood_verdict(diagnosis: Diagnosis) -> str:
     return text
 
 
-def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
+def _predict(rows, x, bundle: ModelBundle, channels, design, rates) -> list[Diagnosis]:
     n = len(rows)
     estimate = lower = upper = share = np.full(n, np.nan)
     guard = bundle.guard
@@ -439,7 +449,8 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
     classes, proba = [], np.zeros((n, 0))
     if bundle.fault is not None:
         classes = [str(c) for c in bundle.fault.classes_]
-        proba = np.asarray(bundle.fault.predict_proba(x), float)
+        reads = x if bundle.fault_features is None else _matrix(rows, bundle.fault_features)
+        proba = np.asarray(bundle.fault.predict_proba(reads), float)
     model = bundle.model_reference()
     out = []
     for i, row in enumerate(rows):
@@ -461,7 +472,7 @@ def _predict(rows, x, bundle: ModelBundle, channels, design) -> list[Diagnosis]:
                 warnings=notes,
                 observability=Observability(clearance_ok, fault_ok),
                 ood_score=finite_or_none(ood[i]),
-                indicator_groups=indicator_groups(row, channels[i]),
+                indicator_groups=indicator_groups(row, channels[i], rates[i]),
                 undecided=_undecided(fault_class, class_set, fault_ok, conditions, bundle),
             )
         )
@@ -547,7 +558,9 @@ def _median_indicators(diagnoses: list[Diagnosis], names: list[str]) -> dict:
 def diagnose_window(run: Run, bundle: ModelBundle) -> Diagnosis:
     """Diagnosis of one window (a :class:`Run` of about the model's window length)."""
     row = bundle.indicators(run)
-    return diagnose_indicators([row], bundle, [tuple(run.channels)], run.operating.design)[0]
+    return diagnose_indicators(
+        [row], bundle, [tuple(run.channels)], run.operating.design, [run.sample_rate]
+    )[0]
 
 
 def split_windows(run: Run, length: float) -> tuple[list[Run], list[str]]:
@@ -676,11 +689,16 @@ def _diagnose_windowed(runs, bundle, *, window, split) -> list[Diagnosis]:
     rows = bundle.indicators_batch([part for parts, _ in split for part in parts])
     channels = [tuple(run.channels) for run, (parts, _) in zip(runs, split) for _ in parts]
     designs = [run.operating.design for run, (parts, _) in zip(runs, split) for _ in parts]
+    rates = [run.sample_rate for run, (parts, _) in zip(runs, split) for _ in parts]
     per_window = []
     for design in dict.fromkeys(designs):  # one call per design (usually one)
         at = [i for i, d in enumerate(designs) if d == design]
         found = diagnose_indicators(
-            [rows[i] for i in at], bundle, [channels[i] for i in at], design
+            [rows[i] for i in at],
+            bundle,
+            [channels[i] for i in at],
+            design,
+            [rates[i] for i in at],
         )
         per_window.extend(zip(at, found))
     per_window = [d for _, d in sorted(per_window, key=lambda pair: pair[0])]

@@ -49,6 +49,7 @@ from prsm_health.core.operating_point import NO_DESIGN
 from prsm_health.core.run import Run
 from prsm_health.physics.kinematics import defect_frequencies, speed_ratios
 
+from .channel_statistics import CHANNEL_STATISTICS, channel_statistics
 from .envelope_analysis import defect_lines_batch
 from .gear_indicators import GEAR_INDICATORS, synchronous_averages, tsa_indicators
 from .generic_indicators import GENERIC, NEEDS_ANY, generic_indicators
@@ -83,6 +84,15 @@ DEFECTS = (
     "carrier",
 )
 ORDER_TRACKING_SPREAD = 0.05
+#: Share of the sample rate up to which a spectral line or mode is searched: below the
+#: anti-alias filter's roll-off (a logger's decimation passes 0.4–0.45 × its rate).
+SEARCH_SHARE = 0.45
+#: Where the nut's dominant axial mode is searched [Hz] (paper 01's axial mode of a healthy
+#: nut lies inside it for the shipped designs' loads).
+AXIAL_SEARCH = (100.0, 2000.0)
+#: Frequency of the nut's bounces across a reversal that the torque rattle counts [Hz]: about
+#: 200 Hz in the simulated reversals (measured 2026-12-02 on the import round trip's rig).
+RATTLE_BOUNCE = 200.0
 #: Most windows processed together by :func:`extract_features_batch` (memory: the
 #: mean-removed vibration of a window of 20,000 samples takes 0.64 MB).
 BATCH_WINDOWS = 16
@@ -139,6 +149,7 @@ def _feature_table() -> dict[str, str]:
         }
     )
     units.update(GENERIC)  # any recording's (signals.generic_indicators)
+    units.update(CHANNEL_STATISTICS)  # the plain baseline's inputs, not a model's indicators
     return units
 
 
@@ -165,21 +176,30 @@ GROUPS = {
     ],
     "gear": [k for k in FEATURES if "_tsa_" in k],
     "envelope": [k for k in FEATURES if "_env_" in k or "_sk_" in k],
-    "torque": [k for k in FEATURES if "torque" in k and k not in GENERIC] + ["efficiency"],
+    "torque": [
+        k for k in FEATURES if "torque" in k and k not in GENERIC and k not in CHANNEL_STATISTICS
+    ]
+    + ["efficiency"],
     "lost_motion": ["lost_motion"],
     "torque_rattle": ["torque_rattle_rate"],
     "operating": ["speed_mean", "load_mean", "load_range", "reversal", "housing_temperature_mean"],
     "generic": list(GENERIC),
+    "statistics": list(CHANNEL_STATISTICS),
 }
+#: Groups that are not condition indicators: the indicator models leave them out (the plain
+#: baseline reads ``statistics`` alone).
+NOT_INDICATORS = ("statistics",)
 
 
 @dataclass(frozen=True)
 class Needs:
-    """The measured channels an indicator group reads: all of ``all_of`` and, when ``any_of``
-    is not empty, at least one of it."""
+    """What an indicator group reads: the measured channels (all of ``all_of`` and, when
+    ``any_of`` is not empty, at least one of it) and the sample rate ``min_rate`` [Hz] below
+    which what it measures is out of the recording's band (its indicators are then NaN)."""
 
     all_of: tuple[str, ...] = ()
     any_of: tuple[str, ...] = ()
+    min_rate: float = 0.0
 
     def missing(self, channels) -> list[str]:
         """What a set of channels lacks for this group (``a or b`` for an any-of set)."""
@@ -188,33 +208,61 @@ class Needs:
             out.append(" or ".join(self.any_of))
         return out
 
+    def too_slow(self, rate: float | None) -> str:
+        """Why a sample rate [Hz] is too low for this group ("" when it is not, or unknown)."""
+        if rate is None or not rate < self.min_rate:
+            return ""
+        return f"sample rate {rate:g} Hz below the {self.min_rate:g} Hz it needs"
 
-#: The channels each indicator group needs: declared once. A window without them has the
-#: group's indicators NaN; a diagnosis names the groups it could not compute and why.
+
+#: The channels and rate each indicator group needs: declared once. A window without them has
+#: the group's indicators NaN; a dataset lists the groups it can use
+#: (:func:`usable_groups`); a diagnosis names the groups it could not compute and why.
 GROUP_CHANNELS: dict[str, Needs] = {
     "mesh": Needs(("screw_speed",), MESH_CHANNELS),
-    "axial_frequency": Needs(("nut_axial_accel",)),
+    # the search band's top within the recording's band
+    "axial_frequency": Needs(("nut_axial_accel",), min_rate=AXIAL_SEARCH[1] / SEARCH_SHARE),
     "classic": Needs(any_of=VIBRATION),
     "gear": Needs(("screw_angle",), TSA_CHANNELS),
     "envelope": Needs(("screw_speed",), ENVELOPE_CHANNELS),
     "torque": Needs(("drive_torque",)),
     "lost_motion": Needs(("nut_position", "screw_angle")),
-    "torque_rattle": Needs(("drive_torque",)),
+    # the bounces it counts within the recording's band
+    "torque_rattle": Needs(("drive_torque",), min_rate=RATTLE_BOUNCE / SEARCH_SHARE),
     "operating": Needs(any_of=("screw_speed", "axial_load", "drive_torque", "housing_temperature")),
     "generic": Needs(any_of=NEEDS_ANY),
+    "statistics": Needs(any_of=CHANNEL_NAMES),
 }
 
 
-def indicator_groups(row: dict, channels) -> dict[str, str]:
+def usable_groups(channels, rate: float | None) -> dict[str, str]:
+    """Each indicator group → ``"usable"`` for recordings of these measured channels at this
+    sample rate [Hz], or why not (the channels it lacks, the rate it needs): what a dataset
+    can train on, before any indicator is computed (a usable group may still be NaN in a
+    window that does not support it, e.g. lost motion without a reversal)."""
+    out = {}
+    for group, needs in GROUP_CHANNELS.items():
+        if missing := needs.missing(channels):
+            out[group] = "missing channel(s) " + ", ".join(missing)
+        else:
+            out[group] = needs.too_slow(rate) or "usable"
+    return out
+
+
+def indicator_groups(row: dict, channels, rate: float | None = None) -> dict[str, str]:
     """Each indicator group of a window's indicators → ``"computed"`` (at least one finite
-    value), or why not: the channels it lacks, or that the window does not support it."""
+    value), or why not: the channels it lacks, the sample rate it needs, or that the window
+    does not support it."""
     out = {}
     for group, members in GROUPS.items():
         values = [row.get(name) for name in members]
+        needs = GROUP_CHANNELS[group]
         if any(v is not None and math.isfinite(v) for v in values):
             out[group] = "computed"
-        elif missing := GROUP_CHANNELS[group].missing(channels):
+        elif missing := needs.missing(channels):
             out[group] = "missing channel(s) " + ", ".join(missing)
+        elif slow := needs.too_slow(rate):
+            out[group] = slow
         else:
             out[group] = "not supported by this window (e.g. no reversal, too slow or too short)"
     return out
@@ -496,6 +544,12 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
     for run, row in zip(runs, rows):
         _torque_and_reversals(run, nut_per_rad, row)
         row.update(generic_indicators(run, nut_per_rad))
+        row.update(channel_statistics(run))
+    # what a group measures lies above the recording's band: not a value, NaN
+    for group, needs in GROUP_CHANNELS.items():
+        if needs.too_slow(rate):
+            for row in rows:
+                row.update(dict.fromkeys(GROUPS[group], np.nan))
     return rows
 
 
@@ -579,7 +633,7 @@ def _axial(centred: np.ndarray, rate: float, design, rows, welch: tuple) -> None
     nperseg = min(512, centred.shape[-1])
     f, psds = welch_psd(centred, rate, nperseg, 3 * nperseg // 4)
     for psd, out in zip(psds, rows):
-        f_dom = peak_frequency(f, psd, (100.0, min(2000.0, 0.45 * rate)))
+        f_dom = peak_frequency(f, psd, (AXIAL_SEARCH[0], min(AXIAL_SEARCH[1], SEARCH_SHARE * rate)))
         out["axial_dominant_frequency"] = f_dom
         band = (f > 0.9 * f_dom) & (f < 1.1 * f_dom)
         out["axial_dominant_amplitude"] = (

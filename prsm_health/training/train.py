@@ -15,6 +15,7 @@ is no better than a constant answer is reported in ``metrics["warnings"]``.
 from __future__ import annotations
 
 import contextlib
+import copy
 import functools
 import json
 import math
@@ -26,10 +27,15 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError, require
 from prsm_health.core.jsonable import dumps
-from prsm_health.signals.channel_statistics import dataset_statistics
-from prsm_health.signals.features import FEATURES, GROUPS, dataset_features
+from prsm_health.signals.features import (
+    FEATURES,
+    GROUPS,
+    NOT_INDICATORS,
+    dataset_features,
+    usable_groups,
+)
 
-from .plain_baseline import baseline_verdict, plain_baseline_cv
+from .fault_candidates import BY_NAME, choose, cross_validate_candidates, make_classifier
 
 #: The operating indicators the out-of-distribution guard interpolates between (continuous
 #: factors a dataset may sweep on a grid; ``reversal`` is a yes/no, not a level).
@@ -529,7 +535,6 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     from prsm_health.diagnostics.estimators import (
         ClearanceEstimator,
         DistributionGuard,
-        FaultClassifier,
     )
     from prsm_health.diagnostics.model_files import save_model
 
@@ -547,10 +552,15 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     if problems:
         raise PRSMHealthError(f"{dataset_dir}: cannot train: " + "; ".join(problems))
     table = dataset_features(ds, progress=progress)
-    # Indicators the dataset's instrumentation cannot give (all NaN: a channel it does not fit)
-    # carry no information and are left out of the model; diagnose() needs only the rest.
-    features = [name for name in FEATURES if table[name].notna().any()]
-    absent = [name for name in FEATURES if name not in features]
+    # Indicators the dataset's instrumentation cannot give (all NaN: a channel it does not fit,
+    # a rate too low for the group) carry no information and are left out of the model;
+    # diagnose() needs only the rest. The channel statistics are no indicators: the plain
+    # baseline's alone.
+    not_indicators = {name for group in NOT_INDICATORS for name in GROUPS[group]}
+    finite = [name for name in FEATURES if table[name].notna().any()]
+    features = [name for name in finite if name not in not_indicators]
+    statistics = [name for name in finite if name in not_indicators]
+    absent = [name for name in FEATURES if name not in finite]
     present_groups = {
         group: kept
         for group, members in GROUPS.items()
@@ -575,6 +585,8 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         "recipe": ds.manifest["name"],
         "runs": {"train": len(train_rows), "test": len(test_rows)},
         "indicators_absent": absent,
+        # what the dataset's channels and rate let each indicator group read
+        "indicator_groups": usable_groups(ds.channels, ds.sample_rate),
     }
     bundle: dict = {"feature_names": features, "clearance": None, "fault": None}
     # How far a window's indicators lie from the training windows (diagnosis: OOD score),
@@ -628,21 +640,25 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
 
     if target in ("fault", "both"):
         labels = train_rows["fault_class"].astype(str).to_numpy()
-
-        def make_classifier():
-            return FaultClassifier(**FAULT_PARAMS, random_state=random_state)
-
+        inputs = {"indicators": x_train, "statistics": train_rows[statistics]}
         with _collect_warnings("fault CV", notes), sparse():
-            metrics["fault_cv"] = _classifier_alone(
-                cross_validated_metrics(make_classifier, x_train, labels, groups=groups, cv=cv)
+            candidates = cross_validate_candidates(
+                inputs, labels, groups, cv, FAULT_PARAMS, random_state
             )
-        with _collect_warnings("plain baseline CV", notes):
-            stats = dataset_statistics(ds, train_rows["run_id"])
-            baseline = plain_baseline_cv(stats, labels, groups, cv, random_state)
-        metrics["fault_plain_baseline_cv"] = baseline
-        notes += baseline_verdict(metrics["fault_cv"]["macro_f1_classifier"], baseline)
+        chosen, said = choose(candidates)
+        candidate = BY_NAME[chosen]
+        metrics["fault_candidates"] = candidates
+        metrics["fault_model"] = {"candidate": chosen, "description": candidate.description}
+        metrics["fault_cv"] = _classifier_alone(copy.deepcopy(candidates[chosen]))
+        if "plain_baseline" in candidates:  # the same folds, plain statistics
+            metrics["fault_plain_baseline_cv"] = candidates["plain_baseline"]
+        notes += said
+        reads = statistics if candidate.reads == "statistics" else features
+        if candidate.reads == "statistics":
+            bundle["fault_features"] = statistics
         with _collect_warnings("fault model", notes), sparse():
-            classifier = make_classifier().fit(x_train, labels)
+            classifier = make_classifier(candidate, FAULT_PARAMS, random_state)
+            classifier.fit(train_rows[reads], labels)
         bundle["fault"] = classifier
         notes += fault_warnings(
             "cross-validated",
@@ -652,15 +668,15 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         )
         y_test = test_rows["fault_class"].astype(str).to_numpy()
         with _collect_warnings("fault held-out", notes):
-            metrics["fault_test"] = _class_metrics(classifier, x_test, y_test)
+            metrics["fault_test"] = _class_metrics(classifier, test_rows[reads], y_test)
             if len(y_test):
                 importance = permutation_importance_table(
                     classifier,
-                    x_test,
+                    test_rows[reads],
                     y_test,
                     n_repeats=5,
                     random_state=random_state,
-                    groups=present_groups,
+                    groups=present_groups if candidate.reads == "indicators" else None,
                 )
                 metrics["fault_importance"] = _importance_records(importance)
         notes += fault_warnings(

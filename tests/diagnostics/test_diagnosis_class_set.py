@@ -76,3 +76,21 @@ def test_recording_states_the_set_once_for_its_mean_probabilities(bundle):
     assert sum("not ruled out at" in w for w in whole.warnings) == 1
     worn = aggregate(diagnose_indicators(_rows(x[y == "wear"][:5]), bundle), bundle)
     assert worn.fault_class == "wear" and worn.class_set == ["wear"]
+
+
+def test_a_shipped_plain_baseline_reads_its_own_columns_through_the_same_diagnosis():
+    # train ships the plain baseline (a forest on channel statistics) when it cross-validates
+    # best: the bundle names the columns it reads, the rest of the diagnosis is unchanged
+    rng = np.random.default_rng(5)
+    torque = np.r_[rng.normal(0.2, 0.01, 60), rng.normal(0.4, 0.01, 60)]
+    labels = np.array(["healthy"] * 60 + ["lubrication"] * 60)
+    fault = FaultClassifier(learner="forest", calibration_cv=3).fit(
+        pd.DataFrame({"stat_drive_torque_mean": torque}), labels
+    )
+    bundle = ModelBundle(
+        None, fault, ["lost_motion"], {"design": None}, fault_features=["stat_drive_torque_mean"]
+    )
+    rows = [{"lost_motion": 1e-5, "reversal": 1.0, "stat_drive_torque_mean": t} for t in (0.2, 0.4)]
+    healthy, lubrication = diagnose_indicators(rows, bundle)
+    assert healthy.fault_class == "healthy" and lubrication.fault_class == "lubrication"
+    assert lubrication.indicators["stat_drive_torque_mean"] == 0.4

@@ -704,3 +704,20 @@ def test_guard_interpolates_between_the_levels_of_an_operating_factor():
     # windows like the training ones score as before or lower (more rows to be near)
     same = windows(80.0, 100)
     assert np.all(between.score(same) <= plain.score(same) + 1e-12)
+
+
+def test_forest_learner_classifies_with_nan_round_trips_and_refuses_an_unknown_learner(tmp_path):
+    X, y = make_fault_data(400, seed=3)
+    X_test, y_test = make_fault_data(300, seed=4)
+    clf = FaultClassifier(learner="forest", calibration_cv=3).fit(X, y)
+    proba = clf.predict_proba(X_test)
+    npt.assert_allclose(proba.sum(axis=1), 1.0, rtol=0, atol=1e-12)
+    # the same data as the boosted test above (Bayes accuracy ≈ 0.98, some f2 missing): a
+    # forest of 100 trees on 400 samples is a few points below the booster on 1200
+    assert np.mean(clf.predict(X_test) == y_test) >= 0.85
+    assert clf.predict_set(X_test).any(axis=1).all() and clf.n_iter_ > 0
+    save_model(tmp_path / "forest.skops", {"fault": clf}, metadata={})
+    loaded, _ = load_model(tmp_path / "forest.skops")
+    npt.assert_array_equal(loaded["fault"].predict_proba(X_test), proba)
+    with pytest.raises(ParameterError, match="learner"):
+        FaultClassifier(learner="svm").fit(X, y)

@@ -300,3 +300,61 @@ def test_efficiency_from_the_energy_balance_survives_a_reversing_load():
     p = steady.channels["axial_load"] * np.gradient(steady.channels["nut_position"], steady.time)
     steady.channels["drive_torque"] = p / eta / steady.channels["screw_speed"]
     assert extract_features(steady)["efficiency"] == pytest.approx(eta, rel=1e-9)
+
+
+def _reversing_drive(rate: float, seconds: float = 4.0) -> Run:
+    """Slow drive channels at ``rate``: speed reversing at 0.5 Hz, a torque that rattles."""
+    t = np.arange(int(seconds * rate)) / rate
+    speed = 20.0 * np.sin(2 * math.pi * 0.5 * t)
+    angle = np.cumsum(speed) / rate
+    torque = 0.2 * np.sign(speed) + 0.05 * np.sin(2 * math.pi * 180.0 * t)
+    ch = {
+        "screw_angle": angle,
+        "screw_speed": speed,
+        "nut_position": speed_ratios(D).nut * angle,
+        "nut_axial_accel": 0.3 * np.sin(2 * math.pi * 437.3 * t),
+        "drive_torque": torque,
+    }
+    return Run(t, ch, rate, operating=OperatingPoint(design="paper01"))
+
+
+def test_a_group_whose_band_lies_above_the_recording_is_nan_and_says_the_rate_it_needs():
+    from prsm_health.signals.features import GROUP_CHANNELS, indicator_groups, usable_groups
+
+    rattle = GROUP_CHANNELS["torque_rattle"].min_rate
+    axial = GROUP_CHANNELS["axial_frequency"].min_rate
+    assert 0 < rattle < 1000.0 < axial  # a 1 kHz logger resolves the bounces, not the mode
+    for rate, rattle_read, axial_read in ((250.0, False, False), (2000.0, True, False)):
+        run = _reversing_drive(rate)
+        row = extract_features(run)
+        assert math.isfinite(row["torque_rattle_rate"]) == rattle_read, rate
+        assert math.isfinite(row["axial_dominant_frequency"]) == axial_read, rate
+        said = indicator_groups(row, run.channels, rate)
+        assert said["axial_frequency"] == f"sample rate {rate:g} Hz below the {axial:g} Hz it needs"
+        assert (said["torque_rattle"] == "computed") == rattle_read
+        usable = usable_groups(run.channels, rate)
+        assert usable["axial_frequency"] == said["axial_frequency"]
+        assert usable["generic"] == usable["statistics"] == "usable"
+        assert usable["mesh"].startswith("missing channel(s) ")
+    # the same signals at 20 kHz read both
+    row = extract_features(_reversing_drive(RATE, 2.5))
+    assert math.isfinite(row["torque_rattle_rate"])
+    assert math.isfinite(row["axial_dominant_frequency"])
+
+
+def test_channel_statistics_are_every_channels_and_no_model_indicator():
+    from prsm_health.signals.channel_statistics import CHANNEL_STATISTICS
+    from prsm_health.signals.features import GROUPS, NOT_INDICATORS
+
+    r, _ = synthetic()
+    row = extract_features(r)
+    assert row["stat_drive_torque_mean"] == pytest.approx(0.2)
+    assert row["stat_axial_load_max"] == pytest.approx(100.0)
+    assert row["stat_nut_axial_accel_std"] == pytest.approx(0.3 / math.sqrt(2), rel=1e-3)
+    assert GROUPS["statistics"] == list(CHANNEL_STATISTICS) and "statistics" in NOT_INDICATORS
+    # a statistic belongs to no indicator group (the torque group's drive_torque_mean is not
+    # stat_drive_torque_mean)
+    others = {n for g, members in GROUPS.items() if g != "statistics" for n in members}
+    assert not others & set(CHANNEL_STATISTICS)
+    without = Run(r.time, {"drive_torque": r.channels["drive_torque"]}, RATE, operating=r.operating)
+    assert math.isnan(extract_features(without)["stat_axial_load_mean"])

@@ -171,13 +171,6 @@ def test_cli_train_too_small_is_one_error_line(tiny, tmp_path, capsys):
 # ------------------------------------------------------------------------------------------
 
 
-@pytest.mark.slow
-def _constant_statistics(dataset, run_ids):
-    """Per-channel statistics of runs that have no samples here (the runs table alone): one
-    constant column, as a rig channel that never moves."""
-    return pd.DataFrame({"drive_torque_mean": np.zeros(len(list(run_ids)))})
-
-
 def test_useless_model_is_reported_not_dressed_up(tiny, tmp_path, monkeypatch):
     # The tiny dataset's manifest, a larger runs table, and indicators that are all constant:
     # the models can learn nothing, so they answer one value and one class.
@@ -193,7 +186,6 @@ def test_useless_model_is_reported_not_dressed_up(tiny, tmp_path, monkeypatch):
         )
 
     monkeypatch.setattr(training, "dataset_features", constant_features)
-    monkeypatch.setattr(training, "dataset_statistics", _constant_statistics)
     # constant indicators give trees without splits: a few iterations show the same thing
     monkeypatch.setitem(training.CLEARANCE_PARAMS, "max_iter", 5)
     monkeypatch.setitem(training.FAULT_PARAMS, "max_iter", 5)
@@ -324,7 +316,6 @@ def test_fault_labels_alone_train_a_fault_model(tiny, tmp_path, monkeypatch):
     table = fault_only(labels_table(24, 8, classes=["healthy", "wear"] * 16))
     ds_dir = _dataset(tiny, tmp_path / "faults", table)
     monkeypatch.setattr(training, "dataset_features", _features_of(table, "lost_motion", 24))
-    monkeypatch.setattr(training, "dataset_statistics", _constant_statistics)
     monkeypatch.setitem(training.FAULT_PARAMS, "max_iter", 3)
     metrics = train(ds_dir, tmp_path / "m.skops", target="fault", cv=2, progress=False)
     assert metrics["fault_plain_baseline_cv"]["n_splits"] == metrics["fault_cv"]["n_splits"]
@@ -354,13 +345,19 @@ def test_a_too_sparse_indicator_is_one_line_never_a_traceback(tiny, tmp_path, mo
         assert (tmp_path / "m.skops").exists()
 
 
-def test_the_plain_baseline_is_named_only_when_it_wins_by_more_than_a_folds_scatter():
-    from prsm_health.training.plain_baseline import MARGIN, baseline_verdict
+def test_the_best_cross_validated_candidate_is_shipped_and_a_winning_baseline_is_said():
+    from prsm_health.training.fault_candidates import choose
 
-    said = baseline_verdict(0.80, {"macro_f1": 0.91})
-    assert len(said) == 1
-    line = said[0]
-    assert "0.91" in line and "0.80" in line and "not shipped" in line
-    assert baseline_verdict(0.80, {"macro_f1": 0.80 + MARGIN / 2}) == []  # noise, not a loss
-    assert baseline_verdict(0.90, {"macro_f1": 0.85}) == []
-    assert baseline_verdict(0.90, {}) == []
+    def scores(boosting, forest, plain):
+        return {
+            "boosting": {"macro_f1": boosting},
+            "forest": {"macro_f1": forest},
+            "plain_baseline": {"macro_f1": plain},
+        }
+
+    assert choose(scores(0.80, 0.90, 0.85)) == ("forest", [])
+    assert choose(scores(0.90, 0.90, 0.90)) == ("boosting", [])  # a tie: the earlier
+    shipped, said = choose(scores(0.70, 0.80, 0.91))
+    assert shipped == "plain_baseline" and len(said) == 1
+    assert "0.91" in said[0] and "0.80" in said[0] and "shipped" in said[0]
+    assert choose({"plain_baseline": {"macro_f1": 0.5}})[0] == "plain_baseline"

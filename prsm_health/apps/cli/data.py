@@ -68,6 +68,15 @@ def import_recordings(args) -> int:
             ("channels", ", ".join(summary["channels"]), ""),
             ("sample rate", summary["sample_rate"], "Hz"),
             ("classes", ", ".join(summary["classes"]) or "–", ""),
+            *group_rows(summary["indicator_groups"]),
         ]
     )
     return 0
+
+
+def group_rows(groups: dict[str, str]) -> list:
+    """Table rows of the indicator groups a dataset can use, and why the others not."""
+    usable = [g for g, why in groups.items() if why == "usable"]
+    rows = [("indicator groups usable", ", ".join(usable) or "–", "")]
+    rows += [(f"  not {g}", why, "") for g, why in groups.items() if why != "usable"]
+    return rows

@@ -139,8 +139,10 @@ def training_rows(metrics: dict) -> list:
             rows.append(
                 (f"{label} {F1_CLASSIFIER}", scaled(metrics[key].get("macro_f1_classifier")), "")
             )
-    if baseline := metrics.get("fault_plain_baseline_cv"):  # the same folds, plain statistics
-        rows.append(("fault CV plain baseline macro-F1", scaled(baseline.get("macro_f1")), ""))
+    shipped = (metrics.get("fault_model") or {}).get("candidate")
+    for name, cv in (metrics.get("fault_candidates") or {}).items():  # the same folds each
+        label = f"fault CV macro-F1, {cv['model']}"
+        rows.append((label, scaled(cv.get("macro_f1")), "shipped" if name == shipped else ""))
     return rows
 
 
