@@ -17,13 +17,12 @@ import numpy as np
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 from prsm_health.diagnostics.check_verdicts import CLEARANCE_ROLE, check_verdicts
+from prsm_health.diagnostics.not_observable import not_observable_text
 from prsm_health.physics.kinematics import speed_ratios
 from prsm_health.signals.check_averages import high_load_averages
 from prsm_health.signals.check_indicators import CENTROID_BAND, CENTROID_SEGMENT, SNR_PERIODS
 from prsm_health.signals.features import run_design
 from prsm_health.signals.spectra import welch_psd
-
-from .not_observable import not_observable_text
 
 #: What each role's panel is called.
 ROLE_TITLES = {
@@ -47,7 +46,7 @@ def panel_title(verdict: dict, diagnosis: dict | None = None) -> str:
     """``<role>: phase '<name>' — read`` (or ``not read`` and why), and on a second line the
     targets the phase shows: the clearance interval (the reversal) and its classes'
     probabilities — "not observable" instead where ``diagnosis`` (its JSON) says the model
-    could not see them (:mod:`prsm_health.apps.not_observable`)."""
+    could not see them (:mod:`prsm_health.diagnostics.not_observable`)."""
     head = ROLE_TITLES[verdict["role"]]
     if verdict["phase"] is None:
         return f"{head}: not read — the check has no {verdict['condition']}"

@@ -88,14 +88,19 @@ def window_diagnoser(bundle) -> Diagnose:
     """Window → its Diagnosis JSON object by a model ``bundle``
     (:func:`~prsm_health.diagnostics.diagnosis.load_bundle`): the window's measured channels
     diagnosed as a run (:func:`~prsm_health.diagnostics.diagnosis.diagnose_window`), the object
-    ``replay --out`` writes on ``/prsm/diagnosis``. Truth signals are never an input."""
+    ``replay --out`` writes on ``/prsm/diagnosis`` (the contract's JSON and what a plot may
+    draw of it, :func:`~prsm_health.diagnostics.not_observable.diagnosis_message`). Truth
+    signals are never an input."""
     # Imported here: playing without a model does not load the estimators.
     from prsm_health.diagnostics.diagnosis import diagnose_window
+    from prsm_health.diagnostics.not_observable import diagnosis_message
 
     def diagnose(w: Window) -> dict:
-        return diagnose_window(
-            Run(w.time, w.channels, w.sample_rate, w.labels, operating=w.operating), bundle
-        ).to_json()
+        return diagnosis_message(
+            diagnose_window(
+                Run(w.time, w.channels, w.sample_rate, w.labels, operating=w.operating), bundle
+            ).to_json()
+        )
 
     return diagnose
 

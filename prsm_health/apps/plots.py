@@ -146,7 +146,7 @@ def plot_diagnosis(result, path: str | Path) -> Path:
 
     Each window is drawn over its own span (start to end), the last one included; the
     recording's overall estimate and interval are the dashed line and the band behind them.
-    Where a target is not observable (:mod:`prsm_health.apps.not_observable`) its numbers are
+    Where a target is not observable (:mod:`prsm_health.diagnostics.not_observable`) its numbers are
     no reading: the clearance estimate is a hollow grey marker in a hatched grey interval, the
     class probabilities are left out (a grey span), each labelled "not observable".
 
@@ -177,7 +177,11 @@ def diagnosis_figure(result):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .not_observable import NOT_OBSERVABLE, not_observable_text, observable
+    from prsm_health.diagnostics.not_observable import (
+        NOT_OBSERVABLE,
+        not_observable_text,
+        observable,
+    )
 
     def um(value):
         return np.nan if value is None else 1e6 * value

@@ -50,7 +50,7 @@ from prsm_health.core.run import MIN_SAMPLES, Run
 from prsm_health.io import ColumnMap, load_column_map, read_with_warnings
 from prsm_health.io.column_map import MIN_RATE as COLUMN_MAP_MIN_RATE
 from prsm_health.io.columns import run_columns, units_schema
-from prsm_health.signals.features import usable_groups
+from prsm_health.signals.indicator_table import usable_groups
 
 #: Lowest sample rate an import accepts [Hz] (a map's ``sample_rate`` is held to it too).
 MIN_RATE = COLUMN_MAP_MIN_RATE

@@ -77,8 +77,8 @@ class Dataset:
     @property
     def indicator_groups(self) -> dict[str, str]:
         """Each indicator group → ``"usable"`` with this dataset's channels and sample rate, or
-        why not (:func:`~prsm_health.signals.features.usable_groups`)."""
-        from prsm_health.signals.features import usable_groups
+        why not (:func:`~prsm_health.signals.indicator_table.usable_groups`)."""
+        from prsm_health.signals.indicator_table import usable_groups
 
         return usable_groups(self.channels, self.sample_rate)
 

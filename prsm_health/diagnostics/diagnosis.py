@@ -46,11 +46,8 @@ from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.jsonable import finite_or_none
 from prsm_health.core.operating_point import NO_DESIGN, OperatingPoint
 from prsm_health.core.run import Run
-from prsm_health.signals.features import (
-    FEATURES,
-    extract_features_batch,
-    indicator_groups,
-)
+from prsm_health.signals.features import FEATURES, extract_features_batch
+from prsm_health.signals.indicator_table import indicator_groups
 
 from .answer import NAME_PROBABILITY, SET_NOTE, ambiguous, fault_answer, not_observable  # noqa: F401 (NAME_PROBABILITY: public here)
 from .contract import (  # OOD_LIMIT: public here too, where it was defined before
@@ -758,6 +755,8 @@ def replay(
     """
     from prsm_health.io.mcap import DiagnosisWriter, iter_windows, window_statistics
 
+    from .not_observable import diagnosis_message
+
     length = window or (bundle.window if bundle else 1.0)
     writer = DiagnosisWriter(path, out) if (out and bundle) else None
     stream = iter_windows(path, length, rate=rate, topics=MEASURED_TOPICS)
@@ -770,7 +769,7 @@ def replay(
                     bundle,
                 )
                 if writer is not None:
-                    writer.add(w.end_ns, step.diagnosis.to_json())
+                    writer.add(w.end_ns, diagnosis_message(step.diagnosis.to_json()))
             else:
                 step.statistics = window_statistics(w)
             yield step

@@ -611,6 +611,11 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         tags.input_tags.allow_nan = True
         return tags
 
+    def __setstate__(self, state):
+        # a model saved before the forest learner existed learnt with the booster
+        state.setdefault("learner", "boosting")
+        super().__setstate__(state)
+
     def _check_params(self) -> None:
         require_range("set_coverage", self.set_coverage, 0.0, 1.0, inclusive=False)
         require(

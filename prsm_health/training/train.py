@@ -27,13 +27,8 @@ import numpy as np
 
 from prsm_health.core.errors import PRSMHealthError, require
 from prsm_health.core.jsonable import dumps
-from prsm_health.signals.features import (
-    FEATURES,
-    GROUPS,
-    NOT_INDICATORS,
-    dataset_features,
-    usable_groups,
-)
+from prsm_health.signals.features import FEATURES, GROUPS, dataset_features
+from prsm_health.signals.indicator_table import NOT_INDICATORS, usable_groups
 
 from .fault_candidates import BY_NAME, choose, cross_validate_candidates, make_classifier
 

@@ -44,6 +44,7 @@ from prsm_health.core.channels import TOPIC_DIAGNOSIS, TOPIC_DRIVE, TOPIC_FIELDS
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.core.run import Run
 from prsm_health.diagnostics.diagnosis import CANNOT_TELL, diagnose_window, load_bundle, replay
+from prsm_health.diagnostics.not_observable import OBSERVABLE, diagnosis_message
 from prsm_health.io.mcap import iter_windows, read_mcap, write_mcap
 from prsm_health.io.mcap.replay import window_origin_ns, window_reached_ns
 from prsm_health.io.mcap.schema import diagnosis_schema, topic_schema
@@ -77,8 +78,9 @@ def bundle():
 
 
 def _diagnoser(bundle):
-    def diagnose(w):
-        return diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
+    def diagnose(w):  # what live and replay publish: the contract's JSON and what plots draw
+        run = Run(w.time, w.channels, w.sample_rate, w.labels)
+        return diagnosis_message(diagnose_window(run, bundle).to_json())
 
     return diagnose
 
@@ -197,7 +199,8 @@ def test_live_replay_publishes_the_recording_and_its_diagnoses(recording, bundle
     assert seen["server_info"]["op"] == "serverInfo"
     diagnosed = recording.parent / "diagnosed.mcap"
     expected = [
-        step.diagnosis.to_json() for step in replay(recording, bundle, window=WINDOW, out=diagnosed)
+        diagnosis_message(step.diagnosis.to_json())
+        for step in replay(recording, bundle, window=WINDOW, out=diagnosed)
     ]
     contract = _file_schemas(diagnosed)  # the recording's schemas + replay's diagnosis schema
     assert set(seen["channels"]) == set(contract) == {*signal_topics, TOPIC_DIAGNOSIS}
@@ -278,7 +281,10 @@ def test_live_run_with_a_bundle_publishes_what_replay_writes(recording, bundle):
     """``bundle=`` (what ``simulate --live`` and ``replay --live`` pass): a Run in memory is
     cut and diagnosed as ``replay --out`` cuts and diagnoses its MCAP file — the same
     diagnoses, at the same window ends."""
-    expected = [step.diagnosis.to_json() for step in replay(recording, bundle, window=WINDOW)]
+    expected = [
+        diagnosis_message(step.diagnosis.to_json())
+        for step in replay(recording, bundle, window=WINDOW)
+    ]
     assert len(expected) == 3
     with LivePlayer(
         read_mcap(recording), window=WINDOW, bundle=bundle, port=0, rate=None, decimate=50
@@ -294,8 +300,7 @@ def test_live_run_with_a_bundle_publishes_what_replay_writes(recording, bundle):
 def test_window_diagnoser_is_the_diagnosis_of_the_window_as_a_run(recording, bundle):
     with contextlib.closing(iter_windows(recording, WINDOW)) as stream:
         w = next(stream)
-    want = diagnose_window(Run(w.time, w.channels, w.sample_rate, w.labels), bundle).to_json()
-    assert window_diagnoser(bundle)(w) == want
+    assert window_diagnoser(bundle)(w) == _diagnoser(bundle)(w)
 
 
 def test_diagnose_and_bundle_together_are_refused(recording, bundle):
@@ -474,7 +479,7 @@ def test_foxglove_layout_file_matches_the_contract(recording, bundle):
 
     # message paths: topic + field (nested for the diagnosis), resolved in the contract schemas
     with contextlib.closing(iter_windows(recording, WINDOW)) as stream:  # no file left open
-        example = _diagnoser(bundle)(next(stream))
+        example = window_diagnoser(bundle)(next(stream))  # what live and replay publish
     schemas = {t: topic_schema(t, list(pairs)) for t, pairs in TOPIC_FIELDS.items()}
     schemas[TOPIC_DIAGNOSIS] = diagnosis_schema(example)
     paths, kinds = [], set()
@@ -489,7 +494,8 @@ def test_foxglove_layout_file_matches_the_contract(recording, bundle):
                 paths.append(item["value"])
         paths += [config[k] for k in ("path", "topicPath") if k in config]
         if kind == "Indicator":
-            assert {r["rawValue"] for r in config["rules"]} <= {*FAULT_CLASSES, CANNOT_TELL}
+            states = {*FAULT_CLASSES, CANNOT_TELL, OBSERVABLE}
+            assert {r["rawValue"] for r in config["rules"]} <= states
     assert kinds == set(PANELS)
     for path in paths:
         topic, _, rest = path.partition(".")
@@ -503,7 +509,12 @@ def test_foxglove_layout_file_matches_the_contract(recording, bundle):
         "/prsm/drive.drive_torque",
         "/prsm/diagnosis.fault_class",
     } <= set(paths)
-    clearance = {f"/prsm/diagnosis.clearance.{k}" for k in ("estimate", "lower", "upper")}
+    # the clearance and its interval as a plot draws them: gaps where not observable (issue
+    # 44), the state beside in words
+    clearance = {
+        f"/prsm/diagnosis.shown.{k}" for k in ("clearance", "clearance_lower", "clearance_upper")
+    }
     assert any(
         {s["value"] for s in c.get("paths", [])} == clearance for c in layout["configById"].values()
     )
+    assert "/prsm/diagnosis.shown.clearance_state" in paths

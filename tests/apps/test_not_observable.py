@@ -1,5 +1,5 @@
 """A target the model could not see is shown as "not observable", never as a number
-(prsm_health.apps.not_observable): in the ``diagnose`` table, replay's lines, the diagnosis
+(prsm_health.diagnostics.not_observable): in the ``diagnose`` table, replay's lines, the diagnosis
 figure and the check figure's panel titles; a clearance a health check measured stays a number.
 Diagnoses built by hand, no model, no simulation."""
 
@@ -12,17 +12,17 @@ import pytest  # noqa: E402
 
 from prsm_health.apps.check_plot import panel_title  # noqa: E402
 from prsm_health.apps.cli.models import _replay_line, diagnosis_rows  # noqa: E402
-from prsm_health.apps.not_observable import (  # noqa: E402
-    NOT_OBSERVABLE,
-    not_observable_text,
-    observable,
-)
 from prsm_health.apps.plots import diagnosis_figure, plot_diagnosis  # noqa: E402
 from prsm_health.diagnostics.answer import not_observable  # noqa: E402
 from prsm_health.diagnostics.contract import (  # noqa: E402
     Diagnosis,
     MeasuredClearance,
     WindowSpan,
+)
+from prsm_health.diagnostics.not_observable import (  # noqa: E402
+    NOT_OBSERVABLE,
+    not_observable_text,
+    observable,
 )
 
 MODEL = {"name": "m", "version": "1", "design": "paper01", "instrumentation": None}
@@ -164,3 +164,19 @@ def test_the_check_panel_says_not_observable():
     assert "clearance not observable — needs a load or motion reversal" in title
     assert "wear: not observable" in title and "P(wear)" not in title
     assert "P(wear) 0.38" in panel_title(verdict)  # without the diagnosis: as before
+
+
+def test_the_messages_foxglove_plots_leave_a_gap_where_the_model_did_not_see():
+    from prsm_health.diagnostics.not_observable import OBSERVABLE, diagnosis_message
+
+    hidden = diagnosis_message(window(0, seen=False).to_json())
+    seen = diagnosis_message(window(1, seen=True).to_json())
+    assert hidden["clearance"]["estimate"] == 4.7e-6  # the contract's numbers stay as they were
+    assert hidden["shown"]["clearance"] is None and hidden["shown"]["clearance_upper"] is None
+    assert set(hidden["shown"]["class_probabilities"]) == set(PROBABILITIES)
+    assert all(p is None for p in hidden["shown"]["class_probabilities"].values())
+    assert hidden["shown"]["clearance_state"].startswith(NOT_OBSERVABLE + " — needs a load")
+    assert seen["shown"]["clearance"] == 24e-6 and seen["shown"]["clearance_lower"] == 20e-6
+    assert seen["shown"]["class_probabilities"] == PROBABILITIES
+    assert seen["shown"]["clearance_state"] == seen["shown"]["fault_state"] == OBSERVABLE
+    assert set(seen["shown"]) == set(hidden["shown"])  # one schema for every message

@@ -16,9 +16,9 @@ from prsm_health.signals.features import (
     GROUPS,
     TRUTH_FEATURES,
     extract_features,
-    indicator_groups,
     windows,
 )
+from prsm_health.signals.indicator_table import indicator_groups
 from prsm_health.signals.lost_motion import lost_motion_spread, lost_motion_step
 
 RATE = 20_000.0
@@ -319,7 +319,7 @@ def _reversing_drive(rate: float, seconds: float = 4.0) -> Run:
 
 
 def test_a_group_whose_band_lies_above_the_recording_is_nan_and_says_the_rate_it_needs():
-    from prsm_health.signals.features import GROUP_CHANNELS, indicator_groups, usable_groups
+    from prsm_health.signals.indicator_table import GROUP_CHANNELS, usable_groups
 
     rattle = GROUP_CHANNELS["torque_rattle"].min_rate
     axial = GROUP_CHANNELS["axial_frequency"].min_rate
@@ -344,7 +344,7 @@ def test_a_group_whose_band_lies_above_the_recording_is_nan_and_says_the_rate_it
 
 def test_channel_statistics_are_every_channels_and_no_model_indicator():
     from prsm_health.signals.channel_statistics import CHANNEL_STATISTICS
-    from prsm_health.signals.features import GROUPS, NOT_INDICATORS
+    from prsm_health.signals.indicator_table import NOT_INDICATORS
 
     r, _ = synthetic()
     row = extract_features(r)

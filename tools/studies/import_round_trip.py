@@ -174,9 +174,13 @@ def main() -> int:
             "cannot_tell_fraction": report["fault"]["cannot_tell_fraction"],
             "f1_by_class": report["fault"]["f1_by_class"],
             "cv_macro_f1_classifier": metrics["fault_cv"]["macro_f1_classifier"],
+            "shipped": metrics["fault_model"]["candidate"],
         },
-        # train's own plain baseline, by the same grouped folds as the model's CV
-        "plain_baseline_cv_macro_f1": metrics["fault_plain_baseline_cv"]["macro_f1"],
+        # train's candidates, the plain baseline among them, by the same grouped folds
+        "candidates_cv_macro_f1": {
+            name: cv["macro_f1"] for name, cv in metrics["fault_candidates"].items()
+        },
+        "indicator_groups": metrics["indicator_groups"],
         "random_forest_on_statistics": {"macro_f1": float(baseline)},
     }
     print(json.dumps(result, indent=2))

@@ -12,6 +12,7 @@ from prsm_health.datasets import Dataset
 from prsm_health.diagnostics.diagnosis import diagnose as diagnose_recording
 from prsm_health.diagnostics.diagnosis import load_bundle, ood_verdict
 from prsm_health.diagnostics.diagnosis import replay as replay_windows
+from prsm_health.diagnostics.not_observable import not_observable_text
 from prsm_health.io import read_recording
 from prsm_health.monitoring import FileAssetStore, commission, diagnose_asset
 from prsm_health.training.check_part import is_check_dataset, train_check_part
@@ -20,7 +21,6 @@ from prsm_health.training.evaluation import evaluate_model
 from prsm_health.training.train import train as train_model
 
 from ..check_plot import plot_check_result
-from ..not_observable import not_observable_text
 from ..plots import plot_diagnosis, plot_evaluation
 from .live import play_live
 from .models_options import DEFAULT_CV

@@ -1,6 +1,6 @@
 """The dashboard's one rule for a target the model could not see (``PH.observable``,
 ``PH.notObservableText`` in static/dashboard/common.js): the same texts as the CLI's
-(prsm_health.apps.not_observable) from the same JSON — run in headless Chromium on common.js
+(prsm_health.diagnostics.not_observable) from the same JSON — run in headless Chromium on common.js
 alone (no server) —, and the fleet and asset pages showing them, greyed, with the hidden
 diagnoses out of the class plot (a real server; diagnoses written to its store, no
 simulation)."""
@@ -19,10 +19,10 @@ from test_dashboard_browser import (  # noqa: F401 (chromium_path: a fixture; py
     pytestmark,
 )
 
-from prsm_health.apps.not_observable import not_observable_text
 from prsm_health.apps.service import create_app
 from prsm_health.diagnostics.answer import not_observable
 from prsm_health.diagnostics.contract import Diagnosis
+from prsm_health.diagnostics.not_observable import not_observable_text
 
 COMMON_JS = files("prsm_health.apps.service") / "static" / "dashboard" / "common.js"
 MODEL = {"name": "m", "version": "1", "design": "paper01", "instrumentation": None}

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from prsm_health.diagnostics import contract
+from . import contract
 
 #: What is shown instead of a target's numbers.
 NOT_OBSERVABLE = "not observable"
@@ -63,3 +63,35 @@ def not_observable_text(diagnosis, target: str) -> str | None:
         if lower is not None and upper is not None:
             text += f" (interval {1e6 * lower:.1f}–{1e6 * upper:.1f} µm)"
     return text
+
+
+#: What :func:`shown` says of a target the model saw.
+OBSERVABLE = "observable"
+
+
+def shown(diagnosis) -> dict:
+    """What a plot may draw of a diagnosis (the ``shown`` object of the ``/prsm/diagnosis``
+    messages that Foxglove plots, docs/live.md): the clearance and its interval [m] and the
+    class probabilities where the model saw them, null where it did not — a gap in a plot,
+    never a number — and each target's state in words (:data:`OBSERVABLE`, or
+    :func:`not_observable_text`). The keys are always there (a schema inferred from one
+    message holds for all)."""
+    c = part(diagnosis, "clearance") or {}
+    if not isinstance(c, Mapping):
+        c = c.to_json()
+    seen_clearance, seen_fault = observable(diagnosis, "clearance"), observable(diagnosis, "fault")
+    probabilities = part(diagnosis, "class_probabilities") or {}
+    return {
+        "clearance": c.get("estimate") if seen_clearance else None,
+        "clearance_lower": c.get("lower") if seen_clearance else None,
+        "clearance_upper": c.get("upper") if seen_clearance else None,
+        "clearance_state": not_observable_text(diagnosis, "clearance") or OBSERVABLE,
+        "class_probabilities": {k: (p if seen_fault else None) for k, p in probabilities.items()},
+        "fault_state": not_observable_text(diagnosis, "fault") or OBSERVABLE,
+    }
+
+
+def diagnosis_message(diagnosis_json: dict) -> dict:
+    """A ``/prsm/diagnosis`` message (replay's MCAP, the live view): the Diagnosis contract's
+    JSON and, beside it, what a plot may draw of it (:func:`shown`)."""
+    return {**diagnosis_json, "shown": shown(diagnosis_json)}
