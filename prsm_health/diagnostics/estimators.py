@@ -63,7 +63,7 @@ __all__ = ["ClearanceEstimator", "DistributionGuard", "FaultClassifier"]
 _SEED_MAX = np.iinfo(np.int32).max
 #: What :class:`FaultClassifier` can learn with.
 LEARNERS = ("boosting", "forest")
-#: Trees of the forest learner (scikit-learn's default count; fully grown, Breiman's forest).
+#: Trees of the forest learner (scikit-learn's default count).
 FOREST_TREES = 100
 
 
@@ -535,10 +535,11 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
         Seeds the folds and the boosting models.
     learner : {"boosting", "forest"}, default "boosting"
         What the calibration wraps: the gradient-boosted trees above, or a random forest of
-        :data:`FOREST_TREES` fully grown trees (scikit-learn's defaults; the boosting
-        parameters do not apply). On a few dozen recordings the forest generalises better
+        :data:`FOREST_TREES` trees (scikit-learn's defaults otherwise; of the boosting
+        parameters only ``max_leaf_nodes`` applies). On a few dozen recordings the forest generalises better
         (2026-12-02, docs/import.md: cross-validated macro-F1 0.83–0.97 against 0.72–0.94 on
-        the same indicators); ``train`` cross-validates both and ships the better.
+        the same indicators); ``train`` cross-validates both and ships the better. Its trees
+        have at most ``max_leaf_nodes`` leaves, as the booster's.
 
     Attributes
     ----------
@@ -636,7 +637,14 @@ class FaultClassifier(ClassifierMixin, BaseEstimator):
     def _learner(self, seed: int):
         """The unfitted model the calibration wraps: the booster, or the forest."""
         if self.learner == "forest":
-            return RandomForestClassifier(n_estimators=FOREST_TREES, random_state=seed, n_jobs=1)
+            # trees no larger than the booster's (max_leaf_nodes): on a few dozen recordings
+            # they grow fully anyway, on thousands a shipped forest stays as small as a booster
+            return RandomForestClassifier(
+                n_estimators=FOREST_TREES,
+                max_leaf_nodes=self.max_leaf_nodes,
+                random_state=seed,
+                n_jobs=1,
+            )
         return HistGradientBoostingClassifier(**_hgb_params(self), random_state=seed)
 
     def fit(self, X, y, groups=None):

@@ -166,7 +166,7 @@ class Needs:
         """Why a sample rate [Hz] is too low for this group ("" when it is not, or unknown)."""
         if rate is None or not rate < self.min_rate:
             return ""
-        return f"sample rate {rate:g} Hz below the {self.min_rate:g} Hz it needs"
+        return f"sample rate {rate:g} Hz below the {self.min_rate:.0f} Hz it needs"
 
 
 #: The channels and rate each indicator group needs: declared once. A window without them has

@@ -330,7 +330,9 @@ def test_a_group_whose_band_lies_above_the_recording_is_nan_and_says_the_rate_it
         assert math.isfinite(row["torque_rattle_rate"]) == rattle_read, rate
         assert math.isfinite(row["axial_dominant_frequency"]) == axial_read, rate
         said = indicator_groups(row, run.channels, rate)
-        assert said["axial_frequency"] == f"sample rate {rate:g} Hz below the {axial:g} Hz it needs"
+        assert (
+            said["axial_frequency"] == f"sample rate {rate:g} Hz below the {axial:.0f} Hz it needs"
+        )
         assert (said["torque_rattle"] == "computed") == rattle_read
         usable = usable_groups(run.channels, rate)
         assert usable["axial_frequency"] == said["axial_frequency"]

@@ -12,7 +12,9 @@ degrees; nothing else. Classes healthy / wear / severe_wear / lubrication, ``--p
 recordings of 11 s each with their own seeds.
 
 The CSV files, a labels table and a column map go through ``prsm-health import``; ``train
---target fault`` and ``evaluate`` run on the imported dataset. In the same run a plain random
+--target fault`` (its three candidates — boosting and a forest on the indicators, the plain
+baseline on channel statistics — cross-validated by the same folds, the best shipped) and
+``evaluate`` run on the imported dataset. In the same run a plain random
 forest (scikit-learn defaults, 300 trees) on simple per-recording statistics of the same
 channels (mean, standard deviation, percentiles 1/50/99, peak-to-peak, mean absolute
 difference) is trained and scored on the same split. Prints both macro-F1s (JSON); results in

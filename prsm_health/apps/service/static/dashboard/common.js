@@ -45,7 +45,7 @@ const PH = (() => {
   const hours = (v) => (finite(v) ? (Math.abs(v) >= 100 ? v.toFixed(0) : v.toPrecision(3)) : "–");
 
   // A target the model could not see is shown as "not observable", never as a number: the
-  // rule of prsm_health.diagnostics.not_observable.py, on the same JSON fields. Observable: seen in
+  // rule of prsm_health/diagnostics/not_observable.py, on the same JSON fields. Observable: seen in
   // the window, or in any window of a recording (a share > 0), or a clearance a health check
   // measured; a diagnosis without observability (stored before it was kept) as it was.
   const NOT_OBSERVABLE = "not observable";
