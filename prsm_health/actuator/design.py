@@ -33,6 +33,8 @@ from prsm_health.core.errors import (
     require_range,
 )
 
+from .recirculation_spec import RecirculationSpec
+
 #: Relative tolerance of the concentric condition d_n = d_s + 2·d_r (paper 03 eq. 1). Real
 #: designs shift the roller pitch diameter by a few tenths of a percent to tune the contact
 #: point, so exact equality is not demanded; 0.5 % of d_n admits that and refuses typos.
@@ -242,6 +244,9 @@ class PRSMDesign:
     screw_material, roller_material, nut_material : Material
     gear : GearGeometry or None
         Required for the standard variant, absent for the recirculating one.
+    recirculation : RecirculationSpec or None
+        Recirculating variant only: the carrier, cam-ring and assembly dimensions it sets
+        (:mod:`prsm_health.actuator.recirculation_spec`); the rest follow paper 03's rules.
     masses : MassProperties
     reference : str
         Where the numbers come from.
@@ -270,6 +275,7 @@ class PRSMDesign:
     roller_material: Material = STEEL
     nut_material: Material = STEEL
     gear: GearGeometry | None = None
+    recirculation: RecirculationSpec | None = None
     reference: str = field(default="user", compare=False)
 
     def __post_init__(self):
@@ -369,6 +375,12 @@ class PRSMDesign:
                 "must be None: a recirculating PRSM has no ring gear",
             )
             return
+        require(
+            self.recirculation is None,
+            "design.recirculation",
+            "RecirculationSpec",
+            "must be absent for a standard PRSM: only the recirculating variant has a cam ring",
+        )
         require(
             isinstance(self.roller_starts, int) and self.roller_starts >= 1,
             "design.roller_starts",
@@ -563,7 +575,12 @@ class PRSMDesign:
         return _from_dict(cls, data, "design")
 
 
-_NESTED = {"Material": Material, "GearGeometry": GearGeometry, "MassProperties": MassProperties}
+_NESTED = {
+    "Material": Material,
+    "GearGeometry": GearGeometry,
+    "MassProperties": MassProperties,
+    "RecirculationSpec": RecirculationSpec,
+}
 
 
 def _to_dict(obj) -> dict:
@@ -733,7 +750,11 @@ def _paper03() -> PRSMDesign:
     # (docs/validation.md, design presets): orbit radius 19.75 mm (§3.2), 12 rollers,
     # single-start 1 mm pitch, roller tooth angle α = 90°.
     d_s, d_r = 32e-3, 7.5e-3
-    roller_mass = 0.02
+    # the roller from its own geometry: a steel cylinder at the pitch diameter (a groove's
+    # teeth fill about half of the crest-to-root band) as long as its 10 engaged grooves of
+    # 1 mm — 3.5 g (was an assumed 20 g; 3.9 g at the crest diameter)
+    roller_length = 10 * 1e-3
+    roller_mass = STEEL.density * math.pi / 4 * d_r**2 * roller_length
     return PRSMDesign(
         name="paper03",
         variant="recirculating",

@@ -2,8 +2,8 @@
 
 A design file holds the fields of :class:`~prsm_health.actuator.design.PRSMDesign` under their own names,
 in SI units (m, kg, kg·m², Pa, rad); the nested dataclasses are tables: ``[masses]``,
-``[gear]`` (standard variant only), ``[screw_material]``, ``[roller_material]``,
-``[nut_material]``. Optional fields (``None`` in Python) are left out. ``name`` defaults to the
+``[gear]`` (standard variant only), ``[recirculation]`` (recirculating variant only: paper 03's
+carrier and cam ring), ``[screw_material]``, ``[roller_material]``, ``[nut_material]``. Optional fields (``None`` in Python) are left out. ``name`` defaults to the
 file's stem. See docs/formats.md → Design files.
 
 Design identity: a design travels with its data (a dataset's manifest, a run's scenario, a
@@ -22,6 +22,7 @@ from prsm_health.core.errors import ParameterError
 from prsm_health.core.tomlfile import read_toml, toml_value
 
 from .design import PRESETS, GearGeometry, MassProperties, Material, PRSMDesign, preset
+from .recirculation_spec import RECIRCULATION_FIELDS, RecirculationSpec
 
 #: Unit and meaning of every design field, by dotted name below the design (``gear.module``);
 #: the material fields apply to each of the three ``*_material`` tables.
@@ -64,6 +65,7 @@ FIELDS = {
     "masses.roller_inertia": ("kg·m²", "polar moment of inertia of one roller"),
     "masses.carrier_mass": ("kg", "carrier mass"),
     "masses.carrier_inertia": ("kg·m²", "carrier polar moment of inertia"),
+    **{f"recirculation.{k}": v for k, v in RECIRCULATION_FIELDS.items()},
 }
 
 _TABLES = {
@@ -72,7 +74,11 @@ _TABLES = {
     "screw_material": Material,
     "roller_material": Material,
     "nut_material": Material,
+    "recirculation": RecirculationSpec,
 }
+#: Tables added to the design after designs had fingerprints: absent (None, or every field
+#: left to its rule) they leave a design's identity as it was.
+_ABSENT_IS_NONE = ("recirculation",)
 
 
 def field_info(dotted: str) -> tuple[str, str]:
@@ -208,6 +214,9 @@ def canonical_design(design: str | Path | dict | PRSMDesign) -> dict:
     data = PRSMDesign.from_dict(load_design(design).to_dict()).to_dict()
     for key in IDENTITY_IGNORES:
         data.pop(key, None)
+    for key in _ABSENT_IS_NONE:
+        if not any(v is not None for v in (data.get(key) or {}).values()):
+            data.pop(key, None)
     return _plain_zero(data)
 
 

@@ -1,6 +1,7 @@
 """Design files: dict and TOML round trips, the shipped preset files, `prsm-health design`,
 `--design FILE`, scenarios and recipes with a design file."""
 
+import dataclasses
 import json
 import math
 import re
@@ -12,7 +13,12 @@ import pandas as pd
 import pytest
 
 from prsm_health.actuator.design import PRESETS, PRSMDesign, preset
-from prsm_health.actuator.design_files import FIELDS, design_to_toml, load_design
+from prsm_health.actuator.design_files import (
+    FIELDS,
+    design_fingerprint,
+    design_to_toml,
+    load_design,
+)
 from prsm_health.apps.cli import main
 from prsm_health.core.errors import ParameterError, PRSMHealthError
 from prsm_health.datasets import load_recipe
@@ -35,7 +41,14 @@ def test_every_preset_round_trips(name, tmp_path):
 
 def test_every_field_has_a_unit_and_meaning():
     top = {f.name for f in fields(PRSMDesign)}
-    nested = {"masses", "gear", "screw_material", "roller_material", "nut_material"}
+    nested = {
+        "masses",
+        "gear",
+        "screw_material",
+        "roller_material",
+        "nut_material",
+        "recirculation",
+    }
     assert top - nested <= set(FIELDS)
 
 
@@ -72,11 +85,53 @@ def _check(path, capsys) -> tuple[int, str, str]:
 
 
 def test_template_then_check(tmp_path, capsys):
-    assert main(["design", "template", "--from", "paper03"]) == 0
+    assert main(["design", "template", "--from", "paper02"]) == 0
     path = tmp_path / "mine.toml"
     path.write_text(capsys.readouterr().out)
-    assert load_design(path) == preset("paper03")
+    assert load_design(path) == preset("paper02")
+    assert _check(path, capsys) == (0, "ok: paper02\n", "")
+
+
+def test_the_recirculating_template_writes_its_cam_ring_geometry_out_and_checks_it(
+    tmp_path, capsys
+):
+    from prsm_health.physics.recirculating import RecirculatingGeometry
+
+    assert main(["design", "template", "--variant", "recirculating"]) == 0
+    text = capsys.readouterr().out
+    assert "[recirculation]" in text and "groove_length = " in text
+    path = tmp_path / "mine.toml"
+    path.write_text(text)
+    mine, paper03 = load_design(path), preset("paper03")
+    # every rule's value written out: the same geometry as the preset's derived one
+    assert RecirculatingGeometry.for_design(mine) == RecirculatingGeometry.for_design(paper03)
     assert _check(path, capsys) == (0, "ok: paper03\n", "")
+    # a value the design file sets is checked against paper 03 and named as its field there
+    path.write_text(
+        text.replace("carrier_outer_diameter = 0.0429375", "carrier_outer_diameter = 0.1")
+    )
+    code, out, err = _check(path, capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith("error: design.recirculation.carrier_outer_diameter = 0.1 is invalid")
+    assert "eq. 15" in err
+    # a standard design has no cam ring; a standard preset is no recirculating template
+    data = preset("paper01").to_dict()
+    with pytest.raises(ParameterError, match=r"design\.recirculation .*standard PRSM"):
+        PRSMDesign.from_dict({**data, "recirculation": {"groove_length": 0.02}})
+    assert main(["design", "template", "--variant", "recirculating", "--from", "paper01"]) == 2
+    assert capsys.readouterr().err.startswith("error: --from paper01 is a standard design")
+
+
+def test_a_design_without_a_recirculation_table_keeps_its_fingerprint():
+    from prsm_health.actuator.recirculation_spec import RecirculationSpec
+
+    paper03 = preset("paper03")
+    # fingerprints from before the table existed (2026-12-02, the roller mass aside: paper01)
+    assert design_fingerprint("paper01") == "8bb0837666273084"
+    empty = dataclasses.replace(paper03, recirculation=RecirculationSpec())
+    assert design_fingerprint(empty) == design_fingerprint(paper03)
+    given = dataclasses.replace(paper03, recirculation=RecirculationSpec(groove_length=0.021))
+    assert design_fingerprint(given) != design_fingerprint(paper03)
 
 
 @pytest.mark.parametrize(

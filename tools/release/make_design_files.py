@@ -1,6 +1,6 @@
 """Write the design presets as TOML design files: datasets/designs/paper01.toml … paper05.toml.
 
-Run after changing a preset in prsm_health/actuator/design.py; tests/test_design_files.py checks that
+Run after changing a preset in prsm_health/actuator/design.py; tests/actuator/test_design_files.py checks that
 each file still equals its preset.
 
     python tools/release/make_design_files.py

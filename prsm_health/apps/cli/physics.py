@@ -6,8 +6,9 @@ from __future__ import annotations
 import math
 import textwrap
 
-from prsm_health.actuator.design import preset
+from prsm_health.actuator.design import DEFAULT_PRESET, preset
 from prsm_health.actuator.design_files import design_rows, design_to_toml, load_design
+from prsm_health.core.errors import PRSMHealthError
 from prsm_health.physics.friction import FrictionParameters, simulate_friction
 from prsm_health.physics.kinematics import (
     characteristic_frequencies,
@@ -15,6 +16,7 @@ from prsm_health.physics.kinematics import (
     speed_ratios,
 )
 from prsm_health.physics.load_rating import load_ratings
+from prsm_health.physics.recirculating import RecirculatingGeometry, with_explicit_geometry
 from prsm_health.physics.stiffness.axial import axial_stiffness
 from prsm_health.physics.stiffness.cylinder import ElectricCylinder, cylinder_deformation
 from prsm_health.physics.stiffness.gear_mesh import mesh_stiffness
@@ -22,6 +24,9 @@ from prsm_health.simulation.instrumentation import list_profiles, load_instrumen
 from prsm_health.validation import _fmt, collect, summary, to_markdown
 
 from .output import print_json, print_table
+
+#: The preset the recirculating design template starts from.
+RECIRCULATING_PRESET = "paper03"
 
 
 # ----------------------------------------------------------------------------- validate
@@ -59,12 +64,30 @@ def _print_validation_text(rows, width: int = 100) -> None:
 
 # ----------------------------------------------------------------------------- design
 def design_template(args) -> int:
-    print(
-        f"# PRSM design file, from preset {args.preset}: edit the values (SI units: m, kg, kg·m²,\n"
-        "# Pa, rad), rename it, then `prsm-health design check FILE` and use it with\n"
-        "# --design FILE. Optional fields left out take their defaults (docs/formats.md).\n"
+    name = args.preset or (
+        RECIRCULATING_PRESET if args.variant == "recirculating" else DEFAULT_PRESET
     )
-    print(design_to_toml(preset(args.preset)), end="")
+    design = preset(name)
+    if args.variant is not None and design.variant != args.variant:
+        raise PRSMHealthError(
+            f"--from {name} is a {design.variant} design, not {args.variant}: leave --from out "
+            f"(the {args.variant} template starts from "
+            f"{RECIRCULATING_PRESET if args.variant == 'recirculating' else DEFAULT_PRESET})"
+        )
+    if design.variant == "recirculating":
+        design = with_explicit_geometry(design)
+    print(
+        f"# PRSM design file, from preset {name}: edit the values (SI units: m, kg, kg·m²,\n"
+        "# Pa, rad), rename it, then `prsm-health design check FILE` and use it with\n"
+        "# --design FILE. Optional fields left out take their defaults (docs/formats.md)."
+    )
+    if design.variant == "recirculating":
+        print(
+            "# [recirculation]: paper 03's carrier and cam ring, each value the rule's for these\n"
+            "# threads; a field left out follows the rule again."
+        )
+    print()
+    print(design_to_toml(design), end="")
     return 0
 
 
@@ -98,6 +121,8 @@ def _in_degrees(row: tuple[str, object, str]) -> tuple[str, object, str]:
 
 def design_check(args) -> int:
     design = load_design(args.file)
+    if design.variant == "recirculating":  # its carrier and cam ring against paper 03
+        RecirculatingGeometry.for_design(design)
     print(f"ok: {design.name}")
     return 0
 

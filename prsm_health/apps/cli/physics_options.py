@@ -30,9 +30,15 @@ def add_physics_commands(command) -> None:
     t.add_argument(
         "--from",
         dest="preset",
-        default=DEFAULT_PRESET,
+        default=None,
         choices=sorted(PRESETS),
-        help="preset to copy",
+        help=f"preset to copy (default {DEFAULT_PRESET}; paper03 for --variant recirculating)",
+    )
+    t.add_argument(
+        "--variant",
+        choices=("standard", "recirculating"),
+        default=None,
+        help="recirculating: a paper-03 design with its cam-ring geometry written out",
     )
     t.set_defaults(handler="physics:design_template")
     t = action("show", "print every field of a design with its unit")

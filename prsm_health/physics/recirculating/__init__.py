@@ -47,6 +47,7 @@ from .geometry import (
     threadless_angle,
     threadless_area,
     threadless_radius,
+    with_explicit_geometry,
 )
 from .impact import (
     PAPER03_CONTACT,
@@ -102,4 +103,5 @@ __all__ = [
     "threadless_angle",
     "threadless_area",
     "threadless_radius",
+    "with_explicit_geometry",
 ]

@@ -41,7 +41,8 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from prsm_health.actuator.design import PRSMDesign, recirculating_roller_limit
-from prsm_health.core.errors import require, require_positive
+from prsm_health.actuator.recirculation_spec import RecirculationSpec
+from prsm_health.core.errors import ParameterError, require, require_positive
 
 TWO_PI = 2.0 * math.pi
 
@@ -372,8 +373,9 @@ class RecirculatingGeometry:
     def for_design(cls, design: PRSMDesign, **overrides) -> RecirculatingGeometry:
         """Geometry with the documented defaults, some overridden, checked against the design.
 
-        Defaults that depend on an overridden value follow it (e.g. ``groove_length`` follows
-        ``groove_end_radius``).
+        What the design's ``[recirculation]`` table sets (``design.recirculation``) replaces
+        the defaults, and ``overrides`` replace both. Defaults that depend on an overridden
+        value follow it (e.g. ``groove_length`` follows ``groove_end_radius``).
 
         Parameters
         ----------
@@ -385,11 +387,24 @@ class RecirculatingGeometry:
         Raises
         ------
         ParameterError
-            Unknown field, or a value that violates eqs. (13)–(22).
+            Unknown field, or a value that violates eqs. (13)–(22); a value the design's
+            table set is named as its field there (``design.recirculation.groove_length``).
         """
         _require_recirculating(design)
         _check_names(overrides)
-        o = dict(overrides)
+        given = design.recirculation.given() if design.recirculation is not None else {}
+        try:
+            return cls._built(design, {**given, **overrides})
+        except ParameterError as exc:
+            name = exc.field.removeprefix("geometry.")
+            if name in given and name not in overrides:
+                raise ParameterError(
+                    f"design.recirculation.{name}", exc.value, exc.allowed
+                ) from None
+            raise
+
+    @classmethod
+    def _built(cls, design: PRSMDesign, o: dict) -> RecirculatingGeometry:
 
         def get(name, default):
             return o[name] if name in o else default()
@@ -436,6 +451,15 @@ class RecirculatingGeometry:
         :func:`check_recirculating` to check it against a design)."""
         _check_names(changes)
         return replace(self, **changes)
+
+
+def with_explicit_geometry(design: PRSMDesign) -> PRSMDesign:
+    """The design with every field of its checked geometry written out in its
+    ``recirculation`` table (what ``design template --variant recirculating`` prints, so a
+    user sees and edits the numbers paper 03's rules give)."""
+    geometry = RecirculatingGeometry.for_design(design)
+    values = {f.name: getattr(geometry, f.name) for f in fields(geometry)}
+    return replace(design, recirculation=RecirculationSpec(**values))
 
 
 def _check_names(names) -> None:

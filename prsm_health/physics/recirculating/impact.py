@@ -16,7 +16,7 @@ Neglected, and why the peak is an idealisation: the radial lift h_r over the scr
 friction on the chamfer, roller spin, any transition curve at the chamfer foot (a sharp foot
 makes the contact start at the full v_cam, ≈ 1 m/s here), and the re-engagement of the
 threads at the end of arc DE (a thread contact, not a cam-ring one). With the paper's large
-damping (C = 50 N·s/mm against a 20 g roller) the impact is damping-dominated; the axial
+damping (C = 50 N·s/mm against the preset's 3.5 g roller) the impact is damping-dominated; the axial
 momentum it transfers lies between m_r·v0 and 2·m_r·v0 (restitution 0…1) whatever the contact
 law, the peak does not. The sampled series keeps the
 momentum exactly (each sample is the mean force over its interval), so it can be added to a
