@@ -16,7 +16,7 @@ lag). No mean of a position or an angle: where the stroke sits says nothing of t
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import detrend
+from scipy.signal import detrend, periodogram
 
 from prsm_health.core.run import Run
 
@@ -96,13 +96,13 @@ def generic_indicators(run: Run, nut_per_rad: float | None) -> dict[str, float]:
 
 
 def _band_shares(channel: str, x: np.ndarray) -> dict[str, float]:
-    """Shares of the detrended signal's power in :data:`BANDS` of [0, Nyquist] (periodogram)."""
-    power = np.abs(np.fft.rfft(detrend(x))) ** 2
-    share = np.arange(len(power)) / max(len(power) - 1, 1)  # frequency as a share of Nyquist
+    """Shares of the linearly detrended signal's power in :data:`BANDS` of [0, Nyquist]
+    (scipy's one-sided periodogram at a sample rate of 2: frequencies in shares of Nyquist)."""
+    share, power = periodogram(x, fs=2.0, window="boxcar", detrend="linear")
     total = float(np.sum(power[1:]))
     out = {}
     for lo, hi in zip(BANDS[:-1], BANDS[1:]):
-        inside = (share > lo) & (share <= hi) if lo > 0 else (share > 0) & (share <= hi)
+        inside = (share > lo) & (share <= hi)
         out[f"{channel}_band_{int(100 * lo)}_{int(100 * hi)}"] = (
             float(np.sum(power[inside]) / total) if total > 0 else np.nan
         )
