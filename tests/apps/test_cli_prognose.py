@@ -8,11 +8,11 @@ as in tests/test_prognostics.py); the fleet dataset is a tiny life recipe genera
 
 import copy
 import json
-import math
 
 import numpy as np
 import pandas as pd
 import pytest
+from synthetic_units import Z90, unit  # tests/: the degradation units, shared
 
 from prsm_health.apps.cli import main
 from prsm_health.apps.cli.output import hours
@@ -29,9 +29,6 @@ from prsm_health.prognostics import (
     read_history,
     save_prognostics_model,
 )
-
-Z90 = 1.6448536269514722
-THRESHOLD, PHI0 = 30e-6, 8e-6
 
 TINY_FLEET = {
     "name": "tiny-fleet",
@@ -50,12 +47,8 @@ TINY_FLEET = {
 
 
 def _unit(uid, rng, n_points=20):
-    ln_theta = math.log(2e-6) + 0.15 * rng.standard_normal()
-    beta = 2.4e-4 * (1 + 0.15 * rng.standard_normal())
-    life = (math.log(THRESHOLD - PHI0) - ln_theta) / beta
-    ages = np.linspace(0.0, life, n_points, endpoint=False)
-    sd = rng.uniform(0.2e-6, 0.5e-6, n_points)
-    estimate = PHI0 + np.exp(ln_theta + beta * ages) + sd * rng.standard_normal(n_points)
+    """One synthetic unit's history table and its life [h] (tests/synthetic_units.py)."""
+    ages, estimate, sd, life = unit(rng, n_points)
     table = pd.DataFrame(
         {
             "unit_id": uid,

@@ -1,6 +1,7 @@
-"""Synthetic units for the service's prognosis tests: degradation histories S(t) = PHI0 +
-exp(ln θ + βt) + noise that fail at THRESHOLD, and a prognostics model fitted on ten of them
-(no simulation)."""
+"""Synthetic units for the prognosis tests (the CLI's and the service's): degradation
+histories S(t) = PHI0 + exp(ln θ + βt) + noise that fail at THRESHOLD, and a prognostics model
+fitted on ten of them (no simulation). At tests/, on the path of every test through
+tests/conftest.py."""
 
 import math
 
