@@ -1,0 +1,313 @@
+"""numba kernels of the recirculating PRSM's axial model: contact forces and a guarded RK4.
+
+Only float64 arrays and scalars cross this boundary; the parameter vector's layout is
+:data:`P_*` below, the physics in :mod:`.model` (which documents every term and cites paper 03).
+
+State ``y``: nut position and velocity, each roller's absolute axial position and velocity, and
+three energy accumulators (work of the prescribed screw/carrier motion, dissipated energy, work
+against the load), so that the energy balance is integrated by the same steps as the motion.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+TWO_PI = 2.0 * math.pi
+
+# ---- parameter vector layout
+P_N = 0  # rollers
+P_LEAD = 1  # lead L [m]
+P_PITCH = 2  # thread pitch p [m] (period of the grooves)
+P_M_ROLLER = 3
+P_M_NUT = 4  # nut, cam rings and payload [kg]
+P_K_THREAD = 5  # Hertz constant of one thread side [N/m^1.5]
+P_B_SCREW = 6  # half-clearance, screw side [m]
+P_B_NUT = 7
+P_C_THREAD = 8  # thread damping [N·s/m]
+P_D_THREAD = 9  # penetration over which the thread damping switches on [m]
+P_K_CAM = 10  # IMPACT (eq. 38) stiffness [N/m^e]
+P_E_CAM = 11
+P_C_CAM = 12
+P_D_CAM = 13
+P_ROOM = 14  # axial room of a roller between the two cam rings [m]
+P_STROKE = 15  # platform height: the reset stroke [m]
+P_BETA = 16  # half the threadless sector's orbital angle [rad]
+P_LIFT = 17  # radial lift over the screw thread crest [m]
+P_LIFT_RAMP = 18  # orbital angle over which a lift (or the platform's edge) ramps [rad]
+P_COT_FLANK = 19  # axial play per radial lift: cos β / sin β of the flank
+P_DIR = 20  # +1 forward, −1 reverse
+P_OMEGA = 21  # screw speed [rad/s]
+P_RATIO = 22  # carrier / screw speed
+P_PHI_ENTRY = 23  # orbital angle where a roller enters the sector [rad]
+P_LOAD = 24  # axial load on the nut, resisting forward motion [N]
+P_LOAD_RAMP = 25  # time over which the load rises from 0 [s]
+P_SIZE = 26
+
+#: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
+R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
+
+# ---- recorded per sample
+OUT_T, OUT_X, OUT_V, OUT_A, OUT_POWER, OUT_W_IN, OUT_W_DISS, OUT_W_LOAD, OUT_ENERGY = range(9)
+OUT_SIZE = 9
+#: Per roller per sample: relative position to the nut, screw-side and nut-side thread force,
+#: cam force (both rings), in the sector (1/0).
+ROLLER_U, ROLLER_F_SCREW, ROLLER_F_NUT, ROLLER_F_CAM, ROLLER_SECTOR = range(5)
+ROLLER_SIZE = 5
+
+
+@njit(cache=True, inline="always")
+def _wrap(x, period):
+    """x wrapped into [−period/2, period/2)."""
+    return x - period * math.floor(x / period + 0.5)
+
+
+@njit(cache=True, inline="always")
+def _step_on(d, depth):
+    """ADAMS STEP from 0 at d = 0 to 1 at d = depth (cubic)."""
+    u = min(max(d / depth, 0.0), 1.0)
+    return u * u * (3.0 - 2.0 * u)
+
+
+@njit(cache=True, inline="always")
+def _sector(p, phi):
+    """(angle travelled into the threadless sector a ∈ [0, 2π), in it?)."""
+    a = (p[P_DIR] * (phi - p[P_PHI_ENTRY])) % TWO_PI
+    return a, a < 2.0 * p[P_BETA]
+
+
+@njit(cache=True, inline="always")
+def _trapezoid(a, end, ramp):
+    """0 → 1 over [0, ramp], 1, 1 → 0 over [end − ramp, end] (0 outside [0, end]); and d/da."""
+    if a <= 0.0 or a >= end:
+        return 0.0, 0.0
+    if a < ramp:
+        return a / ramp, 1.0 / ramp
+    if a > end - ramp:
+        return (end - a) / ramp, -1.0 / ramp
+    return 1.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _plays(p, a, inside):
+    """Axial play the lift adds on the screw side and the nut side [m], and d/da of each: the
+    roller is lifted out of both threads across the threadless area (2β), the lift rising and
+    falling over a ramp at each end so the threads let go and take the roller back gradually.
+
+    An idealisation of A → A' → A'' (§2.1): lifted over the screw thread's crest during the
+    crossing, the roller is held on the platform until the nut thread takes it back; what it
+    leaves out is said in :mod:`.model`."""
+    if not inside:
+        return 0.0, 0.0, 0.0, 0.0
+    scale = p[P_LIFT] * p[P_COT_FLANK]
+    value, slope = _trapezoid(a, 2.0 * p[P_BETA], p[P_LIFT_RAMP])
+    return scale * value, scale * slope, scale * value, scale * slope
+
+
+@njit(cache=True, inline="always")
+def _platform(p, a, inside):
+    """Platform surface height above its ring's face [m] and d/da: the chamfer rises by the
+    stroke over the crossing (the first β), the platform top holds it, and its exit edge drops
+    over the last lift ramp as the threads take the roller back."""
+    if not inside:
+        return 0.0, 0.0
+    beta, ramp, stroke = p[P_BETA], p[P_LIFT_RAMP], p[P_STROKE]
+    if a < beta:
+        return stroke * a / beta, stroke / beta
+    if a > 2.0 * beta - ramp:
+        return stroke * (2.0 * beta - a) / ramp, -stroke / ramp
+    return stroke, 0.0
+
+
+@njit(cache=True)
+def forces(t, y, p, rollers, roller_out, with_out):
+    """Accelerations, the energy accumulators' rates and the largest contact rate [1/s].
+
+    Returns (dy, rate); ``roller_out`` (rollers × ROLLER_SIZE) filled when ``with_out``.
+    """
+    n = int(p[P_N])
+    lead, pitch = p[P_LEAD], p[P_PITCH]
+    m_r, m_n = p[P_M_ROLLER], p[P_M_NUT]
+    omega, ratio, s = p[P_OMEGA], p[P_RATIO], p[P_DIR]
+    phi_dot = ratio * omega
+    a_dot = abs(phi_dot)  # the sector angle grows at the carrier's speed
+    theta = omega * t
+    x, v = y[0], y[1]
+    dy = np.zeros(2 + 2 * n + 3)
+    f_nut = 0.0
+    p_in = 0.0
+    p_diss = 0.0
+    rate = 0.0
+    for i in range(n):
+        z, w = y[2 + i], y[2 + n + i]
+        phi = rollers[i, R_PHI0] + phi_dot * t
+        a, inside = _sector(p, phi)
+        play_s, dplay_s, play_n, dplay_n = _plays(p, a, inside)
+        f_roller = 0.0
+        f_screw = 0.0
+        # ---- thread contacts: screw side, nut side (dead-zone Hertz, damped)
+        f_side = 0.0
+        for side in range(2):
+            if side == 0:
+                e = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
+                e_dot_free = w  # the part from the state
+                e_dot_kin = -lead * (omega - phi_dot) / TWO_PI  # from the prescribed motion
+                b = p[P_B_SCREW] + play_s
+                play_dot = dplay_s * a_dot
+            else:
+                e = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
+                e_dot_free = w - v
+                e_dot_kin = lead * phi_dot / TWO_PI
+                b = p[P_B_NUT] + play_n
+                play_dot = dplay_n * a_dot
+            sign = 1.0 if e >= 0.0 else -1.0
+            d = abs(e) - b
+            force = 0.0
+            if d > 0.0:
+                d_dot_kin = sign * e_dot_kin - play_dot
+                d_dot = sign * e_dot_free + d_dot_kin
+                elastic = p[P_K_THREAD] * d**1.5
+                force = max(elastic + p[P_C_THREAD] * _step_on(d, p[P_D_THREAD]) * d_dot, 0.0)
+                p_in += force * d_dot_kin
+                p_diss += (force - elastic) * d_dot
+                k_eff = 1.5 * p[P_K_THREAD] * math.sqrt(d)
+                rate = max(rate, math.sqrt(k_eff / m_r), p[P_C_THREAD] / m_r)
+            f_roller -= sign * force
+            if side == 1:
+                f_nut += sign * force
+                f_side = -sign * force
+            else:
+                f_screw = -sign * force
+        # ---- cam rings: the left ring's face at u = 0 (with its platform when forward), the
+        # right ring's at u = room (with its platform when reverse)
+        u, u_dot = z - x, w - v
+        rise, drise_da = _platform(p, a, inside)
+        f_cam = 0.0
+        for ring in range(2):
+            if ring == 0:
+                surface = rise if s > 0 else 0.0
+                surface_dot = drise_da * a_dot if s > 0 else 0.0
+                d = surface - u
+                d_dot = surface_dot - u_dot
+                d_dot_kin = surface_dot
+                push = 1.0
+            else:
+                surface = p[P_ROOM] - (rise if s < 0 else 0.0)
+                surface_dot = -(drise_da * a_dot) if s < 0 else 0.0
+                d = u - surface
+                d_dot = u_dot - surface_dot
+                d_dot_kin = -surface_dot
+                push = -1.0
+            if d > 0.0:
+                elastic = p[P_K_CAM] * d ** p[P_E_CAM]
+                force = max(elastic + p[P_C_CAM] * _step_on(d, p[P_D_CAM]) * d_dot, 0.0)
+                p_in += force * d_dot_kin
+                p_diss += (force - elastic) * d_dot
+                k_eff = p[P_E_CAM] * p[P_K_CAM] * d ** (p[P_E_CAM] - 1.0)
+                c_eff = p[P_C_CAM] * _step_on(d, p[P_D_CAM])
+                rate = max(rate, math.sqrt(k_eff / m_r), c_eff / m_r)
+                f_cam += push * force
+        f_roller += f_cam
+        f_nut -= f_cam
+        dy[2 + i] = w
+        dy[2 + n + i] = f_roller / m_r
+        if with_out:
+            roller_out[i, ROLLER_U] = u
+            roller_out[i, ROLLER_F_SCREW] = f_screw
+            roller_out[i, ROLLER_F_NUT] = f_side
+            roller_out[i, ROLLER_F_CAM] = f_cam
+            roller_out[i, ROLLER_SECTOR] = 1.0 if inside else 0.0
+    load = p[P_LOAD] * min(1.0, t / p[P_LOAD_RAMP]) if p[P_LOAD_RAMP] > 0 else p[P_LOAD]
+    dy[0] = v
+    dy[1] = (f_nut - load) / m_n
+    dy[2 + 2 * n] = p_in
+    dy[2 + 2 * n + 1] = p_diss
+    dy[2 + 2 * n + 2] = load * v
+    return dy, rate
+
+
+@njit(cache=True)
+def mechanical_energy(t, y, p, rollers):
+    """Kinetic energy of nut and rollers plus the contacts' elastic energy [J]."""
+    n = int(p[P_N])
+    lead, pitch = p[P_LEAD], p[P_PITCH]
+    omega, ratio, s = p[P_OMEGA], p[P_RATIO], p[P_DIR]
+    phi_dot = ratio * omega
+    theta = omega * t
+    x = y[0]
+    energy = 0.5 * p[P_M_NUT] * y[1] ** 2
+    for i in range(n):
+        z, w = y[2 + i], y[2 + n + i]
+        energy += 0.5 * p[P_M_ROLLER] * w**2
+        phi = rollers[i, R_PHI0] + phi_dot * t
+        a, inside = _sector(p, phi)
+        play_s, _, play_n, _ = _plays(p, a, inside)
+        e_s = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
+        e_n = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
+        for e, b in ((e_s, p[P_B_SCREW] + play_s), (e_n, p[P_B_NUT] + play_n)):
+            d = abs(e) - b
+            if d > 0.0:
+                energy += 0.4 * p[P_K_THREAD] * d**2.5
+        u = z - x
+        rise, _ = _platform(p, a, inside)
+        for d in ((rise if s > 0 else 0.0) - u, u - (p[P_ROOM] - (rise if s < 0 else 0.0))):
+            if d > 0.0:
+                energy += p[P_K_CAM] * d ** (p[P_E_CAM] + 1.0) / (p[P_E_CAM] + 1.0)
+    return energy
+
+
+@njit(cache=True)
+def integrate(y0, p, rollers, step, n_steps, max_substeps, out, roller_out):
+    """Fixed outer steps of RK4, each cut into as many equal sub-steps as the stiffest active
+    contact needs (rate × sub-step ≤ 0.5, from the penetration expected at the step's end);
+    records every outer step. Returns the number of steps done (< n_steps: the guard's limit
+    was reached at that step)."""
+    n = int(p[P_N])
+    size = 2 + 2 * n + 3
+    y = y0.copy()
+    k1 = np.zeros(size)
+    tmp = np.zeros(size)
+    scratch = roller_out[0].copy()
+    t = 0.0
+    for k in range(n_steps):
+        dy, rate = forces(t, y, p, rollers, roller_out[k], True)
+        out[k, OUT_T] = t
+        out[k, OUT_X] = y[0]
+        out[k, OUT_V] = y[1]
+        out[k, OUT_A] = dy[1]
+        out[k, OUT_POWER] = dy[2 + 2 * n]
+        out[k, OUT_W_IN] = y[2 + 2 * n]
+        out[k, OUT_W_DISS] = y[2 + 2 * n + 1]
+        out[k, OUT_W_LOAD] = y[2 + 2 * n + 2]
+        out[k, OUT_ENERGY] = mechanical_energy(t, y, p, rollers)
+        # look ahead one step with an Euler predictor: an impact starting inside the step
+        for j in range(size):
+            tmp[j] = y[j] + step * dy[j]
+        _, rate_end = forces(t + step, tmp, p, rollers, scratch, False)
+        rate = max(rate, rate_end)
+        subs = max(1, int(math.ceil(rate * step / 0.5)))
+        if subs > max_substeps:
+            return k
+        h = step / subs
+        for _ in range(subs):
+            d1, _r = forces(t, y, p, rollers, scratch, False)
+            for j in range(size):
+                k1[j] = d1[j]
+                tmp[j] = y[j] + 0.5 * h * d1[j]
+            d2, _r = forces(t + 0.5 * h, tmp, p, rollers, scratch, False)
+            for j in range(size):
+                k1[j] += 2.0 * d2[j]
+                tmp[j] = y[j] + 0.5 * h * d2[j]
+            d3, _r = forces(t + 0.5 * h, tmp, p, rollers, scratch, False)
+            for j in range(size):
+                k1[j] += 2.0 * d3[j]
+                tmp[j] = y[j] + h * d3[j]
+            d4, _r = forces(t + h, tmp, p, rollers, scratch, False)
+            for j in range(size):
+                y[j] += h * (k1[j] + d4[j]) / 6.0
+            t += h
+        # the step ends where it should, whatever rounding the sub-steps left
+        t = (k + 1) * step
+    return n_steps

@@ -1,0 +1,342 @@
+"""The recirculating PRSM (paper 03) as a dynamic model: the nut and each grooved roller moving
+axially, the threads, the threadless sector and the two cam rings.
+
+Bodies and degrees of freedom
+-----------------------------
+The screw turns at a prescribed speed ω_s and is axially fixed (rigid); the carrier turns with it
+at the rolling ratio ω_c = d_s/(2d_c)·ω_s (eq. 25: no slip, the paper's own simulation is within
+1 % of it); the nut (with its cam rings and the payload) and every roller move axially — the
+N + 1 axial degrees of freedom, integrated by a guarded fixed-step RK4 (:mod:`._kernels`).
+
+Forces, each from one contact law and its energy
+------------------------------------------------
+- **Threads.** A grooved roller (no helix) engages the screw and the nut threads of lead L: its
+  axial error against the nearest screw groove is e_s = wrap_p(z − L(θ_s − φ)/2π − c_s) and
+  against the nut's e_n = wrap_p(z − x_n + Lφ/2π − c_n) (φ its orbital angle, p the pitch,
+  c the assembly offsets that centre every roller at the start, eqs. 35–37); held in both, the
+  nut advances L per screw turn (eq. 28) and the roller drifts back one lead per carrier
+  revolution relative to the nut (eq. 31). Each side is a Hertz contact beyond a half-clearance
+  b: F = K·(|e| − b)^1.5 (+ damping), K matched to paper 04's thread stiffness at the nominal
+  share of the load (:func:`prsm_health.physics.stiffness.thread_load.roller_side_stiffness`).
+- **The threadless sector (2β, eq. 11).** Inside it a roller is lifted over the screw thread and
+  out of the nut's: both sides' play grows by the radial lift h_r (eq. 8's) times cot β_flank (a
+  radial gap h is an axial gap h·cos β/sin β at a flank at β), up over the first quarter of β,
+  held, down over the last quarter — so the threads let go and take the roller back gradually.
+- **Cam rings.** The roller sits between two cam rings fixed to the nut, their faces the cam
+  spacing h (eq. 36's layout) apart: the roller (s1 + s2 long) has L + p/N of axial room. The
+  ring on the side the roller drifts to carries the convex platform: in the sector its chamfer
+  (α/2) pushes the roller forward by one lead over the first β (the crossing, eqs. 9–11), its
+  top holds it, its exit edge drops over the last lift ramp. Every ring contact is the paper's
+  ADAMS IMPACT law (eq. 38, §4.1: K = 1e5 N/mm, e = 1.5, C = 50 N·s/mm, d = 0.1 mm); the far
+  ring's face stops a roller the push threw too far.
+- **Load.** A constant axial force on the nut opposing forward motion, ramped in over
+  ``load_ramp`` (a step would ring the nut on its threads for the whole run).
+
+Idealised: the platform top holds a reset roller across the whole threadless area (2β) until the
+nut thread takes it back; the paper lays out one β per direction of rotation, so a real roller
+runs the second β free of the platform. Forward rotation only: the mirrored reverse layout is
+in the kernels, but its exit, where the loaded flank pulls the landing roller into the platform
+edge, is not validated. Not modelled (yet): friction on the platform and in the threads (the paper's μ = 0.25–0.3 on the
+platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
+(the carrier collisions of Fig. 32), radial and tilting motion; the screw's own axial and
+torsional compliance. The energy of every modelled contact is accounted for: the work of the
+prescribed screw/carrier motion equals the change of kinetic and elastic energy plus what the
+dampers took plus the work against the load (:attr:`RecirculatingRun.energy_error`).
+
+References
+----------
+Paper 03 — eqs. (8)–(11) threadless area and crossing, (25)–(31) motion, (35)–(37) assembly,
+(38) and §4.1 contact; paper 04 — thread stiffness.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from prsm_health.actuator.design import PRSMDesign
+from prsm_health.core.errors import ConvergenceError, require, require_positive
+from prsm_health.physics.kinematics import speed_ratios
+from prsm_health.physics.recirculating import (
+    PAPER03_CONTACT,
+    ImpactContact,
+    RecirculatingGeometry,
+    cam_ring_spacing,
+    orbital_angle,
+    radial_lift,
+    reset_stroke,
+)
+from prsm_health.physics.stiffness.thread_load import roller_side_stiffness
+
+from . import _kernels as K
+
+#: Outer step of the integrator [s]: a quarter of the period of a roller on its threads (≈ 30 kHz
+#: for the paper03 preset); the guard cuts it wherever a contact needs less.
+STEP = 2e-6
+#: Most sub-steps the guard may cut one outer step into before it refuses the run.
+MAX_SUBSTEPS = 2000
+#: Damping ratio of a roller on one thread side (the standard model's contact damping).
+THREAD_DAMPING_RATIO = 0.03
+#: Penetration over which the thread damping switches on [m] (continuity at first contact).
+THREAD_DAMPING_DEPTH = 1e-6
+#: Share of β over which the lift (and the platform's exit edge) ramps.
+LIFT_RAMP_SHARE = 0.25
+
+
+@dataclass(frozen=True)
+class RecirculatingRun:
+    """Truth of a simulated recirculating PRSM (SI units; roller arrays are rollers × samples).
+
+    Attributes
+    ----------
+    time, nut_position, nut_velocity, nut_acceleration : numpy.ndarray [s, m, m/s, m/s²]
+    drive_torque : numpy.ndarray [N·m]
+        The torque the prescribed screw (and, through rolling, carrier) motion takes: its
+        power over ω_s.
+    roller_position : numpy.ndarray [m]
+        Each roller's axial position relative to the nut (0: against the left cam ring).
+    screw_force, nut_force, cam_force : numpy.ndarray [N]
+        Axial force on each roller from the screw thread, the nut thread, the cam rings.
+    in_sector : numpy.ndarray of bool
+        Whether each roller is in the threadless sector.
+    resets : numpy.ndarray of int
+        Crossings of the sector each roller completed.
+    work_in, dissipated, work_load, mechanical_energy : numpy.ndarray [J]
+        Cumulative work of the prescribed motion, energy the dampers took, work against the
+        load; kinetic plus elastic energy.
+    screw_speed, carrier_speed, load : float
+    """
+
+    time: np.ndarray
+    nut_position: np.ndarray
+    nut_velocity: np.ndarray
+    nut_acceleration: np.ndarray
+    drive_torque: np.ndarray
+    roller_position: np.ndarray
+    screw_force: np.ndarray
+    nut_force: np.ndarray
+    cam_force: np.ndarray
+    in_sector: np.ndarray
+    resets: np.ndarray
+    work_in: np.ndarray
+    dissipated: np.ndarray
+    work_load: np.ndarray
+    mechanical_energy: np.ndarray
+    screw_speed: float
+    carrier_speed: float
+    load: float
+
+    @property
+    def energy_error(self) -> float:
+        """|ΔE − (W_in − W_diss − W_load)| at the end over the work put in [-]."""
+        balance = self.work_in[-1] - self.dissipated[-1] - self.work_load[-1]
+        change = self.mechanical_energy[-1] - self.mechanical_energy[0]
+        scale = max(abs(self.work_in[-1]), abs(self.work_load[-1]), 1e-12)
+        return abs(change - balance) / scale
+
+
+def simulate_recirculating(
+    design: PRSMDesign,
+    *,
+    screw_speed: float,
+    load: float,
+    duration: float,
+    clearance: float = 5e-6,
+    payload_mass: float = 0.0,
+    load_ramp: float = 5e-3,
+    contact: ImpactContact = PAPER03_CONTACT,
+    step: float = STEP,
+) -> RecirculatingRun:
+    """Simulate a recirculating PRSM at a constant screw speed under a constant axial load.
+
+    Parameters
+    ----------
+    design : PRSMDesign
+        A recirculating design (its ``[recirculation]`` geometry, or paper 03's rules).
+    screw_speed : float [rad/s]
+        > 0: forward rotation (the left ring's platform resets the rollers).
+    load : float [N]
+        Axial load on the nut, ≥ 0, resisting forward motion.
+    duration : float [s]
+    clearance : float [m]
+        Half-clearance of each roller on each thread side.
+    payload_mass : float [kg]
+        Mass moving with the nut (besides the design's nut mass).
+    load_ramp : float [s]
+        Time over which the load rises from 0.
+    contact : ImpactContact
+        The cam-ring contact (default paper 03 §4.1).
+    step : float [s]
+        Outer step; the guard sub-steps where a contact needs it.
+
+    Raises
+    ------
+    ParameterError
+        A standard design, or a value out of range (named).
+    ConvergenceError
+        A contact stiffer than :data:`MAX_SUBSTEPS` sub-steps of ``step`` can follow.
+    """
+    require(
+        design.variant == "recirculating",
+        "design.variant",
+        design.variant,
+        "must be 'recirculating' (the standard PRSM runs in prsm_health.simulation.dynamics)",
+    )
+    require(
+        isinstance(screw_speed, (int, float)) and math.isfinite(screw_speed) and screw_speed > 0,
+        "screw_speed",
+        screw_speed,
+        "must be a finite speed > 0 [rad/s]: forward rotation only so far (the reverse ring's "
+        "platform is laid out, its exit against the loaded flank not yet validated)",
+    )
+    require(
+        isinstance(load, (int, float)) and math.isfinite(load) and load >= 0,
+        "load",
+        load,
+        "must be a finite force ≥ 0 [N]",
+    )
+    require_positive("duration", duration)
+    require_positive("clearance", clearance)
+    require_positive("step", step)
+    require(
+        isinstance(payload_mass, (int, float)) and payload_mass >= 0,
+        "payload_mass",
+        payload_mass,
+        "must be ≥ 0 [kg]",
+    )
+    require(
+        isinstance(load_ramp, (int, float)) and load_ramp >= 0,
+        "load_ramp",
+        load_ramp,
+        "must be ≥ 0 [s]",
+    )
+    p, rollers, y0 = _parameters(
+        design, screw_speed, load, clearance, payload_mass, load_ramp, contact
+    )
+    n_steps = int(round(duration / step)) + 1
+    n = design.n_rollers
+    out = np.zeros((n_steps, K.OUT_SIZE))
+    roller_out = np.zeros((n_steps, n, K.ROLLER_SIZE))
+    done = K.integrate(y0, p, rollers, step, n_steps, MAX_SUBSTEPS, out, roller_out)
+    if done < n_steps:
+        raise ConvergenceError(
+            f"recirculating PRSM: at t = {done * step:.6g} s a contact needs more than "
+            f"{MAX_SUBSTEPS} sub-steps of {step:g} s: lower step or check the contact parameters"
+        )
+    sector = roller_out[:, :, K.ROLLER_SECTOR].T > 0.5
+    exits = np.sum(sector[:, :-1] & ~sector[:, 1:], axis=1)
+    omega = float(screw_speed)
+    return RecirculatingRun(
+        time=out[:, K.OUT_T],
+        nut_position=out[:, K.OUT_X],
+        nut_velocity=out[:, K.OUT_V],
+        nut_acceleration=out[:, K.OUT_A],
+        drive_torque=out[:, K.OUT_POWER] / omega,
+        roller_position=roller_out[:, :, K.ROLLER_U].T.copy(),
+        screw_force=roller_out[:, :, K.ROLLER_F_SCREW].T.copy(),
+        nut_force=roller_out[:, :, K.ROLLER_F_NUT].T.copy(),
+        cam_force=roller_out[:, :, K.ROLLER_F_CAM].T.copy(),
+        in_sector=sector,
+        resets=exits.astype(int),
+        work_in=out[:, K.OUT_W_IN],
+        dissipated=out[:, K.OUT_W_DISS],
+        work_load=out[:, K.OUT_W_LOAD],
+        mechanical_energy=out[:, K.OUT_ENERGY],
+        screw_speed=omega,
+        carrier_speed=speed_ratios(design).carrier * omega,
+        load=float(load),
+    )
+
+
+def _parameters(design, screw_speed, load, clearance, payload_mass, load_ramp, contact):
+    """(parameter vector, per-roller table, initial state)."""
+    geometry = RecirculatingGeometry.for_design(design)
+    n = design.n_rollers
+    lead, pitch = design.screw_lead, design.pitch
+    beta = orbital_angle(design)
+    ratio = speed_ratios(design).carrier
+    direction = 1.0 if screw_speed > 0 else -1.0
+    room = cam_ring_spacing(design, geometry) - (
+        geometry.roller_half_length_1 + geometry.roller_half_length_2
+    )
+    m_r = design.masses.roller_mass
+    # the thread's Hertz constant from paper 04's stiffness at the nominal share: all but the
+    # rollers crossing carry the load (one at a time for the presets)
+    share = max(load, 1.0) / max(n - 1, 1)
+    k_lin = min(
+        float(roller_side_stiffness(design, share, "screw")),
+        float(roller_side_stiffness(design, share, "nut")),
+    )
+    deflection = 1.5 * share / k_lin  # F = K δ^1.5 with dF/dδ = k_lin at F = share
+    k_hertz = share / deflection**1.5
+    p = np.zeros(K.P_SIZE)
+    p[K.P_N] = n
+    p[K.P_LEAD] = lead
+    p[K.P_PITCH] = pitch
+    p[K.P_M_ROLLER] = m_r
+    p[K.P_M_NUT] = design.masses.nut_mass + payload_mass
+    p[K.P_K_THREAD] = k_hertz
+    p[K.P_B_SCREW] = clearance
+    p[K.P_B_NUT] = clearance
+    p[K.P_C_THREAD] = 2.0 * THREAD_DAMPING_RATIO * math.sqrt(k_lin * m_r)
+    p[K.P_D_THREAD] = THREAD_DAMPING_DEPTH
+    p[K.P_K_CAM] = contact.stiffness
+    p[K.P_E_CAM] = contact.exponent
+    p[K.P_C_CAM] = contact.max_damping
+    p[K.P_D_CAM] = contact.depth
+    p[K.P_ROOM] = room
+    p[K.P_STROKE] = reset_stroke(design)
+    p[K.P_BETA] = beta
+    p[K.P_LIFT] = radial_lift(design)
+    p[K.P_LIFT_RAMP] = LIFT_RAMP_SHARE * beta
+    p[K.P_COT_FLANK] = 1.0 / math.tan(design.contact_angle)
+    p[K.P_DIR] = direction
+    p[K.P_OMEGA] = screw_speed
+    p[K.P_RATIO] = ratio
+    p[K.P_PHI_ENTRY] = -direction * beta  # §3.2: forward rotation enters at −β
+    p[K.P_LOAD] = load
+    p[K.P_LOAD_RAMP] = load_ramp
+    # roller 1 at the sector's entrance, roller i (i − 1)·2π/N behind it (§3.2 steps 4–6)
+    behind = np.arange(n) * 2.0 * math.pi / n
+    phi0 = p[K.P_PHI_ENTRY] - direction * behind
+    # each roller where its drift has brought it: against the platform's ring at the entrance,
+    # one lead from it just after a reset (the far ring then L + p/N − L = p/N away)
+    drift = lead * behind / (2.0 * math.pi)
+    u0 = drift if direction > 0 else room - drift
+    rollers = np.zeros((n, 3))
+    rollers[:, K.R_PHI0] = phi0
+    # centred in their grooves at the start (eqs. 35–37's assembly): e_s = e_n = 0
+    rollers[:, K.R_C_SCREW] = u0 + lead * phi0 / (2.0 * math.pi)
+    rollers[:, K.R_C_NUT] = u0 + lead * phi0 / (2.0 * math.pi)
+    v0 = lead * screw_speed / (2.0 * math.pi)
+    y0 = np.zeros(2 + 2 * n + 3)
+    y0[1] = v0
+    y0[2 : 2 + n] = u0
+    y0[2 + n : 2 + 2 * n] = v0 - lead * ratio * screw_speed / (2.0 * math.pi)
+    return p, rollers, y0
+
+
+def right_hand_side(
+    design: PRSMDesign,
+    *,
+    screw_speed: float,
+    load: float,
+    clearance: float = 5e-6,
+    payload_mass: float = 0.0,
+    load_ramp: float = 5e-3,
+    contact: ImpactContact = PAPER03_CONTACT,
+):
+    """(f, y0): the model's right-hand side f(t, y) → dy/dt and its initial state, for any ODE
+    solver (the benchmark drives scipy's with it). ``y``: nut position and velocity, the
+    rollers' positions, their velocities, then the three energy accumulators."""
+    p, rollers, y0 = _parameters(
+        design, screw_speed, load, clearance, payload_mass, load_ramp, contact
+    )
+    scratch = np.zeros((design.n_rollers, K.ROLLER_SIZE))
+
+    def f(t, y):
+        return K.forces(t, np.asarray(y, float), p, rollers, scratch, False)[0]
+
+    return f, y0
