@@ -31,13 +31,15 @@ def add_physics_commands(command) -> None:
         "--from",
         dest="preset",
         default=None,
+        default_text=f"{DEFAULT_PRESET}; paper03 with --variant recirculating",
         choices=sorted(PRESETS),
-        help=f"preset to copy (default {DEFAULT_PRESET}; paper03 for --variant recirculating)",
+        help="preset to copy",
     )
     t.add_argument(
         "--variant",
         choices=("standard", "recirculating"),
         default=None,
+        default_text="the preset's",
         help="recirculating: a paper-03 design with its cam-ring geometry written out",
     )
     t.set_defaults(handler="physics:design_template")
