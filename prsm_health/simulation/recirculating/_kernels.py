@@ -44,7 +44,10 @@ P_RATIO = 22  # carrier / screw speed
 P_PHI_ENTRY = 23  # orbital angle where a roller enters the sector [rad]
 P_LOAD = 24  # axial load on the nut, resisting forward motion [N]
 P_LOAD_RAMP = 25  # time over which the load rises from 0 [s]
-P_SIZE = 26
+P_SPALL_ANGLE = 26  # orbital angle where a nut-flank spall starts [rad]
+P_SPALL_WIDTH = 27  # its angular extent along the roller's path [rad] (0: no spall)
+P_SPALL_DEPTH = 28  # material missing from the nut flank [m]
+P_SIZE = 29
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
@@ -107,6 +110,18 @@ def _plays(p, a, inside):
 
 
 @njit(cache=True, inline="always")
+def _spall(p, phi):
+    """Depth missing from the nut flank under a roller at orbital angle φ [m], and d/dφ: a
+    spall of the nut thread at a fixed angle, its edges a tenth of its width wide."""
+    width = p[P_SPALL_WIDTH]
+    if width <= 0.0:
+        return 0.0, 0.0
+    along = (p[P_DIR] * (phi - p[P_SPALL_ANGLE])) % TWO_PI
+    value, slope = _trapezoid(along, width, 0.1 * width)
+    return p[P_SPALL_DEPTH] * value, p[P_SPALL_DEPTH] * slope * p[P_DIR]
+
+
+@njit(cache=True, inline="always")
 def _platform(p, a, inside):
     """Platform surface height above its ring's face [m] and d/da: the chamfer rises by the
     stroke over the crossing (the first β), the platform top holds it, and its exit edge drops
@@ -145,6 +160,7 @@ def forces(t, y, p, rollers, roller_out, with_out):
         phi = rollers[i, R_PHI0] + phi_dot * t
         a, inside = _sector(p, phi)
         play_s, dplay_s, play_n, dplay_n = _plays(p, a, inside)
+        pit, dpit = _spall(p, phi)
         f_roller = 0.0
         f_screw = 0.0
         # ---- thread contacts: screw side, nut side (dead-zone Hertz, damped)
@@ -162,6 +178,9 @@ def forces(t, y, p, rollers, roller_out, with_out):
                 e_dot_kin = lead * phi_dot / TWO_PI
                 b = p[P_B_NUT] + play_n
                 play_dot = dplay_n * a_dot
+                if e >= 0.0:  # the flank that carries the load (force on the nut forward)
+                    b += pit
+                    play_dot += dpit * phi_dot
             sign = 1.0 if e >= 0.0 else -1.0
             d = abs(e) - b
             force = 0.0
@@ -244,9 +263,11 @@ def mechanical_energy(t, y, p, rollers):
         phi = rollers[i, R_PHI0] + phi_dot * t
         a, inside = _sector(p, phi)
         play_s, _, play_n, _ = _plays(p, a, inside)
+        pit = _spall(p, phi)[0]
         e_s = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
         e_n = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
-        for e, b in ((e_s, p[P_B_SCREW] + play_s), (e_n, p[P_B_NUT] + play_n)):
+        b_n = p[P_B_NUT] + play_n + (pit if e_n >= 0.0 else 0.0)
+        for e, b in ((e_s, p[P_B_SCREW] + play_s), (e_n, b_n)):
             d = abs(e) - b
             if d > 0.0:
                 energy += 0.4 * p[P_K_THREAD] * d**2.5

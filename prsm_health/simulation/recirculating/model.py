@@ -86,6 +86,40 @@ LIFT_RAMP_SHARE = 0.25
 
 
 @dataclass(frozen=True)
+class NutSpall:
+    """A spall on the nut's thread flank: material missing over an arc of the rollers' path.
+
+    Every roller passes it once per carrier revolution — N·f_c, the rate of the resets: each
+    drops by ``depth`` into it, unloading, and strikes its far edge as the flank takes the load
+    back (the load sets the strike; the reset's platform impact does not feel the load).
+
+    Parameters
+    ----------
+    angle : float [rad]
+        Orbital angle (nut frame) where the spall starts, from the threadless area's entrance
+        side (−β).
+    length : float [m]
+        Its length along the thread (an arc of the orbit radius d_c/2).
+    depth : float [m]
+        Material missing from the flank, > 0.
+    """
+
+    angle: float
+    length: float
+    depth: float
+
+    def __post_init__(self):
+        require(
+            isinstance(self.angle, (int, float)) and math.isfinite(self.angle),
+            "nut_spall.angle",
+            self.angle,
+            "must be a finite angle [rad]",
+        )
+        require_positive("nut_spall.length", self.length)
+        require_positive("nut_spall.depth", self.depth)
+
+
+@dataclass(frozen=True)
 class RecirculatingRun:
     """Truth of a simulated recirculating PRSM (SI units; roller arrays are rollers × samples).
 
@@ -147,6 +181,7 @@ def simulate_recirculating(
     payload_mass: float = 0.0,
     load_ramp: float = 5e-3,
     contact: ImpactContact = PAPER03_CONTACT,
+    nut_spall: NutSpall | None = None,
     step: float = STEP,
 ) -> RecirculatingRun:
     """Simulate a recirculating PRSM at a constant screw speed under a constant axial load.
@@ -168,6 +203,8 @@ def simulate_recirculating(
         Time over which the load rises from 0.
     contact : ImpactContact
         The cam-ring contact (default paper 03 §4.1).
+    nut_spall : NutSpall or None
+        A spall on the nut's thread flank (None: healthy).
     step : float [s]
         Outer step; the guard sub-steps where a contact needs it.
 
@@ -213,7 +250,7 @@ def simulate_recirculating(
         "must be ≥ 0 [s]",
     )
     p, rollers, y0 = _parameters(
-        design, screw_speed, load, clearance, payload_mass, load_ramp, contact
+        design, screw_speed, load, clearance, payload_mass, load_ramp, contact, nut_spall
     )
     n_steps = int(round(duration / step)) + 1
     n = design.n_rollers
@@ -250,7 +287,9 @@ def simulate_recirculating(
     )
 
 
-def _parameters(design, screw_speed, load, clearance, payload_mass, load_ramp, contact):
+def _parameters(
+    design, screw_speed, load, clearance, payload_mass, load_ramp, contact, nut_spall=None
+):
     """(parameter vector, per-roller table, initial state)."""
     geometry = RecirculatingGeometry.for_design(design)
     n = design.n_rollers
@@ -298,6 +337,10 @@ def _parameters(design, screw_speed, load, clearance, payload_mass, load_ramp, c
     p[K.P_PHI_ENTRY] = -direction * beta  # §3.2: forward rotation enters at −β
     p[K.P_LOAD] = load
     p[K.P_LOAD_RAMP] = load_ramp
+    if nut_spall is not None:
+        p[K.P_SPALL_ANGLE] = nut_spall.angle
+        p[K.P_SPALL_WIDTH] = 2.0 * nut_spall.length / design.orbit_diameter
+        p[K.P_SPALL_DEPTH] = nut_spall.depth
     # roller 1 at the sector's entrance, roller i (i − 1)·2π/N behind it (§3.2 steps 4–6)
     behind = np.arange(n) * 2.0 * math.pi / n
     phi0 = p[K.P_PHI_ENTRY] - direction * behind
