@@ -178,6 +178,7 @@ def simulate_recirculating(
     load: float,
     duration: float,
     clearance: float = 5e-6,
+    clearance_nut: float | None = None,
     payload_mass: float = 0.0,
     load_ramp: float = 5e-3,
     contact: ImpactContact = PAPER03_CONTACT,
@@ -196,7 +197,10 @@ def simulate_recirculating(
         Axial load on the nut, ≥ 0, resisting forward motion.
     duration : float [s]
     clearance : float [m]
-        Half-clearance of each roller on each thread side.
+        Half-clearance of each roller on the screw side (and the nut side unless
+        ``clearance_nut``).
+    clearance_nut : float or None [m]
+        Half-clearance on the nut side (None: ``clearance``).
     payload_mass : float [kg]
         Mass moving with the nut (besides the design's nut mass).
     load_ramp : float [s]
@@ -236,6 +240,8 @@ def simulate_recirculating(
     )
     require_positive("duration", duration)
     require_positive("clearance", clearance)
+    if clearance_nut is not None:
+        require_positive("clearance_nut", clearance_nut)
     require_positive("step", step)
     require(
         isinstance(payload_mass, (int, float)) and payload_mass >= 0,
@@ -252,6 +258,8 @@ def simulate_recirculating(
     p, rollers, y0 = _parameters(
         design, screw_speed, load, clearance, payload_mass, load_ramp, contact, nut_spall
     )
+    if clearance_nut is not None:
+        p[K.P_B_NUT] = clearance_nut
     n_steps = int(round(duration / step)) + 1
     n = design.n_rollers
     out = np.zeros((n_steps, K.OUT_SIZE))

@@ -1,0 +1,140 @@
+"""A :class:`~prsm_health.simulation.scenario.Scenario` of a recirculating design through its
+dynamic model (:mod:`.model`): the same :class:`~prsm_health.core.run.Run` as the standard
+PRSM's — measured channels through the scenario's instrumentation, truth, labels, energy — for
+what the model covers, and one error naming the field for what it does not yet.
+
+Covered: a constant screw speed (forward) under a constant axial load, the thread clearances.
+The drive train around it is ideal and stiff: the motor turns N times the screw through the
+reduction (torque × 1/(N·η) while driving), the payload moves rigidly with the nut, the screw's
+thrust bearing holds it axially. The axial model has no lateral motion (the nut's tangential
+and radial accelerations are zero) and no friction (``friction_torque`` truth is zero).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from prsm_health.actuator.states import HealthState
+from prsm_health.core.channels import TRUTH_NAMES
+from prsm_health.core.errors import require
+from prsm_health.core.run import Run
+
+from ..decimation import decimate
+from ..instrumentation import bind_drive_train
+from ..thermal import housing_temperature_signal
+from .model import STEP, simulate_recirculating
+
+#: The load's rise when the profile gives no ramp [s] (a step would ring the nut for the run).
+LOAD_RAMP = 5e-3
+
+
+def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
+    """Simulate a scenario of a recirculating design; see :func:`prsm_health.simulate`.
+
+    Raises
+    ------
+    ParameterError
+        A profile or health state the recirculating model does not cover yet, named.
+    """
+    del progress  # a run of seconds: no bar
+    design, health, profile = scenario.design, scenario.health, scenario.profile
+    instrumentation, drive_train = scenario.instrumentation, scenario.drive_train
+    _require_covered(profile, health)
+    factor = max(1, int(np.ceil(1.0 / (STEP * instrumentation.sample_rate) - 1e-9)))
+    h = 1.0 / (factor * instrumentation.sample_rate)
+    ramp = profile.load_ramp_time if profile.load_ramp_time is not None else LOAD_RAMP
+    run = simulate_recirculating(
+        design,
+        screw_speed=float(profile.speed),
+        load=float(profile.load),
+        duration=profile.duration,
+        clearance=health.clearance_screw,
+        clearance_nut=health.clearance_nut,
+        payload_mass=drive_train.payload_mass,
+        load_ramp=ramp,
+        step=h,
+    )
+    n = int(round(profile.duration / h))  # the standard run's sample count at this step
+    t = run.time[:n]
+    ratio = drive_train.gear_ratio
+    load = profile.load * np.minimum(1.0, t / ramp) if ramp > 0 else np.full(n, profile.load)
+    zero = np.zeros(n)
+    truth_raw = {
+        "motor_angle": ratio * profile.speed * t,
+        "motor_speed": np.full(n, ratio * profile.speed),
+        "motor_torque": run.drive_torque[:n] / (ratio * drive_train.gear_efficiency),
+        "screw_angle": profile.speed * t,
+        "screw_speed": np.full(n, float(profile.speed)),
+        "carrier_speed": np.full(n, run.carrier_speed),
+        "nut_position": run.nut_position[:n],
+        "nut_axial_accel": run.nut_acceleration[:n],
+        "nut_tangential_accel": zero,
+        "nut_radial_x_accel": zero,
+        "nut_radial_y_accel": zero,
+        "friction_torque": zero,
+        "axial_load": load,
+        "payload_position": run.nut_position[:n],
+        "screw_axial_position": zero,
+        "load_force": load,
+    }
+    truth_raw["housing_temperature"] = housing_temperature_signal(profile.temperature, truth_raw)
+    channels = bind_drive_train(instrumentation, drive_train).measure(
+        truth_raw,
+        1.0 / h,
+        np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
+    )
+    record = np.column_stack([truth_raw[name] for name in TRUTH_NAMES])
+    decimated = decimate(record, factor)
+    truth = {name: decimated[:, k] for k, name in enumerate(TRUTH_NAMES)}
+    n_out = len(decimated)
+    time = np.arange(n_out) / instrumentation.sample_rate
+    clearances = {
+        f"clearance_{side}_realised_{stat}": value
+        for side, value in (("screw", health.clearance_screw), ("nut", health.clearance_nut))
+        for stat in ("mean", "min", "max")
+    }
+    return Run(
+        time=time,
+        channels=channels,
+        sample_rate=instrumentation.sample_rate,
+        labels={**scenario.labels(), **clearances},
+        scenario={**scenario.to_dict(), "integration_step": h, "model": "recirculating"},
+        energy={
+            "drive": float(run.work_in[n - 1]),
+            "load": float(run.work_load[n - 1]),
+            "dissipated": float(run.dissipated[n - 1]),
+            "friction": 0.0,
+        },
+        truth=truth,
+        operating=scenario.operating_point(),
+    )
+
+
+def _require_covered(profile, health) -> None:
+    """One error naming the first field the recirculating model does not cover yet."""
+    what = "the recirculating PRSM's model runs a constant speed and load so far"
+    require(profile.check is None, "profile.check", "a health check", f"{what}: no check yet")
+    require(profile.motion == "constant", "profile.motion", profile.motion, f"{what}: 'constant'")
+    require(
+        profile.load_profile == "constant",
+        "profile.load_profile",
+        profile.load_profile,
+        f"{what}: 'constant'",
+    )
+    require(profile.drive == "prescribed", "profile.drive", profile.drive, f"{what}: 'prescribed'")
+    require(profile.speed > 0, "profile.speed", profile.speed, f"{what}: > 0 (forward)")
+    require(profile.load >= 0, "profile.load", profile.load, f"{what}: ≥ 0 (resisting)")
+    nominal = HealthState()
+    for f in dataclasses.fields(HealthState):
+        if f.name in ("clearance_screw", "clearance_nut", "clearance_gear"):
+            continue
+        value = getattr(health, f.name)
+        require(
+            value == getattr(nominal, f.name),
+            f"health.{f.name}",
+            value,
+            f"not modelled for the recirculating PRSM yet (its default "
+            f"{getattr(nominal, f.name)!r} only)",
+        )
