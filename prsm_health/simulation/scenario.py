@@ -62,6 +62,7 @@ from .instrumentation import (
     list_profiles,
     load_instrumentation,
 )
+from .recirculating.scenario_run import simulate_recirculating_scenario
 
 
 def design_ratings(design: PRSMDesign) -> dict[str, float]:
@@ -328,7 +329,15 @@ class Scenario:
 
     def simulate(self, *, progress: bool = False) -> Run:
         """Simulate this scenario (:func:`simulate`) → :class:`~prsm_health.core.run.Run`."""
-        return simulate_scenario(self, progress=progress)
+        return _simulate(self, progress)
+
+
+def _simulate(scenario: Scenario, progress: bool) -> Run:
+    """The scenario through the model of its design's variant: the standard PRSM's lumped
+    dynamics, or the recirculating PRSM's (paper 03: no gears)."""
+    if scenario.design.variant == "recirculating":
+        return simulate_recirculating_scenario(scenario, progress=progress)
+    return simulate_scenario(scenario, progress=progress)
 
 
 def simulation_options(values) -> SimulationOptions:
@@ -421,4 +430,4 @@ def simulate(
         seed=int(seed),
         drive_train=drive_train or DriveTrain(),
     )
-    return simulate_scenario(scenario, progress=progress)
+    return _simulate(scenario, progress)

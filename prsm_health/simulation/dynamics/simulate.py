@@ -218,14 +218,8 @@ def integration_step(
 
 
 def simulate_scenario(scenario, *, progress: bool = False) -> Run:
-    """Simulate a :class:`~prsm_health.simulation.scenario.Scenario`; see :func:`simulate`.
-
-    A recirculating design (paper 03: no gears) runs through its own model
-    (:mod:`prsm_health.simulation.recirculating`)."""
-    if scenario.design.variant == "recirculating":
-        from ..recirculating.scenario_run import simulate_recirculating_scenario
-
-        return simulate_recirculating_scenario(scenario, progress=progress)
+    """Simulate a :class:`~prsm_health.simulation.scenario.Scenario` of a standard design; see
+    :func:`simulate`."""
     design, health, profile = scenario.design, scenario.health, scenario.profile
     instrumentation, options, seed = scenario.instrumentation, scenario.options, scenario.seed
     model = build_model(design, health, profile, options, seed, scenario.drive_train)

@@ -22,6 +22,7 @@ from prsm_health.core.errors import require
 from prsm_health.core.run import Run
 
 from ..decimation import decimate
+from ..dynamics.simulate import choose_step
 from ..instrumentation import bind_drive_train
 from ..thermal import housing_temperature_signal
 from .model import STEP, simulate_recirculating
@@ -42,8 +43,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     design, health, profile = scenario.design, scenario.health, scenario.profile
     instrumentation, drive_train = scenario.instrumentation, scenario.drive_train
     _require_covered(profile, health)
-    factor = max(1, int(np.ceil(1.0 / (STEP * instrumentation.sample_rate) - 1e-9)))
-    h = 1.0 / (factor * instrumentation.sample_rate)
+    h, factor = choose_step(STEP, instrumentation.sample_rate)  # 1/(m·f_s) ≤ the model's step
     ramp = profile.load_ramp_time if profile.load_ramp_time is not None else LOAD_RAMP
     run = simulate_recirculating(
         design,
