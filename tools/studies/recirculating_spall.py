@@ -1,6 +1,7 @@
 """A nut-flank spall on a recirculating PRSM against the reset comb on the same line.
 
     python tools/studies/recirculating_spall.py [--units 24] [--workers 2]
+        [--baseline-spread 0.05]
 
 Both the resets and a nut-flank spall strike once per roller passage, N·f_c: the comb is in
 every recording. Each unit (the paper03 preset at paper 03's 40π rad/s; load 20–60 kN, thread
@@ -28,6 +29,7 @@ import dataclasses
 import json
 import math
 from concurrent.futures import ProcessPoolExecutor
+from functools import partial
 
 import numpy as np
 
@@ -75,7 +77,7 @@ def _tsa(design, load, clearance, spall, sensor_seed):
     return tsa - tsa.mean(), run.energy_error
 
 
-def unit(job):
+def unit(job, spread=0.05):
     from prsm_health.actuator.design import preset
     from prsm_health.physics.recirculating import orbital_angle
     from prsm_health.simulation.recirculating import NutSpall
@@ -92,8 +94,9 @@ def unit(job):
             length=float(rng.uniform(1e-3, 3e-3)),
             depth=float(rng.uniform(10e-6, 30e-6)),
         )
-    # the unit's own baseline: healthy, at a load within 5 % of today's, other sensor noise
-    baseline_load = load * float(rng.uniform(0.95, 1.05))
+    # the unit's own baseline: healthy, at a load within ±spread of today's (a health check
+    # commands its load: a small spread), other sensor noise
+    baseline_load = load * float(rng.uniform(1.0 - spread, 1.0 + spread))
     baseline, _ = _tsa(design, baseline_load, clearance, None, [seed, 2])
     tsa, energy_error = _tsa(design, load, clearance, spall, [seed, 1])
     energy = tsa**2
@@ -126,16 +129,23 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--units", type=int, default=24, help="units of each class")
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument(
+        "--baseline-spread",
+        type=float,
+        default=0.05,
+        help="the baseline's load within ±this share of today's (a check commands its load)",
+    )
     args = parser.parse_args()
     jobs = [(7000 + k, k % 2 == 1) for k in range(2 * args.units)]
     with ProcessPoolExecutor(args.workers) as pool:
-        units = list(pool.map(unit, jobs))
+        units = list(pool.map(partial(unit, spread=args.baseline_spread), jobs))
     healthy = [u["off_reset_share"] for u in units if not u["spall"]]
     spalled = [u for u in units if u["spall"]]
     apart = [u for u in spalled if not (RESET_WINDOW[0] <= u["spall_phase"] < RESET_WINDOW[1])]
     change_healthy = [u["change_from_baseline"] for u in units if not u["spall"]]
     result = {
         "units_each": args.units,
+        "baseline_spread": args.baseline_spread,
         "auc_all": auc(healthy, [u["off_reset_share"] for u in spalled]),
         "auc_spall_outside_reset_window": auc(healthy, [u["off_reset_share"] for u in apart]),
         "auc_change_from_own_baseline": auc(
