@@ -556,13 +556,19 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
     features = [name for name in finite if name not in not_indicators]
     statistics = [name for name in finite if name in not_indicators]
     absent = [name for name in FEATURES if name not in finite]
+    train_rows = table[table["split"] == "train"]
+    test_rows = table[table["split"] == "test"]
+    # an indicator finite in too few training runs for every fit to see one (envelope lines
+    # whose band a run's kurtogram did not reach, …) cannot be cross-validated: left out, said
+    fewest = fit_minimum(train_rows, cv=cv, target=target)
+    finite_in = {name: int(train_rows[name].notna().sum()) for name in features}
+    too_sparse = [name for name in features if 0 < finite_in[name] < fewest]
+    features = [name for name in features if name not in too_sparse]
     present_groups = {
         group: kept
         for group, members in GROUPS.items()
         if (kept := [name for name in members if name in features])
     }
-    train_rows = table[table["split"] == "train"]
-    test_rows = table[table["split"] == "test"]
     x_train, x_test = train_rows[features], test_rows[features]
     groups = operating_point(train_rows)
     # an indicator finite in a few runs only can be absent from one fit's runs: one line, no
@@ -575,11 +581,21 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         words=("indicator", "training runs"),
     )
     notes: list[str] = []
+    if too_sparse:
+        shown = ", ".join(f"{name} ({finite_in[name]})" for name in too_sparse[:6])
+        more = f" and {len(too_sparse) - 6} more" if len(too_sparse) > 6 else ""
+        notes.append(
+            f"indicator(s) finite in fewer than the {fewest} of {len(train_rows)} training runs "
+            f"every --cv {cv} fit needs were left out: {shown}{more} (finite in that many runs); "
+            "more runs, or fewer folds, keep them"
+        )
     metrics: dict = {
         "dataset": str(dataset_dir),
         "recipe": ds.manifest["name"],
         "runs": {"train": len(train_rows), "test": len(test_rows)},
         "indicators_absent": absent,
+        # finite in too few training runs for every cross-validation fit: left out
+        "indicators_too_sparse": too_sparse,
         # what the dataset's channels and rate let each indicator group read
         "indicator_groups": usable_groups(ds.channels, ds.sample_rate),
     }

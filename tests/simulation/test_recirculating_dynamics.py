@@ -75,6 +75,25 @@ def test_a_roller_leaves_the_threads_in_the_threadless_area_and_resets_by_one_le
     assert u[before] > u[inside[0]]
 
 
+def test_a_reversing_load_crosses_the_clearance_and_keeps_the_balance(design):
+    # the load swings ±4 kN at 10 Hz around 0: the rollers cross their clearance at each
+    # reversal — the nut's lag behind the screw swings by the flanks' play plus the elastic
+    # part, so 15 µm more half-clearance on each side is 4 × 15 = 60 µm more swing (measured
+    # 45.3 → 106.0 µm: 60.7 µm); the balance over the gross work closes to 4e-4
+    # (energy_error), a 25× margin to 1e-2
+    lags = []
+    for b in (5e-6, 20e-6):
+        run = simulate_recirculating(
+            design, screw_speed=100.0, load=0.0, load_sine=(4e3, 10.0), duration=0.2, clearance=b
+        )
+        assert run.energy_error < 1e-2
+        assert run.axial_load.min() < -3.9e3 and run.axial_load.max() > 3.9e3
+        lag = run.nut_position - design.screw_lead * 100.0 * run.time / (2 * math.pi)
+        steady = run.time >= 0.05
+        lags.append(np.ptp(lag[steady]))
+    assert lags[1] - lags[0] == pytest.approx(4 * 15e-6, rel=0.25)
+
+
 def test_the_platform_impact_does_not_depend_on_the_load(runs):
     peaks = [run.cam_force.max() for run in runs.values()]
     assert max(peaks) / min(peaks) < 1.05
@@ -86,7 +105,9 @@ def test_bad_input_and_the_step_guard(design):
     with pytest.raises(ParameterError, match="forward rotation only"):
         simulate_recirculating(design, screw_speed=-SPEED, load=0.0, duration=0.01)
     with pytest.raises(ParameterError, match="load"):
-        simulate_recirculating(design, screw_speed=SPEED, load=-1.0, duration=0.01)
+        simulate_recirculating(
+            design, screw_speed=SPEED, load=[[0.0, 0.0], [1.0, 2.0]], duration=0.01
+        )
     # a cam contact far stiffer than any steel: the guard refuses rather than blow up
     stiff = ImpactContact(1e15, 1.5, 1e9, 1e-4)
     with pytest.raises(ConvergenceError, match="sub-steps"):

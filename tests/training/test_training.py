@@ -18,9 +18,9 @@ from prsm_health.actuator.states import HealthState
 from prsm_health.apps.cli import main
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.datasets import Dataset, FaultThresholds, Recipe, generate
+from prsm_health.diagnostics.model_files import load_model
 from prsm_health.signals.features import FEATURES
 from prsm_health.training import train as training
-from prsm_health.training.evaluation import SparseFeatureError
 from prsm_health.training.train import (
     calibration_minimums,
     fit_minimum,
@@ -327,22 +327,19 @@ def test_fault_labels_alone_train_a_fault_model(tiny, tmp_path, monkeypatch):
         train(ds_dir, tmp_path / "c.skops", target="clearance", cv=2, progress=False)
 
 
-def test_a_too_sparse_indicator_is_one_line_never_a_traceback(tiny, tmp_path, monkeypatch):
-    # lost_motion finite in 1 of 16 training runs (a rig whose recordings rarely reverse): the
-    # CV fold that holds that run out fits on none of its values
+def test_a_too_sparse_indicator_is_left_out_and_said_never_a_traceback(tiny, tmp_path, monkeypatch):
+    # lost_motion finite in 1 of 16 training runs (a rig whose recordings rarely reverse): a CV
+    # fold that holds that run out would fit on none of its values, so it is left out, said
     table = labels_table(16, 4, classes=["healthy", "wear"] * 10)
     ds_dir = _dataset(tiny, tmp_path / "sparse", table)
     monkeypatch.setattr(training, "dataset_features", _features_of(table, "lost_motion", 1))
     monkeypatch.setitem(training.FAULT_PARAMS, "max_iter", 3)
-    try:
-        train(ds_dir, tmp_path / "m.skops", target="fault", cv=3, progress=False)
-    except SparseFeatureError as err:  # the boosted trees cannot bin a column without values
-        message = str(err)
-        assert "\n" not in message and message.startswith(f"{ds_dir}: cannot train: --cv 3")
-        assert "lost_motion finite in 1 of 16 training runs" in message
-        assert f"finite in ≥ {fit_minimum(table, cv=3, target='fault')} of the 16" in message
-    else:  # an estimator that copes with such a column in a fit trains instead
-        assert (tmp_path / "m.skops").exists()
+    metrics = train(ds_dir, tmp_path / "m.skops", target="fault", cv=3, progress=False)
+    fewest = fit_minimum(table, cv=3, target="fault")
+    assert metrics["indicators_too_sparse"] == ["lost_motion"]
+    (said,) = [n for n in metrics["warnings"] if n.startswith("indicator(s) finite in fewer")]
+    assert f"the {fewest} of 16 training runs" in said and "lost_motion (1)" in said
+    assert "lost_motion" not in load_model(tmp_path / "m.skops")[0]["feature_names"]
 
 
 def test_the_best_cross_validated_candidate_is_shipped_and_a_winning_baseline_is_said():

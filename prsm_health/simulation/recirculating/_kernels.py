@@ -42,19 +42,22 @@ P_DIR = 20  # +1 forward, −1 reverse
 P_OMEGA = 21  # screw speed [rad/s]
 P_RATIO = 22  # carrier / screw speed
 P_PHI_ENTRY = 23  # orbital angle where a roller enters the sector [rad]
-P_LOAD = 24  # axial load on the nut, resisting forward motion [N]
+P_LOAD = 24  # (unused: the load is the knots' and the sinusoid's) [N]
 P_LOAD_RAMP = 25  # time over which the load rises from 0 [s]
 P_SPALL_ANGLE = 26  # orbital angle where a nut-flank spall starts [rad]
 P_SPALL_WIDTH = 27  # its angular extent along the roller's path [rad] (0: no spall)
 P_SPALL_DEPTH = 28  # material missing from the nut flank [m]
-P_SIZE = 29
+P_LOAD_SINE = 29  # amplitude of a sinusoid added to the load knots [N]
+P_LOAD_FREQUENCY = 30  # its frequency [Hz]
+P_SIZE = 31
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
 
 # ---- recorded per sample
 OUT_T, OUT_X, OUT_V, OUT_A, OUT_POWER, OUT_W_IN, OUT_W_DISS, OUT_W_LOAD, OUT_ENERGY = range(9)
-OUT_SIZE = 9
+OUT_LOAD = 9
+OUT_SIZE = 10
 #: Per roller per sample: relative position to the nut, screw-side and nut-side thread force,
 #: cam force (both rings), in the sector (1/0).
 ROLLER_U, ROLLER_F_SCREW, ROLLER_F_NUT, ROLLER_F_CAM, ROLLER_SECTOR = range(5)
@@ -136,8 +139,19 @@ def _platform(p, a, inside):
     return stroke, 0.0
 
 
+@njit(cache=True, inline="always")
+def _load(t, p, knots):
+    """Axial load on the nut at t [N], resisting forward motion when positive: the profile's
+    knots plus its sinusoid, brought in over the load ramp."""
+    value = np.interp(t, knots[0], knots[1])
+    value += p[P_LOAD_SINE] * math.sin(TWO_PI * p[P_LOAD_FREQUENCY] * t)
+    if p[P_LOAD_RAMP] > 0.0 and t < p[P_LOAD_RAMP]:
+        value *= t / p[P_LOAD_RAMP]
+    return value
+
+
 @njit(cache=True)
-def forces(t, y, p, rollers, roller_out, with_out):
+def forces(t, y, p, rollers, knots, roller_out, with_out):
     """Accelerations, the energy accumulators' rates and the largest contact rate [1/s].
 
     Returns (dy, rate); ``roller_out`` (rollers × ROLLER_SIZE) filled when ``with_out``.
@@ -238,7 +252,7 @@ def forces(t, y, p, rollers, roller_out, with_out):
             roller_out[i, ROLLER_F_NUT] = f_side
             roller_out[i, ROLLER_F_CAM] = f_cam
             roller_out[i, ROLLER_SECTOR] = 1.0 if inside else 0.0
-    load = p[P_LOAD] * min(1.0, t / p[P_LOAD_RAMP]) if p[P_LOAD_RAMP] > 0 else p[P_LOAD]
+    load = _load(t, p, knots)
     dy[0] = v
     dy[1] = (f_nut - load) / m_n
     dy[2 + 2 * n] = p_in
@@ -280,7 +294,7 @@ def mechanical_energy(t, y, p, rollers):
 
 
 @njit(cache=True)
-def integrate(y0, p, rollers, step, n_steps, max_substeps, out, roller_out):
+def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_out):
     """Fixed outer steps of RK4, each cut into as many equal sub-steps as the stiffest active
     contact needs (rate × sub-step ≤ 0.5, from the penetration expected at the step's end);
     records every outer step. Returns the number of steps done (< n_steps: the guard's limit
@@ -293,7 +307,7 @@ def integrate(y0, p, rollers, step, n_steps, max_substeps, out, roller_out):
     scratch = roller_out[0].copy()
     t = 0.0
     for k in range(n_steps):
-        dy, rate = forces(t, y, p, rollers, roller_out[k], True)
+        dy, rate = forces(t, y, p, rollers, knots, roller_out[k], True)
         out[k, OUT_T] = t
         out[k, OUT_X] = y[0]
         out[k, OUT_V] = y[1]
@@ -303,29 +317,30 @@ def integrate(y0, p, rollers, step, n_steps, max_substeps, out, roller_out):
         out[k, OUT_W_DISS] = y[2 + 2 * n + 1]
         out[k, OUT_W_LOAD] = y[2 + 2 * n + 2]
         out[k, OUT_ENERGY] = mechanical_energy(t, y, p, rollers)
+        out[k, OUT_LOAD] = _load(t, p, knots)
         # look ahead one step with an Euler predictor: an impact starting inside the step
         for j in range(size):
             tmp[j] = y[j] + step * dy[j]
-        _, rate_end = forces(t + step, tmp, p, rollers, scratch, False)
+        _, rate_end = forces(t + step, tmp, p, rollers, knots, scratch, False)
         rate = max(rate, rate_end)
         subs = max(1, int(math.ceil(rate * step / 0.5)))
         if subs > max_substeps:
             return k
         h = step / subs
         for _ in range(subs):
-            d1, _r = forces(t, y, p, rollers, scratch, False)
+            d1, _r = forces(t, y, p, rollers, knots, scratch, False)
             for j in range(size):
                 k1[j] = d1[j]
                 tmp[j] = y[j] + 0.5 * h * d1[j]
-            d2, _r = forces(t + 0.5 * h, tmp, p, rollers, scratch, False)
+            d2, _r = forces(t + 0.5 * h, tmp, p, rollers, knots, scratch, False)
             for j in range(size):
                 k1[j] += 2.0 * d2[j]
                 tmp[j] = y[j] + 0.5 * h * d2[j]
-            d3, _r = forces(t + 0.5 * h, tmp, p, rollers, scratch, False)
+            d3, _r = forces(t + 0.5 * h, tmp, p, rollers, knots, scratch, False)
             for j in range(size):
                 k1[j] += 2.0 * d3[j]
                 tmp[j] = y[j] + h * d3[j]
-            d4, _r = forces(t + h, tmp, p, rollers, scratch, False)
+            d4, _r = forces(t + h, tmp, p, rollers, knots, scratch, False)
             for j in range(size):
                 y[j] += h * (k1[j] + d4[j]) / 6.0
             t += h

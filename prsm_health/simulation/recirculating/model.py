@@ -29,14 +29,16 @@ Forces, each from one contact law and its energy
   top holds it, its exit edge drops over the last lift ramp. Every ring contact is the paper's
   ADAMS IMPACT law (eq. 38, §4.1: K = 1e5 N/mm, e = 1.5, C = 50 N·s/mm, d = 0.1 mm); the far
   ring's face stops a roller the push threw too far.
-- **Load.** A constant axial force on the nut opposing forward motion, ramped in over
-  ``load_ramp`` (a step would ring the nut on its threads for the whole run).
+- **Load.** An axial force on the nut, positive opposing forward motion (negative: assisting
+  it, the other flanks carry it): constant, or the profile's knots plus a sinusoid (a reversing
+  load swings it through zero: the rollers cross their clearance), ramped in over ``load_ramp``
+  (a step would ring the nut on its threads for the whole run).
 
 Idealised: the platform top holds a reset roller across the whole threadless area (2β) until the
 nut thread takes it back; the paper lays out one β per direction of rotation, so a real roller
-runs the second β free of the platform. Forward rotation only: the mirrored reverse layout is
-in the kernels, but its exit, where the loaded flank pulls the landing roller into the platform
-edge, is not validated. Not modelled (yet): friction on the platform and in the threads (the paper's μ = 0.25–0.3 on the
+runs the second β free of the platform. Forward rotation only (the load may reverse): the
+mirrored reverse layout is in the kernels, but its exit, where the loaded flank pulls the
+landing roller into the platform edge, is not validated. Not modelled (yet): friction on the platform and in the threads (the paper's μ = 0.25–0.3 on the
 platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
 (the carrier collisions of Fig. 32), radial and tilting motion; the screw's own axial and
 torsional compliance. The energy of every modelled contact is accounted for: the work of the
@@ -129,6 +131,8 @@ class RecirculatingRun:
     drive_torque : numpy.ndarray [N·m]
         The torque the prescribed screw (and, through rolling, carrier) motion takes: its
         power over ω_s.
+    axial_load : numpy.ndarray [N]
+        The load on the nut at each sample (positive resists forward motion).
     roller_position : numpy.ndarray [m]
         Each roller's axial position relative to the nut (0: against the left cam ring).
     screw_force, nut_force, cam_force : numpy.ndarray [N]
@@ -140,7 +144,7 @@ class RecirculatingRun:
     work_in, dissipated, work_load, mechanical_energy : numpy.ndarray [J]
         Cumulative work of the prescribed motion, energy the dampers took, work against the
         load; kinetic plus elastic energy.
-    screw_speed, carrier_speed, load : float
+    screw_speed, carrier_speed : float
     """
 
     time: np.ndarray
@@ -148,6 +152,7 @@ class RecirculatingRun:
     nut_velocity: np.ndarray
     nut_acceleration: np.ndarray
     drive_torque: np.ndarray
+    axial_load: np.ndarray
     roller_position: np.ndarray
     screw_force: np.ndarray
     nut_force: np.ndarray
@@ -160,14 +165,18 @@ class RecirculatingRun:
     mechanical_energy: np.ndarray
     screw_speed: float
     carrier_speed: float
-    load: float
 
     @property
     def energy_error(self) -> float:
-        """|ΔE − (W_in − W_diss − W_load)| at the end over the work put in [-]."""
+        """|ΔE − (W_in − W_diss − W_load)| at the end over the gross work that flowed in or out
+        (∫|P| dt of the drive and of the load: a reversing load's net works cancel) [-]."""
         balance = self.work_in[-1] - self.dissipated[-1] - self.work_load[-1]
         change = self.mechanical_energy[-1] - self.mechanical_energy[0]
-        scale = max(abs(self.work_in[-1]), abs(self.work_load[-1]), 1e-12)
+        drive = np.abs(self.drive_torque * self.screw_speed)
+        load = np.abs(self.axial_load * self.nut_velocity)
+        scale = max(
+            float(np.trapezoid(drive, self.time)), float(np.trapezoid(load, self.time)), 1e-12
+        )
         return abs(change - balance) / scale
 
 
@@ -175,8 +184,9 @@ def simulate_recirculating(
     design: PRSMDesign,
     *,
     screw_speed: float,
-    load: float,
+    load,
     duration: float,
+    load_sine: tuple[float, float] = (0.0, 0.0),
     clearance: float = 5e-6,
     clearance_nut: float | None = None,
     payload_mass: float = 0.0,
@@ -192,9 +202,13 @@ def simulate_recirculating(
     design : PRSMDesign
         A recirculating design (its ``[recirculation]`` geometry, or paper 03's rules).
     screw_speed : float [rad/s]
-        > 0: forward rotation (the left ring's platform resets the rollers).
-    load : float [N]
-        Axial load on the nut, ≥ 0, resisting forward motion.
+        > 0: forward rotation (the left ring's platform resets the rollers); the load may
+        reverse.
+    load : float or array of shape (2, K) [N; s, N]
+        Axial load on the nut (positive resists forward motion): a constant, or knots
+        (times, loads) interpolated linearly (``OperatingProfile.load_knots``).
+    load_sine : (float, float) [N, Hz]
+        Amplitude and frequency of a sinusoid added to the load.
     duration : float [s]
     clearance : float [m]
         Half-clearance of each roller on the screw side (and the nut side unless
@@ -232,11 +246,12 @@ def simulate_recirculating(
         "must be a finite speed > 0 [rad/s]: forward rotation only so far (the reverse ring's "
         "platform is laid out, its exit against the loaded flank not yet validated)",
     )
+    knots = _load_knots(load, duration)
     require(
-        isinstance(load, (int, float)) and math.isfinite(load) and load >= 0,
-        "load",
-        load,
-        "must be a finite force ≥ 0 [N]",
+        len(load_sine) == 2 and all(math.isfinite(v) for v in load_sine) and load_sine[1] >= 0,
+        "load_sine",
+        load_sine,
+        "must be (amplitude [N], frequency ≥ 0 [Hz])",
     )
     require_positive("duration", duration)
     require_positive("clearance", clearance)
@@ -255,16 +270,18 @@ def simulate_recirculating(
         load_ramp,
         "must be ≥ 0 [s]",
     )
+    nominal = float(np.max(np.abs(knots[1]))) + abs(float(load_sine[0]))
     p, rollers, y0 = _parameters(
-        design, screw_speed, load, clearance, payload_mass, load_ramp, contact, nut_spall
+        design, screw_speed, nominal, clearance, payload_mass, load_ramp, contact, nut_spall
     )
+    p[K.P_LOAD_SINE], p[K.P_LOAD_FREQUENCY] = float(load_sine[0]), float(load_sine[1])
     if clearance_nut is not None:
         p[K.P_B_NUT] = clearance_nut
     n_steps = int(round(duration / step)) + 1
     n = design.n_rollers
     out = np.zeros((n_steps, K.OUT_SIZE))
     roller_out = np.zeros((n_steps, n, K.ROLLER_SIZE))
-    done = K.integrate(y0, p, rollers, step, n_steps, MAX_SUBSTEPS, out, roller_out)
+    done = K.integrate(y0, p, rollers, knots, step, n_steps, MAX_SUBSTEPS, out, roller_out)
     if done < n_steps:
         raise ConvergenceError(
             f"recirculating PRSM: at t = {done * step:.6g} s a contact needs more than "
@@ -279,6 +296,7 @@ def simulate_recirculating(
         nut_velocity=out[:, K.OUT_V],
         nut_acceleration=out[:, K.OUT_A],
         drive_torque=out[:, K.OUT_POWER] / omega,
+        axial_load=out[:, K.OUT_LOAD],
         roller_position=roller_out[:, :, K.ROLLER_U].T.copy(),
         screw_force=roller_out[:, :, K.ROLLER_F_SCREW].T.copy(),
         nut_force=roller_out[:, :, K.ROLLER_F_NUT].T.copy(),
@@ -291,8 +309,26 @@ def simulate_recirculating(
         mechanical_energy=out[:, K.OUT_ENERGY],
         screw_speed=omega,
         carrier_speed=speed_ratios(design).carrier * omega,
-        load=float(load),
     )
+
+
+def _load_knots(load, duration: float) -> np.ndarray:
+    """The load as (2, K) knots [s, N], checked."""
+    if isinstance(load, (int, float)):
+        require(math.isfinite(load), "load", load, "must be a finite force [N]")
+        return np.array([[0.0, max(duration, 1e-9)], [float(load), float(load)]])
+    knots = np.asarray(load, dtype=float)
+    require(
+        knots.ndim == 2
+        and knots.shape[0] == 2
+        and knots.shape[1] >= 2
+        and bool(np.all(np.isfinite(knots)))
+        and bool(np.all(np.diff(knots[0]) > 0)),
+        "load",
+        f"array of shape {knots.shape}",
+        "must be a force [N] or (2, K ≥ 2) knots: increasing times [s], finite forces [N]",
+    )
+    return np.ascontiguousarray(knots)
 
 
 def _parameters(
@@ -385,9 +421,10 @@ def right_hand_side(
     p, rollers, y0 = _parameters(
         design, screw_speed, load, clearance, payload_mass, load_ramp, contact
     )
+    knots = _load_knots(load, 1.0)
     scratch = np.zeros((design.n_rollers, K.ROLLER_SIZE))
 
     def f(t, y):
-        return K.forces(t, np.asarray(y, float), p, rollers, scratch, False)[0]
+        return K.forces(t, np.asarray(y, float), p, rollers, knots, scratch, False)[0]
 
     return f, y0

@@ -3,7 +3,8 @@ dynamic model (:mod:`.model`): the same :class:`~prsm_health.core.run.Run` as th
 PRSM's — measured channels through the scenario's instrumentation, truth, labels, energy — for
 what the model covers, and one error naming the field for what it does not yet.
 
-Covered: a constant screw speed (forward) under a constant axial load, the thread clearances.
+Covered: a constant screw speed (forward) under the profile's axial load — constant, sinusoidal
+or reversing —, the thread clearances.
 The drive train around it is ideal and stiff: the motor turns N times the screw through the
 reduction (torque × 1/(N·η) while driving), the payload moves rigidly with the nut, the screw's
 thrust bearing holds it axially. The axial model has no lateral motion (the nut's tangential
@@ -27,7 +28,8 @@ from ..instrumentation import bind_drive_train
 from ..thermal import housing_temperature_signal
 from .model import STEP, simulate_recirculating
 
-#: The load's rise when the profile gives no ramp [s] (a step would ring the nut for the run).
+#: The load's rise from zero at the start [s]: the model starts unloaded (a step would ring the
+#: nut on its threads for the whole run).
 LOAD_RAMP = 5e-3
 
 
@@ -44,22 +46,23 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     instrumentation, drive_train = scenario.instrumentation, scenario.drive_train
     _require_covered(profile, health)
     h, factor = choose_step(STEP, instrumentation.sample_rate)  # 1/(m·f_s) ≤ the model's step
-    ramp = profile.load_ramp_time if profile.load_ramp_time is not None else LOAD_RAMP
+    knots, amplitude, frequency = profile.load_knots()
     run = simulate_recirculating(
         design,
         screw_speed=float(profile.speed),
-        load=float(profile.load),
+        load=knots,
+        load_sine=(amplitude, frequency),
         duration=profile.duration,
         clearance=health.clearance_screw,
         clearance_nut=health.clearance_nut,
         payload_mass=drive_train.payload_mass,
-        load_ramp=ramp,
+        load_ramp=LOAD_RAMP,
         step=h,
     )
     n = int(round(profile.duration / h))  # the standard run's sample count at this step
     t = run.time[:n]
     ratio = drive_train.gear_ratio
-    load = profile.load * np.minimum(1.0, t / ramp) if ramp > 0 else np.full(n, profile.load)
+    load = run.axial_load[:n]
     zero = np.zeros(n)
     truth_raw = {
         "motor_angle": ratio * profile.speed * t,
@@ -114,18 +117,11 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
 
 def _require_covered(profile, health) -> None:
     """One error naming the first field the recirculating model does not cover yet."""
-    what = "the recirculating PRSM's model runs a constant speed and load so far"
+    what = "the recirculating PRSM's model runs a constant forward speed so far"
     require(profile.check is None, "profile.check", "a health check", f"{what}: no check yet")
     require(profile.motion == "constant", "profile.motion", profile.motion, f"{what}: 'constant'")
-    require(
-        profile.load_profile == "constant",
-        "profile.load_profile",
-        profile.load_profile,
-        f"{what}: 'constant'",
-    )
     require(profile.drive == "prescribed", "profile.drive", profile.drive, f"{what}: 'prescribed'")
     require(profile.speed > 0, "profile.speed", profile.speed, f"{what}: > 0 (forward)")
-    require(profile.load >= 0, "profile.load", profile.load, f"{what}: ≥ 0 (resisting)")
     nominal = HealthState()
     for f in dataclasses.fields(HealthState):
         if f.name in ("clearance_screw", "clearance_nut", "clearance_gear"):
