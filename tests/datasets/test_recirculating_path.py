@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[2]
 def test_a_recirculating_recipe_generates_trains_and_diagnoses(tmp_path, capsys):
     data = tomllib.loads((ROOT / "datasets" / "recirculating.toml").read_text())
     data["duration"] = 0.12  # two load reversals (10 Hz)
-    data["sweep"]["repeats"] = 5
+    data["sweep"]["repeats"] = 10
     generate(Recipe.from_dict(data), tmp_path / "ds", progress=False)
     ds = Dataset(tmp_path / "ds")
     assert len(ds) == 20 and ds.design.variant == "recirculating"
@@ -77,6 +77,8 @@ def test_a_recirculating_recipe_generates_trains_and_diagnoses(tmp_path, capsys)
         "paper03",
         "--duration",
         "0.12",
+        "--speed",
+        "125.66",  # the recipe's (paper 03's 40π)
         "--clearance",
         "20e-6",
         "--load",
@@ -95,7 +97,7 @@ def test_a_recirculating_recipe_generates_trains_and_diagnoses(tmp_path, capsys)
     diagnose = ["diagnose", str(tmp_path / "rev.parquet"), "--model", str(tmp_path / "m.skops")]
     assert main([*diagnose, "--json"]) == 0
     answer = json.loads(capsys.readouterr().out)
-    assert answer["observability"]["fault"] > 0
+    assert answer["observability"]["fault"] > 0, answer["warnings"]
 
 
 @pytest.mark.parametrize(
