@@ -42,14 +42,13 @@ P_DIR = 20  # +1 forward, −1 reverse
 P_OMEGA = 21  # screw speed [rad/s]
 P_RATIO = 22  # carrier / screw speed
 P_PHI_ENTRY = 23  # orbital angle where a roller enters the sector [rad]
-P_LOAD = 24  # (unused: the load is the knots' and the sinusoid's) [N]
-P_LOAD_RAMP = 25  # time over which the load rises from 0 [s]
-P_SPALL_ANGLE = 26  # orbital angle where a nut-flank spall starts [rad]
-P_SPALL_WIDTH = 27  # its angular extent along the roller's path [rad] (0: no spall)
-P_SPALL_DEPTH = 28  # material missing from the nut flank [m]
-P_LOAD_SINE = 29  # amplitude of a sinusoid added to the load knots [N]
-P_LOAD_FREQUENCY = 30  # its frequency [Hz]
-P_SIZE = 31
+P_LOAD_RAMP = 24  # time over which the load rises from 0 [s] (the load: knots + sinusoid)
+P_SPALL_ANGLE = 25  # orbital angle where a nut-flank spall starts [rad]
+P_SPALL_WIDTH = 26  # its angular extent along the roller's path [rad] (0: no spall)
+P_SPALL_DEPTH = 27  # material missing from the nut flank [m]
+P_LOAD_SINE = 28  # amplitude of a sinusoid added to the load knots [N]
+P_LOAD_FREQUENCY = 29  # its frequency [Hz]
+P_SIZE = 30
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2

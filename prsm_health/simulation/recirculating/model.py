@@ -332,9 +332,10 @@ def _load_knots(load, duration: float) -> np.ndarray:
 
 
 def _parameters(
-    design, screw_speed, load, clearance, payload_mass, load_ramp, contact, nut_spall=None
+    design, screw_speed, nominal_load, clearance, payload_mass, load_ramp, contact, nut_spall=None
 ):
-    """(parameter vector, per-roller table, initial state)."""
+    """(parameter vector, per-roller table, initial state); ``nominal_load`` [N] the largest
+    load, which sets the threads' Hertz constant."""
     geometry = RecirculatingGeometry.for_design(design)
     n = design.n_rollers
     lead, pitch = design.screw_lead, design.pitch
@@ -347,7 +348,7 @@ def _parameters(
     m_r = design.masses.roller_mass
     # the thread's Hertz constant from paper 04's stiffness at the nominal share: all but the
     # rollers crossing carry the load (one at a time for the presets)
-    share = max(load, 1.0) / max(n - 1, 1)
+    share = max(abs(nominal_load), 1.0) / max(n - 1, 1)
     k_lin = min(
         float(roller_side_stiffness(design, share, "screw")),
         float(roller_side_stiffness(design, share, "nut")),
@@ -379,7 +380,6 @@ def _parameters(
     p[K.P_OMEGA] = screw_speed
     p[K.P_RATIO] = ratio
     p[K.P_PHI_ENTRY] = -direction * beta  # §3.2: forward rotation enters at −β
-    p[K.P_LOAD] = load
     p[K.P_LOAD_RAMP] = load_ramp
     if nut_spall is not None:
         p[K.P_SPALL_ANGLE] = nut_spall.angle
