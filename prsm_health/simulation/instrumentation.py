@@ -70,6 +70,12 @@ DEFAULT_PROFILE = "flight-ema"
 DEFAULT_SAMPLE_RATE = 20_000.0
 
 
+def sensor_rng(sensors_seed: int) -> np.random.Generator:
+    """The random stream every sensor of a run draws from (its own child per channel, in
+    :meth:`Instrumentation.measure`): the run's sensor seed and the tag "SENS"."""
+    return np.random.default_rng([sensors_seed, 0x53454E53])
+
+
 def bind_drive_train(instrumentation, drive_train):
     """The instrumentation with its drive sensors bound to ``drive_train`` (one declaration of
     the motor and the reduction): the angle sensor and the speed estimate report the output

@@ -16,7 +16,7 @@ from prsm_health.core.errors import SimulationError
 from prsm_health.core.run import Run
 
 from ..decimation import decimate
-from ..instrumentation import bind_drive_train
+from ..instrumentation import bind_drive_train, sensor_rng
 from ..thermal import housing_temperature_signal
 from . import _kernels
 from . import layout as L
@@ -234,7 +234,7 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     channels = bind_drive_train(instrumentation, scenario.drive_train).measure(
         truth_raw,
         1.0 / h,
-        np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
+        sensor_rng(scenario.sensors_seed),
     )
     # the record's columns filtered together, in place (decimation's kernel)
     truth = _truth_from_record(decimate(record, factor))

@@ -326,8 +326,9 @@ def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_ou
         if subs > max_substeps:
             return k
         h = step / subs
-        for _ in range(subs):
-            d1, _r = forces(t, y, p, rollers, knots, scratch, False)
+        for sub in range(subs):
+            # the first sub-step starts where the recorded forces were taken: reuse them
+            d1 = dy if sub == 0 else forces(t, y, p, rollers, knots, scratch, False)[0]
             for j in range(size):
                 k1[j] = d1[j]
                 tmp[j] = y[j] + 0.5 * h * d1[j]

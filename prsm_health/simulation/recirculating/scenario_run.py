@@ -24,7 +24,7 @@ from prsm_health.core.run import Run
 
 from ..decimation import decimate
 from ..dynamics.simulate import choose_step
-from ..instrumentation import bind_drive_train
+from ..instrumentation import bind_drive_train, sensor_rng
 from ..thermal import housing_temperature_signal
 from .model import STEP, simulate_recirculating
 
@@ -86,7 +86,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     channels = bind_drive_train(instrumentation, drive_train).measure(
         truth_raw,
         1.0 / h,
-        np.random.default_rng([scenario.sensors_seed, 0x53454E53]),  # "SENS": its sensors
+        sensor_rng(scenario.sensors_seed),
     )
     record = np.column_stack([truth_raw[name] for name in TRUTH_NAMES])
     decimated = decimate(record, factor)
