@@ -2,7 +2,8 @@
 
 A :class:`~prsm_health.actuator.states.HealthState` holds its clearances and lubricant state plus a list
 of faults, each a mechanism the dynamics model makes (docs/faults.md): a flank :class:`Spall`,
-gear tooth damage, :class:`PreloadLoss`. Every kind has a ``kind`` name, a ``location`` where it
+gear tooth damage, :class:`PreloadLoss`, and the recirculating PRSM's own
+(:class:`CamWear`, :class:`PlatformLoss`, :class:`ReentryEdgeDamage`). Every kind has a ``kind`` name, a ``location`` where it
 applies, and one **severity** field (its SI size, e.g. a spall's depth) that recipes scale when
 they sweep severities.
 
@@ -79,6 +80,8 @@ class Spall:
     kind: ClassVar[str] = "spall"
     severity_field: ClassVar[str] = "length"
     locations: ClassVar[tuple[str, ...]] = SPALL_LOCATIONS
+    #: The design variants whose model makes this fault (the recirculating one: a nut spall).
+    variants: ClassVar[tuple[str, ...]] = ("standard", "recirculating")
 
     location: str = "screw"
     depth: float = 20e-6
@@ -117,6 +120,7 @@ class PreloadLoss:
     """
 
     kind: ClassVar[str] = "preload_loss"
+    variants: ClassVar[tuple[str, ...]] = ("standard",)
     severity_field: ClassVar[str] = "fraction"
     locations: ClassVar[tuple[str, ...]] = ("nut",)
 
@@ -154,6 +158,7 @@ class ToothCrack:
     """
 
     kind: ClassVar[str] = "tooth_crack"
+    variants: ClassVar[tuple[str, ...]] = ("standard",)
     severity_field: ClassVar[str] = "depth"
     locations: ClassVar[tuple[str, ...]] = GEAR_LOCATIONS
 
@@ -194,6 +199,7 @@ class ToothPit:
     """
 
     kind: ClassVar[str] = "tooth_pit"
+    variants: ClassVar[tuple[str, ...]] = ("standard",)
     severity_field: ClassVar[str] = "depth"
     locations: ClassVar[tuple[str, ...]] = GEAR_LOCATIONS
 
@@ -215,8 +221,100 @@ class ToothPit:
         _require_index("faults.roller", self.roller)
 
 
+# ------------------------------------------------------------- the recirculating PRSM's own
+@dataclass(frozen=True)
+class CamWear:
+    """Wear of a recirculating PRSM's cam-ring chamfer (paper 03 §2: the chamfer that pushes
+    each roller one lead forward across the threadless area): every reset strikes the chamfer's
+    entrance, and the strikes wear it down there, tapering to nothing at the platform's top.
+    The roller meets the worn chamfer later and climbs it faster: the reset's entry pulse comes
+    later in the passage and harder, whatever the load
+    (:mod:`prsm_health.simulation.recirculating.model`).
+
+    Parameters
+    ----------
+    depth : float [m]
+        Axial depth worn off at the chamfer's entrance (the severity), ≤ half the reset stroke.
+    """
+
+    kind: ClassVar[str] = "cam_wear"
+    variants: ClassVar[tuple[str, ...]] = ("recirculating",)
+    severity_field: ClassVar[str] = "depth"
+    locations: ClassVar[tuple[str, ...]] = ("cam_ring",)
+
+    location: str = "cam_ring"
+    depth: float = 0.1e-3
+
+    def __post_init__(self):
+        _require_location(self)
+        require_range("faults.depth", self.depth, 0.0, 5e-3, unit="m")
+
+
+@dataclass(frozen=True)
+class PlatformLoss:
+    """Height lost by a recirculating PRSM's cam-ring platform (wear or plastic flattening of
+    the convex top that holds a reset roller): the chamfer pushes the roller L − h instead of
+    one lead, and unless the push throws it further the nut thread must push the landing roller
+    the rest — an incomplete reset, toward jamming once h reaches half a pitch (refused there).
+
+    Parameters
+    ----------
+    height : float [m]
+        Height lost (the severity), below 0.4 of the thread pitch.
+    """
+
+    kind: ClassVar[str] = "platform_loss"
+    variants: ClassVar[tuple[str, ...]] = ("recirculating",)
+    severity_field: ClassVar[str] = "height"
+    locations: ClassVar[tuple[str, ...]] = ("cam_ring",)
+
+    location: str = "cam_ring"
+    height: float = 0.1e-3
+
+    def __post_init__(self):
+        _require_location(self)
+        require_range("faults.height", self.height, 0.0, 5e-3, unit="m")
+
+
+@dataclass(frozen=True)
+class ReentryEdgeDamage:
+    """Damage at a recirculating PRSM's nut-thread re-entry edge, where each reset roller lands
+    back on the nut thread after the threadless area: material missing from both flanks over
+    ``length`` of the rollers' path after the exit, on every engaged turn. The roller takes its
+    share of the load back later and harder (a landing strike that grows with the load).
+
+    Parameters
+    ----------
+    length : float [m]
+        Extent along the rollers' path (the severity).
+    depth : float [m]
+        Material missing from each flank there, up to 0.4 mm (a chipped thread start). Below
+        what the reset leaves between the landing roller and its groove (up to p/N: the
+        push throws it against the far ring) the flank meets the roller during its lift's
+        ramp anyway and the damage barely shows; deeper, the landing waits for the intact
+        thread (measured: docs/faults.md).
+    """
+
+    kind: ClassVar[str] = "reentry_edge"
+    variants: ClassVar[tuple[str, ...]] = ("recirculating",)
+    severity_field: ClassVar[str] = "length"
+    locations: ClassVar[tuple[str, ...]] = ("nut",)
+
+    location: str = "nut"
+    length: float = 1e-3
+    depth: float = 0.15e-3
+
+    def __post_init__(self):
+        _require_location(self)
+        require_range("faults.length", self.length, 1e-5, 10e-3, unit="m")
+        require_range("faults.depth", self.depth, 1e-7, 0.4e-3, unit="m")
+
+
 #: Fault kinds by name (``kind`` of a ``[[faults]]`` table).
-FAULT_KINDS: dict[str, type] = {cls.kind: cls for cls in (Spall, ToothCrack, ToothPit, PreloadLoss)}
+FAULT_KINDS: dict[str, type] = {
+    cls.kind: cls
+    for cls in (Spall, ToothCrack, ToothPit, PreloadLoss, CamWear, PlatformLoss, ReentryEdgeDamage)
+}
 
 
 def _require_location(fault) -> None:
@@ -281,6 +379,8 @@ FAULT_CLASSES = (
     "spall",
     "tooth_damage",
     "preload_loss",
+    "cam_ring",
+    "reentry_edge",
 )
 
 
@@ -289,7 +389,10 @@ FAULT_CLASSES = (
 FAULT_RULE = (
     "A run's class, in this order of precedence: spall when it has a spall longer than spall "
     "[m]; tooth_damage when a gear tooth has a crack or pit deeper than tooth_damage [m]; "
-    "severe_wear when its largest thread clearance ≥ severe_wear [m]; wear when ≥ wear [m]; "
+    "reentry_edge when a recirculating nut's re-entry edge is damaged over more than "
+    "reentry_edge [m]; cam_ring when a recirculating cam ring's chamfer is worn or its "
+    "platform lost more than cam_ring [m]; severe_wear when its largest thread clearance ≥ "
+    "severe_wear [m]; wear when ≥ wear [m]; "
     "preload_loss when it has lost a share ≥ preload_loss of a preload; lubrication when its "
     "friction scale ≥ lubrication [-] or its lubricant degradation or starvation ≥ lubricant "
     "[-]; else healthy. Localised damage comes first because it grows to the end of the unit "
@@ -310,6 +413,8 @@ class FaultThresholds:
     tooth_damage: float = 0.0
     preload_loss: float = 0.5
     lubricant: float = 0.5
+    reentry_edge: float = 0.0
+    cam_ring: float = 0.0
 
     def classify(self, health) -> str:
         """The primary class of a :class:`~prsm_health.actuator.states.HealthState`."""
@@ -322,6 +427,10 @@ class FaultThresholds:
         tooth = max(by_kind.get("tooth_crack", 0.0), by_kind.get("tooth_pit", 0.0))
         if tooth > self.tooth_damage:
             return "tooth_damage"
+        if by_kind.get("reentry_edge", 0.0) > self.reentry_edge:
+            return "reentry_edge"
+        if max(by_kind.get("cam_wear", 0.0), by_kind.get("platform_loss", 0.0)) > self.cam_ring:
+            return "cam_ring"
         if clearance >= self.severe_wear:
             return "severe_wear"
         if clearance >= self.wear:

@@ -276,6 +276,20 @@ TRUTH_CHANNELS: tuple[Channel, ...] = (
         "steady contact-to-housing rise of the run's friction power",
         "true value; measured channel housing_temperature is its sensor reading",
     ),
+    # The recirculating PRSM's own (paper 03): absent from a standard PRSM's runs.
+    _truth(
+        "cam_force",
+        "N",
+        "recirculating PRSM: the cam rings' axial force on the rollers, summed — the largest "
+        "within each sample's interval (the ≈ 20 µs reset pulse kept, not filtered away)",
+        "inside the nut: no sensor reaches the cam ring",
+    ),
+    _truth(
+        "reset_count",
+        "1",
+        "recirculating PRSM: crossings of the threadless area the rollers completed so far",
+        "inside the nut: no sensor counts the resets",
+    ),
 )
 
 #: Measured channel names in contract order (the keys a :class:`Run`'s channels may have).
@@ -284,6 +298,12 @@ CHANNEL_NAMES: tuple[str, ...] = tuple(c.name for c in CHANNELS)
 MEASURED_NAMES: tuple[str, ...] = CHANNEL_NAMES
 #: Truth signal names in the simulator's order (the keys a :class:`Run`'s truth may have).
 TRUTH_NAMES: tuple[str, ...] = tuple(c.name for c in TRUTH_CHANNELS)
+#: The truth only the recirculating PRSM's model gives (no cam ring, no resets elsewhere).
+RECIRCULATING_TRUTH: tuple[str, ...] = ("cam_force", "reset_count")
+#: The truth of a standard PRSM's run: every other signal, in the simulator's order.
+STANDARD_TRUTH_NAMES: tuple[str, ...] = tuple(
+    n for n in TRUTH_NAMES if n not in RECIRCULATING_TRUTH
+)
 
 
 def truth_column(name: str) -> str:

@@ -138,6 +138,14 @@ class Scenario:
             self.sensor_seed,
             "must be an integer ≥ 0 (or absent: the seed's)",
         )
+        for fault in self.health.faults:
+            require(
+                self.design.variant in fault.variants,
+                "faults.kind",
+                fault.kind,
+                f"is a fault of the {' or '.join(fault.variants)} PRSM, not of this "
+                f"{self.design.variant} design",
+            )
         self._resolve_loads()
 
     def _resolve_loads(self) -> None:

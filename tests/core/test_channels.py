@@ -12,12 +12,16 @@ from prsm_health.simulation.dynamics.simulate import _truth_from_record
 def test_the_kernel_records_every_truth_signal_in_contract_order():
     # The kernel's record columns (layout C_<NAME>) are the truth signals, in the order of
     # TRUTH_CHANNELS; the simulator names them from that order. The truth signals after them
-    # (housing_temperature) are derived from the record, not recorded.
+    # (housing_temperature) are derived from the record, not recorded; the recirculating
+    # model's own (cam_force, reset_count) come from its own model.
     recorded = channels.TRUTH_NAMES[: layout.N_CHANNELS]
     assert [getattr(layout, "C_" + name.upper()) for name in recorded] == list(
         range(layout.N_CHANNELS)
     )
-    assert channels.TRUTH_NAMES[layout.N_CHANNELS :] == ("housing_temperature",)
+    assert channels.TRUTH_NAMES[layout.N_CHANNELS :] == (
+        "housing_temperature",
+        *channels.RECIRCULATING_TRUTH,
+    )
     raw = np.arange(5.0 * layout.N_CHANNELS).reshape(5, layout.N_CHANNELS)
     truth = _truth_from_record(raw)
     assert tuple(truth) == recorded
@@ -29,7 +33,7 @@ def test_measured_and_truth_are_apart():
     assert all(c.kind == channels.MEASURED for c in channels.CHANNELS)
     assert all(c.kind == channels.TRUTH for c in channels.TRUTH_CHANNELS)
     assert channels.CHANNEL_NAMES == tuple(c.name for c in channels.CHANNELS)
-    assert len(set(channels.TRUTH_NAMES)) == len(channels.TRUTH_NAMES) == 17
+    assert len(set(channels.TRUTH_NAMES)) == len(channels.TRUTH_NAMES) == 19
     # No truth-only signal is a channel; the shared names are the true value of what a sensor
     # reads, and are told apart in files by the truth_ prefix.
     assert {"friction_torque", "carrier_speed", "motor_torque", "load_force"}.isdisjoint(

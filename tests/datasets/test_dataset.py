@@ -13,7 +13,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
+from prsm_health.core.channels import CHANNEL_NAMES, STANDARD_TRUTH_NAMES, UNITS, truth_column
 from prsm_health.datasets import Dataset, Recipe, RecipeError, generate, load_recipe
 from prsm_health.simulation.scenario import simulate
 
@@ -175,7 +175,7 @@ def test_workers_1_and_2_identical_and_readers(recipe_path, tmp_path):
     runs_pl = pl.read_parquet(tmp_path / "a" / "runs.parquet")
     assert runs_pl.height == 6
     signals_pl = pl.read_parquet(str(tmp_path / "a" / "signals" / "*.parquet"))
-    truth_columns = [truth_column(n) for n in TRUTH_NAMES]
+    truth_columns = [truth_column(n) for n in STANDARD_TRUTH_NAMES]
     assert signals_pl.columns == ["run_id", "time", *CHANNEL_NAMES, *truth_columns]
     assert manifest["truth"] == {c: UNITS[c] for c in truth_columns}
     assert "carrier_speed" not in manifest["channels"]
@@ -210,8 +210,8 @@ def test_dataset_run_equals_simulation(recipe_path, tmp_path):
     assert np.array_equal(stored.time, direct.time)
     for name in CHANNEL_NAMES:  # float32 storage: equal to float32 precision
         assert np.array_equal(stored[name], direct[name].astype(np.float32).astype(float)), name
-    assert list(stored.truth) == list(TRUTH_NAMES)
-    for name in TRUTH_NAMES:
+    assert list(stored.truth) == list(STANDARD_TRUTH_NAMES)
+    for name in STANDARD_TRUTH_NAMES:
         expected = direct.truth[name].astype(np.float32).astype(float)
         assert np.array_equal(stored.truth[name], expected), name
     assert stored.labels["clearance_screw"] == scenario.health.clearance_screw
@@ -240,7 +240,7 @@ def test_runs_with_some_channels_are_stored_as_they_are(recipe_path, tmp_path, m
     kept = tuple(c for c in CHANNEL_NAMES if c not in dropped)
     assert ds.channels == kept and tuple(ds.manifest["channels"]) == ("time", *kept)
     run = ds.run(1)
-    assert tuple(run.channels) == kept and list(run.truth) == list(TRUTH_NAMES)
+    assert tuple(run.channels) == kept and list(run.truth) == list(STANDARD_TRUTH_NAMES)
     assert "axial_load" in run.truth  # the truth is whole whatever the sensors
 
 

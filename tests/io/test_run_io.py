@@ -9,7 +9,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from prsm_health import HealthState, OperatingProfile, simulate
-from prsm_health.core.channels import CHANNEL_NAMES, TRUTH_NAMES, UNITS, truth_column
+from prsm_health.core.channels import CHANNEL_NAMES, STANDARD_TRUTH_NAMES, UNITS, truth_column
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.io.csv import read_csv
 from prsm_health.io.parquet import read_run_parquet, write_run_parquet
@@ -27,8 +27,8 @@ def test_round_trip_exact(tmp_path, run):
     assert np.array_equal(back.time, run.time)
     for name in CHANNEL_NAMES:
         assert np.array_equal(back[name], run[name]), name
-    assert list(back.truth) == list(TRUTH_NAMES)
-    for name in TRUTH_NAMES:
+    assert list(back.truth) == list(STANDARD_TRUTH_NAMES)
+    for name in STANDARD_TRUTH_NAMES:
         assert np.array_equal(back.truth[name], run.truth[name]), name
     assert back.labels == json.loads(json.dumps(run.labels))
 
@@ -36,7 +36,7 @@ def test_round_trip_exact(tmp_path, run):
 def test_independent_readers(tmp_path, run):
     path = write_run_parquet(run, tmp_path / "run.parquet")
     frame = pd.read_parquet(path)
-    truth_columns = [truth_column(n) for n in TRUTH_NAMES]
+    truth_columns = [truth_column(n) for n in STANDARD_TRUTH_NAMES]
     assert list(frame.columns) == ["time", *CHANNEL_NAMES, *truth_columns]
     table = pq.read_table(path)
     assert np.array_equal(table.column("truth_friction_torque"), run.truth["friction_torque"])
@@ -79,7 +79,7 @@ def test_simulated_truth_is_the_physics_without_sensor_errors(run):
     # the motor side for angle and torque. With the default drive train the linkage force
     # (axial_load) differs from the applied force by the payload's vibration, and the screw
     # sits pushed back on its thrust bearing.
-    assert list(run.truth) == list(TRUTH_NAMES)
+    assert list(run.truth) == list(STANDARD_TRUTH_NAMES)
     assert "carrier_speed" not in run.channels and "friction_torque" not in run.channels
     # the resolver is on the motor: the drive reports the screw angle as its reading / N
     ratio = run.scenario["drive_train"]["gear_ratio"]
@@ -104,7 +104,9 @@ def test_files_without_truth_and_truth_columns_in_csv(tmp_path, run):
     # a truth column alone is no recording.
     run.to_frame().to_csv(tmp_path / "run.csv", index=False)
     csv = read_csv(tmp_path / "run.csv")
-    assert list(csv.channels) == list(CHANNEL_NAMES) and list(csv.truth) == list(TRUTH_NAMES)
+    assert list(csv.channels) == list(CHANNEL_NAMES) and list(csv.truth) == list(
+        STANDARD_TRUTH_NAMES
+    )
     assert np.allclose(csv.truth["carrier_speed"], run.truth["carrier_speed"], rtol=1e-15)
     only_truth = run.to_frame()[["time", "truth_nut_axial_accel", "truth_friction_torque"]]
     only_truth.to_csv(tmp_path / "truth.csv", index=False)

@@ -131,3 +131,103 @@ def test_a_nut_spall_unloads_each_roller_passing_it_and_keeps_the_balance(design
     assert abs(run.nut_force[0, on]).mean() < 0.7 * abs(run.nut_force[0, off]).mean()
     with pytest.raises(ParameterError, match="nut_spall.depth"):
         NutSpall(angle=0.0, length=1e-3, depth=0.0)
+
+
+def _onsets(run, force, beta, threshold):
+    """Orbital angle after each roller's entry into the threadless area where |force| first
+    exceeds ``threshold`` [N], over β (settled entries only)."""
+    out = []
+    dt = run.time[1] - run.time[0]
+    for inside, f in zip(run.in_sector, force):
+        for k in np.flatnonzero(~inside[:-1] & inside[1:]) + 1:
+            hit = np.flatnonzero(np.abs(f[k : k + 4000]) > threshold)
+            if run.time[k] > SETTLED and len(hit):
+                out.append(hit[0] * dt * run.carrier_speed / beta)
+    return np.array(out)
+
+
+def test_cam_wear_meets_the_chamfer_later_and_harder(design, runs):
+    # Geometry, not a trajectory: a chamfer worn w at its entrance (tapering to 0 at its top)
+    # is met where (stroke + w)·a/β = w, a = β·w/(stroke + w) = β/6 for w = 0.2 mm and the
+    # 1 mm stroke — 8 ± 1 entries averaged, each within a step (2 µs ≈ 0.002 β).
+    from prsm_health.physics.recirculating import orbital_angle
+
+    beta = orbital_angle(design)
+    worn = simulate_recirculating(
+        design, screw_speed=SPEED, load=2e4, duration=0.1, cam_wear=0.2e-3
+    )
+    assert worn.energy_error < 1e-2
+    new_onset = _onsets(runs[20.0], runs[20.0].cam_force, beta, 1.0).mean()
+    worn_onset = _onsets(worn, worn.cam_force, beta, 1.0).mean()
+    assert worn_onset - new_onset == pytest.approx(1 / 6, abs=0.03)
+    # the worn chamfer climbs faster: the pulse's peak rises (measured +8 %; > 2 % asked)
+    peak = [np.abs(r.cam_force[:, r.time > SETTLED]).max(axis=1).mean() for r in (runs[20.0], worn)]
+    assert peak[1] > 1.02 * peak[0]
+
+
+def test_a_chipped_reentry_edge_delays_the_landing_to_the_intact_thread(design, runs):
+    # A chip deeper than what the reset leaves between the landing roller and its groove
+    # (up to p/N = 83 µm) holds the load off the landing roller until the intact thread:
+    # measured 0.98 β after the exit for a 1 mm (= 1.0 β of orbit) chip 0.15 mm deep, against
+    # 0.001 β for an intact edge; the bounds are a tenth of β wide.
+    from prsm_health.physics.recirculating import orbital_angle
+    from prsm_health.simulation.recirculating import ReentryEdge
+
+    beta = orbital_angle(design)
+    chipped = simulate_recirculating(
+        design,
+        screw_speed=SPEED,
+        load=2e4,
+        duration=0.1,
+        reentry_edge=ReentryEdge(length=1e-3, depth=0.15e-3),
+    )
+    assert chipped.energy_error < 1e-2 and chipped.resets.sum() >= 10
+    share = 2e4 / (design.n_rollers - 1)
+
+    def landing(run):
+        # the loaded nut flank taking half the roller's share back, from the sector's exit
+        out = []
+        dt = run.time[1] - run.time[0]
+        for inside, f in zip(run.in_sector, run.nut_force):
+            for k in np.flatnonzero(inside[:-1] & ~inside[1:]) + 1:
+                hit = np.flatnonzero(np.abs(f[k : k + 4000]) > 0.5 * share)
+                if run.time[k] > SETTLED and len(hit):
+                    out.append(hit[0] * dt * run.carrier_speed / beta)
+        return np.array(out)
+
+    assert landing(runs[20.0]).mean() < 0.1
+    assert 0.85 < landing(chipped).mean() < 1.1
+    k = chipped.time > SETTLED
+    assert chipped.nut_acceleration[k].std() > 1.3 * runs[20.0].nut_acceleration[k].std()
+
+
+def test_ring_faults_out_of_range_are_refused(design):
+    with pytest.raises(ParameterError, match="platform_loss"):
+        simulate_recirculating(
+            design, screw_speed=SPEED, load=2e4, duration=0.01, platform_loss=0.5e-3
+        )
+    with pytest.raises(ParameterError, match="cam_wear"):
+        simulate_recirculating(design, screw_speed=SPEED, load=2e4, duration=0.01, cam_wear=1e-3)
+
+
+def test_a_scenario_carries_the_recirculating_faults_and_its_truth():
+    from prsm_health.simulation.scenario import Scenario
+
+    base = {"design": "paper03", "profile": {"speed": SPEED, "duration": 0.03, "load": 2e4}}
+    faults = [
+        {"kind": "spall", "location": "nut", "depth": 20e-6, "length": 2e-3},
+        {"kind": "cam_wear", "depth": 0.1e-3},
+        {"kind": "platform_loss", "height": 0.1e-3},
+        {"kind": "reentry_edge"},
+    ]
+    run = Scenario.from_dict({**base, "health": {"faults": faults}}).simulate()
+    assert run.labels["fault_kinds"] == "cam_wear+platform_loss+reentry_edge+spall"
+    # the resets so far (one roller enters at t = 0; 12 pass in 2π/ω_c) and the cam pulses
+    assert run.truth["reset_count"][-1] >= 1 and np.all(np.diff(run.truth["reset_count"]) >= 0)
+    assert run.truth["cam_force"].max() > 100.0  # N: the platform's impact (≈ 350–600 N)
+    with pytest.raises(ParameterError, match="nut's loaded flank"):
+        Scenario.from_dict(
+            {**base, "health": {"faults": [{"kind": "spall", "location": "screw"}]}}
+        ).simulate()
+    with pytest.raises(ParameterError, match="recirculating PRSM, not of this standard"):
+        Scenario.from_dict({"design": "paper01", "health": {"faults": [faults[1]]}})

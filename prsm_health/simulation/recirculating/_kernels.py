@@ -48,7 +48,12 @@ P_SPALL_WIDTH = 26  # its angular extent along the roller's path [rad] (0: no sp
 P_SPALL_DEPTH = 27  # material missing from the nut flank [m]
 P_LOAD_SINE = 28  # amplitude of a sinusoid added to the load knots [N]
 P_LOAD_FREQUENCY = 29  # its frequency [Hz]
-P_SIZE = 30
+P_SPALL_SHARE = 30  # share of the engaged thread turns the spall is on (1/n_t: one turn)
+P_CAM_WEAR = 31  # material worn off the chamfer at its entrance [m], tapering to 0 at its top
+P_PLATFORM_LOSS = 32  # height the platform lost [m]: the reset falls short by it
+P_EDGE_WIDTH = 33  # orbital extent of the damaged nut thread after the sector's exit [rad]
+P_EDGE_DEPTH = 34  # material missing from both nut flanks there [m]
+P_SIZE = 35
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
@@ -124,18 +129,47 @@ def _spall(p, phi):
 
 
 @njit(cache=True, inline="always")
+def _edge(p, a):
+    """Depth missing from both nut flanks at the thread's re-entry edge under a roller that has
+    travelled a into the sector [m], and d/da: the first stretch of nut thread after the
+    threadless area's exit (a = 2β) is worn or chipped, the depth ending over the last tenth
+    of the stretch where the intact thread starts."""
+    width = p[P_EDGE_WIDTH]
+    if width <= 0.0:
+        return 0.0, 0.0
+    along = a - 2.0 * p[P_BETA]
+    if along <= 0.0 or along >= width:
+        return 0.0, 0.0
+    ramp = 0.1 * width
+    if along > width - ramp:
+        return p[P_EDGE_DEPTH] * (width - along) / ramp, -p[P_EDGE_DEPTH] / ramp
+    return p[P_EDGE_DEPTH], 0.0
+
+
+@njit(cache=True, inline="always")
 def _platform(p, a, inside):
     """Platform surface height above its ring's face [m] and d/da: the chamfer rises by the
     stroke over the crossing (the first β), the platform top holds it, and its exit edge drops
-    over the last lift ramp as the threads take the roller back."""
+    over the last lift ramp as the threads take the roller back.
+
+    Faults of the ring: chamfer wear removes w at the chamfer's entrance, tapering to nothing at
+    its top (where the rollers strike it: the surface is max(0, (stroke + w)·a/β − w), met later
+    and climbed faster); a platform that lost height h tops out at stroke − h (the reset falls
+    short of one lead by h and the nut thread must push the landing roller the rest)."""
     if not inside:
         return 0.0, 0.0
     beta, ramp, stroke = p[P_BETA], p[P_LIFT_RAMP], p[P_STROKE]
+    wear, top = p[P_CAM_WEAR], p[P_STROKE] - p[P_PLATFORM_LOSS]
     if a < beta:
-        return stroke * a / beta, stroke / beta
+        rise = (stroke + wear) * a / beta - wear
+        if rise <= 0.0:
+            return 0.0, 0.0
+        if rise >= top:
+            return top, 0.0
+        return rise, (stroke + wear) / beta
     if a > 2.0 * beta - ramp:
-        return stroke * (2.0 * beta - a) / ramp, -stroke / ramp
-    return stroke, 0.0
+        return top * (2.0 * beta - a) / ramp, -top / ramp
+    return top, 0.0
 
 
 @njit(cache=True, inline="always")
@@ -147,6 +181,20 @@ def _load(t, p, knots):
     if p[P_LOAD_RAMP] > 0.0 and t < p[P_LOAD_RAMP]:
         value *= t / p[P_LOAD_RAMP]
     return value
+
+
+@njit(cache=True, inline="always")
+def _hertz(d, d_dot, d_dot_kin, p):
+    """One thread side penetrated by d [m] (≤ 0: apart) at rate d_dot, d_dot_kin of it from the
+    prescribed motion: (force [N], power from the prescribed motion, dissipated power [W], the
+    contact's rate [1/s] for the step guard)."""
+    if d <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    elastic = p[P_K_THREAD] * d**1.5
+    force = max(elastic + p[P_C_THREAD] * _step_on(d, p[P_D_THREAD]) * d_dot, 0.0)
+    k_eff = 1.5 * p[P_K_THREAD] * math.sqrt(d)
+    rate = max(math.sqrt(k_eff / p[P_M_ROLLER]), p[P_C_THREAD] / p[P_M_ROLLER])
+    return force, force * d_dot_kin, (force - elastic) * d_dot, rate
 
 
 @njit(cache=True)
@@ -176,6 +224,7 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
         pit, dpit = _spall(p, phi)
         f_roller = 0.0
         f_screw = 0.0
+        edge, dedge = _edge(p, a)
         # ---- thread contacts: screw side, nut side (dead-zone Hertz, damped)
         f_side = 0.0
         for side in range(2):
@@ -189,23 +238,25 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
                 e = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
                 e_dot_free = w - v
                 e_dot_kin = lead * phi_dot / TWO_PI
-                b = p[P_B_NUT] + play_n
-                play_dot = dplay_n * a_dot
-                if e >= 0.0:  # the flank that carries the load (force on the nut forward)
-                    b += pit
-                    play_dot += dpit * phi_dot
+                b = p[P_B_NUT] + play_n + edge
+                play_dot = (dplay_n + dedge) * a_dot
             sign = 1.0 if e >= 0.0 else -1.0
             d = abs(e) - b
-            force = 0.0
-            if d > 0.0:
-                d_dot_kin = sign * e_dot_kin - play_dot
-                d_dot = sign * e_dot_free + d_dot_kin
-                elastic = p[P_K_THREAD] * d**1.5
-                force = max(elastic + p[P_C_THREAD] * _step_on(d, p[P_D_THREAD]) * d_dot, 0.0)
-                p_in += force * d_dot_kin
-                p_diss += (force - elastic) * d_dot
-                k_eff = 1.5 * p[P_K_THREAD] * math.sqrt(d)
-                rate = max(rate, math.sqrt(k_eff / m_r), p[P_C_THREAD] / m_r)
+            d_dot_kin = sign * e_dot_kin - play_dot
+            d_dot = sign * e_dot_free + d_dot_kin
+            force, power_in, power_diss, contact_rate = _hertz(d, d_dot, d_dot_kin, p)
+            if side == 1 and e >= 0.0 and pit > 0.0:
+                # the spalled turn (share s of the engaged ones, the flank that carries the
+                # load) closes the pit's depth later; the other turns as before
+                share = p[P_SPALL_SHARE]
+                pit_dot = dpit * phi_dot
+                f2, in2, diss2, _r = _hertz(d - pit, d_dot - pit_dot, d_dot_kin - pit_dot, p)
+                force = (1.0 - share) * force + share * f2
+                power_in = (1.0 - share) * power_in + share * in2
+                power_diss = (1.0 - share) * power_diss + share * diss2
+            p_in += power_in
+            p_diss += power_diss
+            rate = max(rate, contact_rate)
             f_roller -= sign * force
             if side == 1:
                 f_nut += sign * force
@@ -279,11 +330,15 @@ def mechanical_energy(t, y, p, rollers):
         pit = _spall(p, phi)[0]
         e_s = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
         e_n = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
-        b_n = p[P_B_NUT] + play_n + (pit if e_n >= 0.0 else 0.0)
-        for e, b in ((e_s, p[P_B_SCREW] + play_s), (e_n, b_n)):
-            d = abs(e) - b
-            if d > 0.0:
-                energy += 0.4 * p[P_K_THREAD] * d**2.5
+        d_s = abs(e_s) - p[P_B_SCREW] - play_s
+        d_n = abs(e_n) - p[P_B_NUT] - play_n - _edge(p, a)[0]
+        energy += 0.4 * p[P_K_THREAD] * max(d_s, 0.0) ** 2.5
+        if e_n >= 0.0 and pit > 0.0:  # the spalled turn's share closes later
+            share = p[P_SPALL_SHARE]
+            energy += 0.4 * p[P_K_THREAD] * (1.0 - share) * max(d_n, 0.0) ** 2.5
+            energy += 0.4 * p[P_K_THREAD] * share * max(d_n - pit, 0.0) ** 2.5
+        else:
+            energy += 0.4 * p[P_K_THREAD] * max(d_n, 0.0) ** 2.5
         u = z - x
         rise, _ = _platform(p, a, inside)
         for d in ((rise if s > 0 else 0.0) - u, u - (p[P_ROOM] - (rise if s < 0 else 0.0))):

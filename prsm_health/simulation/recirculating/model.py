@@ -34,6 +34,19 @@ Forces, each from one contact law and its energy
   load swings it through zero: the rollers cross their clearance), ramped in over ``load_ramp``
   (a step would ring the nut on its threads for the whole run).
 
+Faults, each a change of one surface (:mod:`prsm_health.actuator.faults` maps a health state's
+faults onto them): a **nut spall** (:class:`NutSpall`: the loaded flank lower over an arc, on
+a share of the turns); **cam-chamfer wear** (the chamfer's entrance worn down, tapering to its
+top: met later, climbed faster); **platform height loss** (the top lower: the push falls short
+of a lead, the threads must finish the reset); a damaged **re-entry edge** (:class:`ReentryEdge`:
+both nut flanks lower over a stretch after the exit: the landing roller takes its share back
+later, at the intact thread). What the model shows of them (docs/faults.md): the worn chamfer
+moves the entry pulse by the geometry's β·w/(stroke + w); an edge chip deeper than the landing
+roller's offset (up to p/N) delays the landing to the intact thread; the platform's lost height
+is masked at every speed tried (2–126 rad/s) because nothing holds a lifted roller on the
+platform — the chamfer's elastic push throws it at twice the chamfer's speed and it rattles
+between the platform and the far ring until the threads take it back.
+
 Idealised: the platform top holds a reset roller across the whole threadless area (2β) until the
 nut thread takes it back; the paper lays out one β per direction of rotation, so a real roller
 runs the second β free of the platform. Forward rotation only (the load may reverse): the
@@ -104,11 +117,17 @@ class NutSpall:
         Its length along the thread (an arc of the orbit radius d_c/2).
     depth : float [m]
         Material missing from the flank, > 0.
+    share : float [-]
+        Share of the engaged thread turns it is on, in (0, 1]: 1/n_t for a spall on one turn
+        (what a health state's ``spall`` fault on the nut makes: the spalled turn's share of
+        the contact closes ``depth`` later, the other turns as before, as in the standard
+        model), 1 for a spall across every turn at that angle (the spall study's worst case).
     """
 
     angle: float
     length: float
     depth: float
+    share: float = 1.0
 
     def __post_init__(self):
         require(
@@ -119,6 +138,38 @@ class NutSpall:
         )
         require_positive("nut_spall.length", self.length)
         require_positive("nut_spall.depth", self.depth)
+        require(
+            isinstance(self.share, (int, float)) and 0.0 < self.share <= 1.0,
+            "nut_spall.share",
+            self.share,
+            "must be in (0, 1]: the share of the engaged thread turns the spall is on",
+        )
+
+
+@dataclass(frozen=True)
+class ReentryEdge:
+    """Damage at the nut thread's re-entry edge: where the threadless area ends (a = 2β) every
+    landing roller strikes the first stretch of nut thread as it takes the load back, and the
+    edge wears or chips there. Material missing from both flanks over ``length`` of the
+    rollers' path after the exit: a landing roller re-engages later — after its lift has
+    closed — and harder, the loaded flank snapping its share of the load back at the intact
+    thread's start (the strike grows with the load).
+
+    Parameters
+    ----------
+    length : float [m]
+        Extent of the damaged thread along the rollers' path (an arc of the orbit radius).
+    depth : float [m]
+        Material missing from each flank, > 0 (on every engaged turn: each turn's edge takes
+        the same landings).
+    """
+
+    length: float
+    depth: float
+
+    def __post_init__(self):
+        require_positive("reentry_edge.length", self.length)
+        require_positive("reentry_edge.depth", self.depth)
 
 
 @dataclass(frozen=True)
@@ -193,6 +244,9 @@ def simulate_recirculating(
     load_ramp: float = 5e-3,
     contact: ImpactContact = PAPER03_CONTACT,
     nut_spall: NutSpall | None = None,
+    cam_wear: float = 0.0,
+    platform_loss: float = 0.0,
+    reentry_edge: ReentryEdge | None = None,
     step: float = STEP,
 ) -> RecirculatingRun:
     """Simulate a recirculating PRSM at a constant screw speed under a constant axial load.
@@ -223,6 +277,18 @@ def simulate_recirculating(
         The cam-ring contact (default paper 03 §4.1).
     nut_spall : NutSpall or None
         A spall on the nut's thread flank (None: healthy).
+    cam_wear : float [m]
+        Material the rollers' strikes wore off the chamfer's entrance (0: new), tapering to
+        nothing at the platform's top: the roller meets the chamfer later and is pushed faster
+        (the reset's entry pulse later and stronger). At most half the reset stroke.
+    platform_loss : float [m]
+        Height the platform lost (0: new): the reset pushes the roller L − h instead of one
+        lead L, and the nut thread pushes the landing roller the rest (a strike at the exit,
+        whatever the load). Below 0.4 of the pitch: at p/2 the landing roller's nearest groove
+        is the one it left — the reset fails and the roller jams against the ring at its next
+        pass (not modelled: refused).
+    reentry_edge : ReentryEdge or None
+        Damage at the nut thread's re-entry edge (None: intact).
     step : float [s]
         Outer step; the guard sub-steps where a contact needs it.
 
@@ -270,10 +336,28 @@ def simulate_recirculating(
         load_ramp,
         "must be ≥ 0 [s]",
     )
+    require(
+        isinstance(cam_wear, (int, float)) and 0.0 <= cam_wear <= 0.5 * reset_stroke(design),
+        "cam_wear",
+        cam_wear,
+        f"must be in [0, {0.5 * reset_stroke(design):g}] m: at most half the reset stroke",
+    )
+    require(
+        isinstance(platform_loss, (int, float)) and 0.0 <= platform_loss < 0.4 * design.pitch,
+        "platform_loss",
+        platform_loss,
+        f"must be in [0, {0.4 * design.pitch:g}) m: below 0.4 pitch (from p/2 the reset fails "
+        "and the roller jams against the ring, which the model does not follow)",
+    )
     nominal = float(np.max(np.abs(knots[1]))) + abs(float(load_sine[0]))
     p, rollers, y0 = _parameters(
         design, screw_speed, nominal, clearance, payload_mass, load_ramp, contact, nut_spall
     )
+    p[K.P_CAM_WEAR] = cam_wear
+    p[K.P_PLATFORM_LOSS] = platform_loss
+    if reentry_edge is not None:
+        p[K.P_EDGE_WIDTH] = 2.0 * reentry_edge.length / design.orbit_diameter
+        p[K.P_EDGE_DEPTH] = reentry_edge.depth
     p[K.P_LOAD_SINE], p[K.P_LOAD_FREQUENCY] = float(load_sine[0]), float(load_sine[1])
     if clearance_nut is not None:
         p[K.P_B_NUT] = clearance_nut
@@ -385,6 +469,7 @@ def _parameters(
         p[K.P_SPALL_ANGLE] = nut_spall.angle
         p[K.P_SPALL_WIDTH] = 2.0 * nut_spall.length / design.orbit_diameter
         p[K.P_SPALL_DEPTH] = nut_spall.depth
+        p[K.P_SPALL_SHARE] = nut_spall.share
     # roller 1 at the sector's entrance, roller i (i − 1)·2π/N behind it (§3.2 steps 4–6)
     behind = np.arange(n) * 2.0 * math.pi / n
     phi0 = p[K.P_PHI_ENTRY] - direction * behind

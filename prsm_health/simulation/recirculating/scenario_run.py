@@ -4,7 +4,11 @@ PRSM's — measured channels through the scenario's instrumentation, truth, labe
 what the model covers, and one error naming the field for what it does not yet.
 
 Covered: a constant screw speed (forward) under the profile's axial load — constant, sinusoidal
-or reversing —, the thread clearances.
+or reversing —, the thread clearances, and the faults of a recirculating unit: a spall on the
+nut's loaded flank (on one thread turn of the n_t engaged: share 1/n_t, as the standard model's),
+cam-chamfer wear, platform height loss, re-entry-edge damage (:mod:`prsm_health.actuator.faults`).
+Truth beyond the standard's: ``cam_force`` (the largest summed cam force within each sample's
+interval) and ``reset_count``.
 The drive train around it is ideal and stiff: the motor turns N times the screw through the
 reduction (torque × 1/(N·η) while driving), the payload moves rigidly with the nut, the screw's
 thrust bearing holds it axially. The axial model has no lateral motion (the nut's tangential
@@ -26,7 +30,7 @@ from ..decimation import decimate
 from ..dynamics.simulate import choose_step
 from ..instrumentation import bind_drive_train, sensor_rng
 from ..thermal import housing_temperature_signal
-from .model import STEP, simulate_recirculating
+from .model import STEP, NutSpall, ReentryEdge, simulate_recirculating
 
 #: The load's rise from zero at the start [s]: the model starts unloaded (a step would ring the
 #: nut on its threads for the whole run).
@@ -45,6 +49,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     design, health, profile = scenario.design, scenario.health, scenario.profile
     instrumentation, drive_train = scenario.instrumentation, scenario.drive_train
     _require_covered(profile, health)
+    faults = _fault_arguments(design, health)
     h, factor = choose_step(STEP, instrumentation.sample_rate)  # 1/(m·f_s) ≤ the model's step
     knots, amplitude, frequency = profile.load_knots()
     run = simulate_recirculating(
@@ -58,6 +63,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
         payload_mass=drive_train.payload_mass,
         load_ramp=LOAD_RAMP,
         step=h,
+        **faults,
     )
     n = int(round(profile.duration / h))  # the standard run's sample count at this step
     t = run.time[:n]
@@ -88,10 +94,17 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
         1.0 / h,
         sensor_rng(scenario.sensors_seed),
     )
-    record = np.column_stack([truth_raw[name] for name in TRUTH_NAMES])
-    decimated = decimate(record, factor)
-    truth = {name: decimated[:, k] for k, name in enumerate(TRUTH_NAMES)}
+    names = [name for name in TRUTH_NAMES if name in truth_raw]
+    decimated = decimate(np.column_stack([truth_raw[name] for name in names]), factor)
+    truth = {name: decimated[:, k] for k, name in enumerate(names)}
     n_out = len(decimated)
+    # pulses and counts are not band-limited signals: the largest force and the count reached
+    # within each sample's interval
+    cam = np.abs(run.cam_force[:, : n_out * factor]).sum(axis=0)
+    truth["cam_force"] = cam.reshape(n_out, factor).max(axis=1)
+    exits = run.in_sector[:, :-1] & ~run.in_sector[:, 1:]
+    count = np.concatenate([[0], np.cumsum(exits.sum(axis=0))])[: n_out * factor]
+    truth["reset_count"] = count.reshape(n_out, factor)[:, -1].astype(float)
     time = np.arange(n_out) / instrumentation.sample_rate
     clearances = {
         f"clearance_{side}_realised_{stat}": value
@@ -124,7 +137,7 @@ def _require_covered(profile, health) -> None:
     require(profile.speed > 0, "profile.speed", profile.speed, f"{what}: > 0 (forward)")
     nominal = HealthState()
     for f in dataclasses.fields(HealthState):
-        if f.name in ("clearance_screw", "clearance_nut", "clearance_gear"):
+        if f.name in ("clearance_screw", "clearance_nut", "clearance_gear", "faults"):
             continue
         value = getattr(health, f.name)
         require(
@@ -134,3 +147,39 @@ def _require_covered(profile, health) -> None:
             f"not modelled for the recirculating PRSM yet (its default "
             f"{getattr(nominal, f.name)!r} only)",
         )
+
+
+def _fault_arguments(design, health) -> dict:
+    """The health state's faults as :func:`~.model.simulate_recirculating`'s arguments: one of
+    each kind at most; a spall on the nut's loaded flank only (the axial model has no screw
+    or roller surface to carry one)."""
+    kinds = [f.kind for f in health.faults]
+    for kind in set(kinds):
+        require(
+            kinds.count(kind) == 1,
+            "faults.kind",
+            kind,
+            "one fault of each kind per run at most (the recirculating model has one of each)",
+        )
+    out = {}
+    for fault in health.faults:
+        if fault.kind == "spall":
+            require(
+                fault.location == "nut" and fault.flank == "loaded",
+                "faults.location",
+                f"{fault.location} ({fault.flank} flank)",
+                "the recirculating model carries a spall on the nut's loaded flank only",
+            )
+            out["nut_spall"] = NutSpall(
+                angle=fault.angle,
+                length=fault.length,
+                depth=fault.depth,
+                share=1.0 / design.engaged_threads,
+            )
+        elif fault.kind == "cam_wear":
+            out["cam_wear"] = fault.depth
+        elif fault.kind == "platform_loss":
+            out["platform_loss"] = fault.height
+        elif fault.kind == "reentry_edge":
+            out["reentry_edge"] = ReentryEdge(length=fault.length, depth=fault.depth)
+    return out
