@@ -71,6 +71,7 @@ from .indicator_table import (  # the indicators' table, declared there
 from .kernels import hysteresis_crossings, moment_sums, screw_power_sums
 from .lost_motion import lost_motion_spread
 from .percentiles import percentiles
+from .reset_comb import reset_comb_indicators
 from .spectra import amplitude_spectrum, peak_frequency, welch_psd
 
 #: Most windows processed together by :func:`extract_features_batch` (memory: the
@@ -343,6 +344,9 @@ def _extract(runs: list[Run], design: PRSMDesign | None, lead: float | None) -> 
     # ---- time-synchronous averages and the gear indicators (docs/gear-indicators.md)
     if "screw_angle" in present and design is not None:
         _gear(runs, design, ratios, rows)
+        if design.variant == "recirculating":  # the resets' comb (signals.reset_comb)
+            for run, row in zip(runs, rows):
+                row.update(reset_comb_indicators(run.channels, design, SEARCH_SHARE))
     # ---- envelope lines at the defect frequencies, band by spectral kurtosis
     if design is not None:
         _envelope(runs, rows, design)

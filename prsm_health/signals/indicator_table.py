@@ -14,6 +14,7 @@ from prsm_health.core.channels import CHANNEL_NAMES, VIBRATION
 from .channel_statistics import CHANNEL_STATISTICS
 from .gear_indicators import GEAR_INDICATORS
 from .generic_indicators import GENERIC, NEEDS_ANY
+from .reset_comb import REFERENCE_PASSAGE_RATE, RESET_COMB, RESOLVED_HARMONICS
 
 SHORT = {
     "nut_axial_accel": "ax",
@@ -80,6 +81,7 @@ def _feature_table() -> dict[str, str]:
             for name in TSA_INDICATORS:
                 unit = "m/s²" if name in ("tsa_rms", "sideband_index") else "-"
                 units[f"{SHORT[ch]}_tsa_{period}_{name}"] = unit
+    units.update(RESET_COMB)  # the recirculating PRSM's resets (signals.reset_comb)
     units.update(
         {
             "mesh_frequency": "Hz",
@@ -129,6 +131,7 @@ GROUPS = {
         and not any(tag in k for tag in ("_mesh_", "_tsa_", "_env_", "_sk_"))
     ],
     "gear": [k for k in FEATURES if "_tsa_" in k],
+    "reset_comb": list(RESET_COMB),
     "envelope": [k for k in FEATURES if "_env_" in k or "_sk_" in k],
     "torque": [
         k for k in FEATURES if "torque" in k and k not in GENERIC and k not in CHANNEL_STATISTICS
@@ -178,6 +181,15 @@ GROUP_CHANNELS: dict[str, Needs] = {
     "axial_frequency": Needs(("nut_axial_accel",), min_rate=AXIAL_SEARCH[1] / SEARCH_SHARE),
     "classic": Needs(any_of=VIBRATION),
     "gear": Needs(("screw_angle",), TSA_CHANNELS),
+    # the passage period's first RESOLVED_HARMONICS harmonics within the recording's band —
+    # the entry and the landing (0.19 of the period apart for paper03) resolved — at a passage
+    # rate of 100 Hz (paper03 at paper 03's 40π rad/s: 97 Hz): 4.4 kHz; each window checks
+    # its own rate. The pulses' ringing (the nut's axial mode, ≈ 6 kHz for paper03) needs
+    # more to be kept whole: the 20 kHz profiles keep it.
+    "reset_comb": Needs(
+        ("nut_axial_accel", "screw_angle"),
+        min_rate=RESOLVED_HARMONICS * REFERENCE_PASSAGE_RATE / SEARCH_SHARE,
+    ),
     "envelope": Needs(("screw_speed",), ENVELOPE_CHANNELS),
     "torque": Needs(("drive_torque",)),
     "lost_motion": Needs(("nut_position", "screw_angle")),
