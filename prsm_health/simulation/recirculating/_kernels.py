@@ -3,9 +3,10 @@
 Only float64 arrays and scalars cross this boundary; the parameter vector's layout is
 :data:`P_*` below, the physics in :mod:`.model` (which documents every term and cites paper 03).
 
-State ``y``: nut position and velocity, each roller's absolute axial position and velocity, and
+State ``y``: nut position and velocity, each roller's absolute axial position and velocity,
 three energy accumulators (work of the prescribed screw/carrier motion, dissipated energy, work
-against the load), so that the energy balance is integrated by the same steps as the motion.
+against the load), so that the energy balance is integrated by the same steps as the motion,
+then the payload's position and velocity (behind the linkage, or following the nut rigidly).
 """
 
 from __future__ import annotations
@@ -53,7 +54,10 @@ P_CAM_WEAR = 31  # material worn off the chamfer at its entrance [m], tapering t
 P_PLATFORM_LOSS = 32  # height the platform lost [m]: the reset falls short by it
 P_EDGE_WIDTH = 33  # orbital extent of the damaged nut thread after the sector's exit [rad]
 P_EDGE_DEPTH = 34  # material missing from both nut flanks there [m]
-P_SIZE = 35
+P_LINK_K = 35  # linkage stiffness nut–payload [N/m] (0: the payload rides rigidly on the nut)
+P_LINK_C = 36  # linkage damping [N·s/m]
+P_M_PAYLOAD = 37  # payload behind the linkage [kg]
+P_SIZE = 38
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
@@ -61,7 +65,9 @@ R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
 # ---- recorded per sample
 OUT_T, OUT_X, OUT_V, OUT_A, OUT_POWER, OUT_W_IN, OUT_W_DISS, OUT_W_LOAD, OUT_ENERGY = range(9)
 OUT_LOAD = 9
-OUT_SIZE = 10
+OUT_ROD = 10  # force of the linkage on the nut [N] (the load itself without a linkage)
+OUT_XP, OUT_VP = 11, 12  # payload position and velocity
+OUT_SIZE = 13
 #: Per roller per sample: relative position to the nut, screw-side and nut-side thread force,
 #: cam force (both rings), in the sector (1/0).
 ROLLER_U, ROLLER_F_SCREW, ROLLER_F_NUT, ROLLER_F_CAM, ROLLER_SECTOR = range(5)
@@ -184,6 +190,13 @@ def _load(t, p, knots):
 
 
 @njit(cache=True, inline="always")
+def _rod(y, p, ip):
+    """Force of the linkage on the nut [N], positive resisting forward motion: spring and
+    damper between the nut (y[0], y[1]) and the payload (y[ip], y[ip + 1])."""
+    return p[P_LINK_K] * (y[0] - y[ip]) + p[P_LINK_C] * (y[1] - y[ip + 1])
+
+
+@njit(cache=True, inline="always")
 def _hertz(d, d_dot, d_dot_kin, p):
     """One thread side penetrated by d [m] (≤ 0: apart) at rate d_dot, d_dot_kin of it from the
     prescribed motion: (force [N], power from the prescribed motion, dissipated power [W], the
@@ -211,7 +224,7 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
     a_dot = abs(phi_dot)  # the sector angle grows at the carrier's speed
     theta = omega * t
     x, v = y[0], y[1]
-    dy = np.zeros(2 + 2 * n + 3)
+    dy = np.zeros(2 + 2 * n + 5)
     f_nut = 0.0
     p_in = 0.0
     p_diss = 0.0
@@ -303,11 +316,24 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
             roller_out[i, ROLLER_F_CAM] = f_cam
             roller_out[i, ROLLER_SECTOR] = 1.0 if inside else 0.0
     load = _load(t, p, knots)
+    ip = 2 + 2 * n + 3  # the payload's states
     dy[0] = v
-    dy[1] = (f_nut - load) / m_n
+    if p[P_LINK_K] > 0.0:  # the load acts on the payload, the linkage on the nut
+        relative = v - y[ip + 1]
+        f_rod = _rod(y, p, ip)
+        p_diss += p[P_LINK_C] * relative * relative
+        dy[1] = (f_nut - f_rod) / m_n
+        dy[ip] = y[ip + 1]
+        dy[ip + 1] = (f_rod - load) / p[P_M_PAYLOAD]
+        dy[2 + 2 * n + 2] = load * y[ip + 1]
+        rate = max(rate, math.sqrt(p[P_LINK_K] / m_n), p[P_LINK_C] / m_n)
+    else:  # the payload (in the nut's mass) follows the nut
+        dy[1] = (f_nut - load) / m_n
+        dy[ip] = v
+        dy[ip + 1] = dy[1]
+        dy[2 + 2 * n + 2] = load * v
     dy[2 + 2 * n] = p_in
     dy[2 + 2 * n + 1] = p_diss
-    dy[2 + 2 * n + 2] = load * v
     return dy, rate
 
 
@@ -321,6 +347,9 @@ def mechanical_energy(t, y, p, rollers):
     theta = omega * t
     x = y[0]
     energy = 0.5 * p[P_M_NUT] * y[1] ** 2
+    if p[P_LINK_K] > 0.0:
+        ip = 2 + 2 * n + 3
+        energy += 0.5 * p[P_M_PAYLOAD] * y[ip + 1] ** 2 + 0.5 * p[P_LINK_K] * (x - y[ip]) ** 2
     for i in range(n):
         z, w = y[2 + i], y[2 + n + i]
         energy += 0.5 * p[P_M_ROLLER] * w**2
@@ -354,7 +383,7 @@ def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_ou
     records every outer step. Returns the number of steps done (< n_steps: the guard's limit
     was reached at that step)."""
     n = int(p[P_N])
-    size = 2 + 2 * n + 3
+    size = 2 + 2 * n + 5
     y = y0.copy()
     k1 = np.zeros(size)
     tmp = np.zeros(size)
@@ -372,6 +401,10 @@ def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_ou
         out[k, OUT_W_LOAD] = y[2 + 2 * n + 2]
         out[k, OUT_ENERGY] = mechanical_energy(t, y, p, rollers)
         out[k, OUT_LOAD] = _load(t, p, knots)
+        ip = 2 + 2 * n + 3
+        out[k, OUT_ROD] = _rod(y, p, ip) if p[P_LINK_K] > 0.0 else out[k, OUT_LOAD]
+        out[k, OUT_XP] = y[ip]
+        out[k, OUT_VP] = y[ip + 1]
         # look ahead one step with an Euler predictor: an impact starting inside the step
         for j in range(size):
             tmp[j] = y[j] + step * dy[j]

@@ -5,8 +5,10 @@ Bodies and degrees of freedom
 -----------------------------
 The screw turns at a prescribed speed ω_s and is axially fixed (rigid); the carrier turns with it
 at the rolling ratio ω_c = d_s/(2d_c)·ω_s (eq. 25: no slip, the paper's own simulation is within
-1 % of it); the nut (with its cam rings and the payload) and every roller move axially — the
-N + 1 axial degrees of freedom, integrated by a guarded fixed-step RK4 (:mod:`._kernels`).
+1 % of it); the nut (with its cam rings) and every roller move axially — the N + 1 axial
+degrees of freedom, integrated by a guarded fixed-step RK4 (:mod:`._kernels`) — and the payload
+either rides rigidly on the nut or sits behind a linkage (spring and damper: one more degree of
+freedom, the load on it; the standard model's drive train, :mod:`prsm_health.actuator.drive_train`).
 
 Forces, each from one contact law and its energy
 ------------------------------------------------
@@ -183,7 +185,11 @@ class RecirculatingRun:
         The torque the prescribed screw (and, through rolling, carrier) motion takes: its
         power over ω_s.
     axial_load : numpy.ndarray [N]
-        The load on the nut at each sample (positive resists forward motion).
+        The applied load at each sample (positive resists forward motion), on the nut or,
+        behind a linkage, on the payload.
+    linkage_force, payload_position, payload_velocity : numpy.ndarray [N, m, m/s]
+        The linkage's force on the nut (what a load cell in the rod reads; the load itself
+        without a linkage) and the payload's motion (the nut's without a linkage).
     roller_position : numpy.ndarray [m]
         Each roller's axial position relative to the nut (0: against the left cam ring).
     screw_force, nut_force, cam_force : numpy.ndarray [N]
@@ -204,6 +210,9 @@ class RecirculatingRun:
     nut_acceleration: np.ndarray
     drive_torque: np.ndarray
     axial_load: np.ndarray
+    linkage_force: np.ndarray
+    payload_position: np.ndarray
+    payload_velocity: np.ndarray
     roller_position: np.ndarray
     screw_force: np.ndarray
     nut_force: np.ndarray
@@ -224,7 +233,7 @@ class RecirculatingRun:
         balance = self.work_in[-1] - self.dissipated[-1] - self.work_load[-1]
         change = self.mechanical_energy[-1] - self.mechanical_energy[0]
         drive = np.abs(self.drive_torque * self.screw_speed)
-        load = np.abs(self.axial_load * self.nut_velocity)
+        load = np.abs(self.axial_load * self.payload_velocity)
         scale = max(
             float(np.trapezoid(drive, self.time)), float(np.trapezoid(load, self.time)), 1e-12
         )
@@ -242,6 +251,7 @@ def simulate_recirculating(
     clearance_nut: float | None = None,
     payload_mass: float = 0.0,
     load_ramp: float = 5e-3,
+    linkage: tuple[float, float] | None = None,
     contact: ImpactContact = PAPER03_CONTACT,
     nut_spall: NutSpall | None = None,
     cam_wear: float = 0.0,
@@ -270,7 +280,12 @@ def simulate_recirculating(
     clearance_nut : float or None [m]
         Half-clearance on the nut side (None: ``clearance``).
     payload_mass : float [kg]
-        Mass moving with the nut (besides the design's nut mass).
+        Mass moving with the nut (besides the design's nut mass), or behind the linkage.
+    linkage : (float, float) or None [N/m, -]
+        Stiffness and damping ratio (of the payload on it, nut held) of a linkage between the
+        nut and the payload: the load then acts on the payload and the nut feels the linkage's
+        force (an actuator's rod end and attachment, as the standard model's drive train);
+        None: the payload rides rigidly on the nut and the load acts on the nut.
     load_ramp : float [s]
         Time over which the load rises from 0.
     contact : ImpactContact
@@ -353,6 +368,20 @@ def simulate_recirculating(
     p, rollers, y0 = _parameters(
         design, screw_speed, nominal, clearance, payload_mass, load_ramp, contact, nut_spall
     )
+    if linkage is not None:
+        stiffness, ratio = linkage
+        require_positive("linkage stiffness", stiffness)
+        require(
+            isinstance(ratio, (int, float)) and ratio >= 0,
+            "linkage damping ratio",
+            ratio,
+            "must be ≥ 0",
+        )
+        require(payload_mass > 0, "payload_mass", payload_mass, "must be > 0 behind a linkage")
+        p[K.P_M_NUT] = design.masses.nut_mass
+        p[K.P_M_PAYLOAD] = payload_mass
+        p[K.P_LINK_K] = stiffness
+        p[K.P_LINK_C] = 2.0 * ratio * math.sqrt(stiffness * payload_mass)
     p[K.P_CAM_WEAR] = cam_wear
     p[K.P_PLATFORM_LOSS] = platform_loss
     if reentry_edge is not None:
@@ -381,6 +410,9 @@ def simulate_recirculating(
         nut_acceleration=out[:, K.OUT_A],
         drive_torque=out[:, K.OUT_POWER] / omega,
         axial_load=out[:, K.OUT_LOAD],
+        linkage_force=out[:, K.OUT_ROD],
+        payload_position=out[:, K.OUT_XP],
+        payload_velocity=out[:, K.OUT_VP],
         roller_position=roller_out[:, :, K.ROLLER_U].T.copy(),
         screw_force=roller_out[:, :, K.ROLLER_F_SCREW].T.copy(),
         nut_force=roller_out[:, :, K.ROLLER_F_NUT].T.copy(),
@@ -483,8 +515,9 @@ def _parameters(
     rollers[:, K.R_C_SCREW] = u0 + lead * phi0 / (2.0 * math.pi)
     rollers[:, K.R_C_NUT] = u0 + lead * phi0 / (2.0 * math.pi)
     v0 = lead * screw_speed / (2.0 * math.pi)
-    y0 = np.zeros(2 + 2 * n + 3)
+    y0 = np.zeros(2 + 2 * n + 5)
     y0[1] = v0
+    y0[-1] = v0  # the payload moves with the nut, the linkage unstretched
     y0[2 : 2 + n] = u0
     y0[2 + n : 2 + 2 * n] = v0 - lead * ratio * screw_speed / (2.0 * math.pi)
     return p, rollers, y0
@@ -502,7 +535,8 @@ def right_hand_side(
 ):
     """(f, y0): the model's right-hand side f(t, y) → dy/dt and its initial state, for any ODE
     solver (the benchmark drives scipy's with it). ``y``: nut position and velocity, the
-    rollers' positions, their velocities, then the three energy accumulators."""
+    rollers' positions, their velocities, the three energy accumulators, then the payload's
+    position and velocity."""
     p, rollers, y0 = _parameters(
         design, screw_speed, load, clearance, payload_mass, load_ramp, contact
     )

@@ -9,9 +9,11 @@ nut's loaded flank (on one thread turn of the n_t engaged: share 1/n_t, as the s
 cam-chamfer wear, platform height loss, re-entry-edge damage (:mod:`prsm_health.actuator.faults`).
 Truth beyond the standard's: ``cam_force`` (the largest summed cam force within each sample's
 interval) and ``reset_count``.
-The drive train around it is ideal and stiff: the motor turns N times the screw through the
-reduction (torque × 1/(N·η) while driving), the payload moves rigidly with the nut, the screw's
-thrust bearing holds it axially. The axial model has no lateral motion (the nut's tangential
+The drive train around it is ideal and stiff up to the nut: the motor turns N times the screw
+through the reduction (torque × 1/(N·η) while driving), the screw's thrust bearing holds it
+axially; beyond the nut the drive train's linkage and payload are modelled (the load acts on the
+payload, ``axial_load`` is the linkage's force on the nut) unless its ``load_application`` is
+``"nut"`` (an ideal force on the nut, no payload). The axial model has no lateral motion (the nut's tangential
 and radial accelerations are zero) and no friction (``friction_torque`` truth is zero).
 """
 
@@ -52,6 +54,12 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     faults = _fault_arguments(design, health)
     h, factor = choose_step(STEP, instrumentation.sample_rate)  # 1/(m·f_s) ≤ the model's step
     knots, amplitude, frequency = profile.load_knots()
+    # the load on the payload behind the drive train's linkage (the standard model's), or an
+    # ideal force on the nut (paper 03's own case: no payload)
+    on_payload = drive_train.load_application == "payload"
+    linkage = (
+        (drive_train.linkage_stiffness, drive_train.linkage_damping_ratio) if on_payload else None
+    )
     run = simulate_recirculating(
         design,
         screw_speed=float(profile.speed),
@@ -60,7 +68,8 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
         duration=profile.duration,
         clearance=health.clearance_screw,
         clearance_nut=health.clearance_nut,
-        payload_mass=drive_train.payload_mass,
+        payload_mass=drive_train.payload_mass if on_payload else 0.0,
+        linkage=linkage,
         load_ramp=LOAD_RAMP,
         step=h,
         **faults,
@@ -68,7 +77,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     n = int(round(profile.duration / h))  # the standard run's sample count at this step
     t = run.time[:n]
     ratio = drive_train.gear_ratio
-    load = run.axial_load[:n]
+    rod = run.linkage_force[:n]
     zero = np.zeros(n)
     truth_raw = {
         "motor_angle": ratio * profile.speed * t,
@@ -83,10 +92,10 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
         "nut_radial_x_accel": zero,
         "nut_radial_y_accel": zero,
         "friction_torque": zero,
-        "axial_load": load,
-        "payload_position": run.nut_position[:n],
+        "axial_load": rod,
+        "payload_position": run.payload_position[:n],
         "screw_axial_position": zero,
-        "load_force": load,
+        "load_force": run.axial_load[:n],
     }
     truth_raw["housing_temperature"] = housing_temperature_signal(profile.temperature, truth_raw)
     channels = bind_drive_train(instrumentation, drive_train).measure(
