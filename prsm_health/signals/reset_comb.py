@@ -311,7 +311,8 @@ def _indicators(found: CombAverage, design: PRSMDesign, out: dict) -> dict[str, 
         out["comb_sync_share"] = max(0.0, p_tsa - noise * (bins - 1) / (bins * n)) / total
     energy = energy_profile(found.power)
     out["comb_outside_share"] = outside_share(energy, reset_window_share(design))
-    out["comb_doublet_spacing"], out["comb_peak_ratio"] = doublet(np.sqrt(energy))
+    amplitude = np.sqrt(np.maximum(energy, 0.0))  # the moving average may round below 0
+    out["comb_doublet_spacing"], out["comb_peak_ratio"] = doublet(amplitude)
     if found.loads is not None:
         out["comb_load_slope"] = load_slope(found.power, found.loads)
     return out
