@@ -102,8 +102,11 @@ def test_the_platform_impact_does_not_depend_on_the_load(runs):
 def test_bad_input_and_the_step_guard(design):
     with pytest.raises(ParameterError, match="design.variant"):
         simulate_recirculating(preset("paper01"), screw_speed=SPEED, load=0.0, duration=0.01)
-    with pytest.raises(ParameterError, match="forward rotation only"):
+    with pytest.raises(ParameterError, match="forward rotation or rest only"):
         simulate_recirculating(design, screw_speed=-SPEED, load=0.0, duration=0.01)
+    backward = [[0.0, 0.01], [SPEED, -SPEED]]
+    with pytest.raises(ParameterError, match="forward rotation or rest only"):
+        simulate_recirculating(design, screw_speed=backward, load=0.0, duration=0.01)
     with pytest.raises(ParameterError, match="load"):
         simulate_recirculating(
             design, screw_speed=SPEED, load=[[0.0, 0.0], [1.0, 2.0]], duration=0.01
@@ -249,3 +252,37 @@ def test_a_payload_behind_the_linkage_carries_the_load_and_keeps_the_balance(des
     assert run.linkage_force[k].mean() == pytest.approx(2e4, rel=1e-2)
     stretch = (run.nut_position - run.payload_position)[k].mean()
     assert stretch == pytest.approx(2e4 / 5e7, rel=2e-2)
+
+
+def test_a_stroke_from_rest_and_back_to_rest_under_load(design):
+    # the speed's knots: up in 20 ms, held, down in 20 ms. The nut travels the lead per turn
+    # (1.6 turns) less the threads' deflection under 10 kN (≈ 30 µm here; 0.1 mm allowed); at
+    # rest holding the load the screw takes F·L/2π (frictionless threads: exact but for the
+    # nut's residual ringing, 1 % allowed) and the balance closes over the run.
+    motion = [[0.0, 0.02, 0.08, 0.1], [0.0, SPEED, SPEED, 0.0]]
+    run = simulate_recirculating(design, screw_speed=motion, load=1e4, duration=0.1)
+    turns = (0.5 * 0.02 * SPEED * 2 + 0.06 * SPEED) / (2 * math.pi)
+    assert run.screw_angle[-1] == pytest.approx(2 * math.pi * turns, rel=1e-9)
+    assert run.nut_position[-1] == pytest.approx(turns * design.screw_lead, abs=1e-4)
+    assert run.resets.sum() >= 5 and run.energy_error < 1e-2
+    held = 1e4 * design.screw_lead / (2 * math.pi)
+    assert run.drive_torque[-1] == pytest.approx(held, rel=1e-2)
+
+
+def test_a_health_check_of_forward_phases_runs_and_one_turning_back_is_refused():
+    from prsm_health.simulation.scenario import Scenario
+
+    check = {
+        "name": "forward",
+        "phases": [
+            {"name": "no-load", "motion": "constant", "speed": 60.0, "load": 0, "duration": 0.05},
+            {"name": "loaded", "motion": "constant", "speed": SPEED, "load": "40 % C_a",
+             "duration": 0.05},
+        ],
+    }  # fmt: skip
+    run = Scenario.from_dict({"design": "paper03", "profile": {"check": check}}).simulate()
+    assert run.check is not None and run.truth["reset_count"][-1] >= 5
+    # the logger's anti-alias filter overshoots the ramp's corner by ≈ 2e-5 (1e-3 allowed)
+    assert run.truth["screw_speed"].max() == pytest.approx(SPEED, rel=1e-3)
+    with pytest.raises(ParameterError, match="check.phases"):
+        Scenario.from_dict({"design": "paper03", "profile": {"check": "health-check"}}).simulate()

@@ -71,7 +71,7 @@ def _tsa(design, load, clearance, spall, sensor_seed):
     a = accel_only.measure(truth, rate, np.random.default_rng(sensor_seed))["nut_axial_accel"]
     t = np.arange(len(a)) / accel_only.sample_rate
     keep = t >= SETTLED
-    period = 2 * math.pi / (design.n_rollers * abs(run.carrier_speed))
+    period = 2 * math.pi / (design.n_rollers * abs(float(np.mean(run.carrier_speed))))
     bins = np.minimum(((t[keep] / period) % 1.0 * BINS).astype(int), BINS - 1)
     tsa = np.bincount(bins, weights=a[keep], minlength=BINS) / np.bincount(bins, minlength=BINS)
     return tsa - tsa.mean(), run.energy_error

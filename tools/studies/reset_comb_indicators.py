@@ -77,8 +77,8 @@ def _measure(
     t = run.time
     zero = np.zeros_like(t)
     truth = {
-        "motor_angle": drive_train.gear_ratio * run.screw_speed * t,
-        "screw_angle": run.screw_speed * t,
+        "motor_angle": drive_train.gear_ratio * run.screw_angle,
+        "screw_angle": run.screw_angle,
         "nut_axial_accel": run.nut_acceleration,
         "nut_tangential_accel": zero,
         "nut_radial_x_accel": zero,

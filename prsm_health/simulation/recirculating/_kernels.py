@@ -40,34 +40,34 @@ P_LIFT = 17  # radial lift over the screw thread crest [m]
 P_LIFT_RAMP = 18  # orbital angle over which a lift (or the platform's edge) ramps [rad]
 P_COT_FLANK = 19  # axial play per radial lift: cos β / sin β of the flank
 P_DIR = 20  # +1 forward, −1 reverse
-P_OMEGA = 21  # screw speed [rad/s]
-P_RATIO = 22  # carrier / screw speed
-P_PHI_ENTRY = 23  # orbital angle where a roller enters the sector [rad]
-P_LOAD_RAMP = 24  # time over which the load rises from 0 [s] (the load: knots + sinusoid)
-P_SPALL_ANGLE = 25  # orbital angle where a nut-flank spall starts [rad]
-P_SPALL_WIDTH = 26  # its angular extent along the roller's path [rad] (0: no spall)
-P_SPALL_DEPTH = 27  # material missing from the nut flank [m]
-P_LOAD_SINE = 28  # amplitude of a sinusoid added to the load knots [N]
-P_LOAD_FREQUENCY = 29  # its frequency [Hz]
-P_SPALL_SHARE = 30  # share of the engaged thread turns the spall is on (1/n_t: one turn)
-P_CAM_WEAR = 31  # material worn off the chamfer at its entrance [m], tapering to 0 at its top
-P_PLATFORM_LOSS = 32  # height the platform lost [m]: the reset falls short by it
-P_EDGE_WIDTH = 33  # orbital extent of the damaged nut thread after the sector's exit [rad]
-P_EDGE_DEPTH = 34  # material missing from both nut flanks there [m]
-P_LINK_K = 35  # linkage stiffness nut–payload [N/m] (0: the payload rides rigidly on the nut)
-P_LINK_C = 36  # linkage damping [N·s/m]
-P_M_PAYLOAD = 37  # payload behind the linkage [kg]
-P_SIZE = 38
+P_RATIO = 21  # carrier / screw speed
+P_PHI_ENTRY = 22  # orbital angle where a roller enters the sector [rad]
+P_LOAD_RAMP = 23  # time over which the load rises from 0 [s] (the load: knots + sinusoid)
+P_SPALL_ANGLE = 24  # orbital angle where a nut-flank spall starts [rad]
+P_SPALL_WIDTH = 25  # its angular extent along the roller's path [rad] (0: no spall)
+P_SPALL_DEPTH = 26  # material missing from the nut flank [m]
+P_LOAD_SINE = 27  # amplitude of a sinusoid added to the load knots [N]
+P_LOAD_FREQUENCY = 28  # its frequency [Hz]
+P_SPALL_SHARE = 29  # share of the engaged thread turns the spall is on (1/n_t: one turn)
+P_CAM_WEAR = 30  # material worn off the chamfer at its entrance [m], tapering to 0 at its top
+P_PLATFORM_LOSS = 31  # height the platform lost [m]: the reset falls short by it
+P_EDGE_WIDTH = 32  # orbital extent of the damaged nut thread after the sector's exit [rad]
+P_EDGE_DEPTH = 33  # material missing from both nut flanks there [m]
+P_LINK_K = 34  # linkage stiffness nut–payload [N/m] (0: the payload rides rigidly on the nut)
+P_LINK_C = 35  # linkage damping [N·s/m]
+P_M_PAYLOAD = 36  # payload behind the linkage [kg]
+P_SIZE = 37
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
 
 # ---- recorded per sample
-OUT_T, OUT_X, OUT_V, OUT_A, OUT_POWER, OUT_W_IN, OUT_W_DISS, OUT_W_LOAD, OUT_ENERGY = range(9)
+OUT_T, OUT_X, OUT_V, OUT_A, OUT_TORQUE, OUT_W_IN, OUT_W_DISS, OUT_W_LOAD, OUT_ENERGY = range(9)
 OUT_LOAD = 9
 OUT_ROD = 10  # force of the linkage on the nut [N] (the load itself without a linkage)
 OUT_XP, OUT_VP = 11, 12  # payload position and velocity
-OUT_SIZE = 13
+OUT_THETA, OUT_OMEGA = 13, 14  # screw angle [rad] and speed [rad/s]
+OUT_SIZE = 15
 #: Per roller per sample: relative position to the nut, screw-side and nut-side thread force,
 #: cam force (both rings), in the sector (1/0).
 ROLLER_U, ROLLER_F_SCREW, ROLLER_F_NUT, ROLLER_F_CAM, ROLLER_SECTOR = range(5)
@@ -179,6 +179,21 @@ def _platform(p, a, inside):
 
 
 @njit(cache=True, inline="always")
+def _screw(t, motion):
+    """Screw angle [rad] and speed [rad/s] at t from the motion's knots (rows: times [s],
+    speeds [rad/s], angles [rad] at the knots): the speed linear between knots, the angle its
+    exact integral; held at the last speed beyond the last knot."""
+    times = motion[0]
+    k = np.searchsorted(times, t, side="right") - 1
+    k = min(max(k, 0), len(times) - 1)
+    tau = t - times[k]
+    if k == len(times) - 1:
+        return motion[2, k] + motion[1, k] * tau, motion[1, k]
+    slope = (motion[1, k + 1] - motion[1, k]) / (times[k + 1] - times[k])
+    return motion[2, k] + motion[1, k] * tau + 0.5 * slope * tau * tau, motion[1, k] + slope * tau
+
+
+@njit(cache=True, inline="always")
 def _load(t, p, knots):
     """Axial load on the nut at t [N], resisting forward motion when positive: the profile's
     knots plus its sinusoid, brought in over the load ramp."""
@@ -197,41 +212,45 @@ def _rod(y, p, ip):
 
 
 @njit(cache=True, inline="always")
-def _hertz(d, d_dot, d_dot_kin, p):
-    """One thread side penetrated by d [m] (≤ 0: apart) at rate d_dot, d_dot_kin of it from the
-    prescribed motion: (force [N], power from the prescribed motion, dissipated power [W], the
-    contact's rate [1/s] for the step guard)."""
+def _hertz(d, d_dot, kin_unit, p):
+    """One thread side penetrated by d [m] (≤ 0: apart) at rate d_dot, kin_unit·ω_s of it
+    from the prescribed motion (kin_unit [m/rad]): (force [N], its torque on the screw's
+    prescribed motion force·kin_unit [N·m], dissipated power [W], the contact's rate [1/s] for
+    the step guard)."""
     if d <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
     elastic = p[P_K_THREAD] * d**1.5
     force = max(elastic + p[P_C_THREAD] * _step_on(d, p[P_D_THREAD]) * d_dot, 0.0)
     k_eff = 1.5 * p[P_K_THREAD] * math.sqrt(d)
     rate = max(math.sqrt(k_eff / p[P_M_ROLLER]), p[P_C_THREAD] / p[P_M_ROLLER])
-    return force, force * d_dot_kin, (force - elastic) * d_dot, rate
+    return force, force * kin_unit, (force - elastic) * d_dot, rate
 
 
 @njit(cache=True)
-def forces(t, y, p, rollers, knots, roller_out, with_out):
-    """Accelerations, the energy accumulators' rates and the largest contact rate [1/s].
+def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
+    """Accelerations, the energy accumulators' rates, the largest contact rate [1/s] and the
+    torque the prescribed screw (and, rolling, carrier) motion takes [N·m].
 
-    Returns (dy, rate); ``roller_out`` (rollers × ROLLER_SIZE) filled when ``with_out``.
+    Every prescribed rate is ω_s times a geometric factor (the carrier turns at ratio·ω_s),
+    so the torque is Σ force × factor and the power it puts in torque × ω_s — defined at rest.
+    Returns (dy, rate, torque); ``roller_out`` (rollers × ROLLER_SIZE) filled when
+    ``with_out``.
     """
     n = int(p[P_N])
     lead, pitch = p[P_LEAD], p[P_PITCH]
     m_r, m_n = p[P_M_ROLLER], p[P_M_NUT]
-    omega, ratio, s = p[P_OMEGA], p[P_RATIO], p[P_DIR]
-    phi_dot = ratio * omega
-    a_dot = abs(phi_dot)  # the sector angle grows at the carrier's speed
-    theta = omega * t
+    ratio, s = p[P_RATIO], p[P_DIR]
+    theta, omega = _screw(t, motion)
+    a_dot_unit = abs(ratio)  # the sector angle grows at the carrier's speed (forward)
     x, v = y[0], y[1]
     dy = np.zeros(2 + 2 * n + 5)
     f_nut = 0.0
-    p_in = 0.0
+    torque = 0.0
     p_diss = 0.0
     rate = 0.0
     for i in range(n):
         z, w = y[2 + i], y[2 + n + i]
-        phi = rollers[i, R_PHI0] + phi_dot * t
+        phi = rollers[i, R_PHI0] + ratio * theta
         a, inside = _sector(p, phi)
         play_s, dplay_s, play_n, dplay_n = _plays(p, a, inside)
         pit, dpit = _spall(p, phi)
@@ -244,30 +263,32 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
             if side == 0:
                 e = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
                 e_dot_free = w  # the part from the state
-                e_dot_kin = -lead * (omega - phi_dot) / TWO_PI  # from the prescribed motion
+                e_kin_unit = -lead * (1.0 - ratio) / TWO_PI  # per ω_s, the prescribed motion's
                 b = p[P_B_SCREW] + play_s
-                play_dot = dplay_s * a_dot
+                play_unit = dplay_s * a_dot_unit
             else:
                 e = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
                 e_dot_free = w - v
-                e_dot_kin = lead * phi_dot / TWO_PI
+                e_kin_unit = lead * ratio / TWO_PI
                 b = p[P_B_NUT] + play_n + edge
-                play_dot = (dplay_n + dedge) * a_dot
+                play_unit = (dplay_n + dedge) * a_dot_unit
             sign = 1.0 if e >= 0.0 else -1.0
             d = abs(e) - b
-            d_dot_kin = sign * e_dot_kin - play_dot
-            d_dot = sign * e_dot_free + d_dot_kin
-            force, power_in, power_diss, contact_rate = _hertz(d, d_dot, d_dot_kin, p)
+            kin_unit = sign * e_kin_unit - play_unit
+            d_dot = sign * e_dot_free + omega * kin_unit
+            force, torque_part, power_diss, contact_rate = _hertz(d, d_dot, kin_unit, p)
             if side == 1 and e >= 0.0 and pit > 0.0:
                 # the spalled turn (share s of the engaged ones, the flank that carries the
                 # load) closes the pit's depth later; the other turns as before
                 share = p[P_SPALL_SHARE]
-                pit_dot = dpit * phi_dot
-                f2, in2, diss2, _r = _hertz(d - pit, d_dot - pit_dot, d_dot_kin - pit_dot, p)
+                pit_unit = dpit * ratio
+                f2, torque2, diss2, _r = _hertz(
+                    d - pit, d_dot - omega * pit_unit, kin_unit - pit_unit, p
+                )
                 force = (1.0 - share) * force + share * f2
-                power_in = (1.0 - share) * power_in + share * in2
+                torque_part = (1.0 - share) * torque_part + share * torque2
                 power_diss = (1.0 - share) * power_diss + share * diss2
-            p_in += power_in
+            torque += torque_part
             p_diss += power_diss
             rate = max(rate, contact_rate)
             f_roller -= sign * force
@@ -284,22 +305,21 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
         for ring in range(2):
             if ring == 0:
                 surface = rise if s > 0 else 0.0
-                surface_dot = drise_da * a_dot if s > 0 else 0.0
+                surface_unit = drise_da * a_dot_unit if s > 0 else 0.0  # per ω_s
                 d = surface - u
-                d_dot = surface_dot - u_dot
-                d_dot_kin = surface_dot
+                kin_unit = surface_unit
                 push = 1.0
             else:
                 surface = p[P_ROOM] - (rise if s < 0 else 0.0)
-                surface_dot = -(drise_da * a_dot) if s < 0 else 0.0
+                surface_unit = -(drise_da * a_dot_unit) if s < 0 else 0.0
                 d = u - surface
-                d_dot = u_dot - surface_dot
-                d_dot_kin = -surface_dot
+                kin_unit = -surface_unit
                 push = -1.0
+            d_dot = omega * kin_unit - push * u_dot
             if d > 0.0:
                 elastic = p[P_K_CAM] * d ** p[P_E_CAM]
                 force = max(elastic + p[P_C_CAM] * _step_on(d, p[P_D_CAM]) * d_dot, 0.0)
-                p_in += force * d_dot_kin
+                torque += force * kin_unit
                 p_diss += (force - elastic) * d_dot
                 k_eff = p[P_E_CAM] * p[P_K_CAM] * d ** (p[P_E_CAM] - 1.0)
                 c_eff = p[P_C_CAM] * _step_on(d, p[P_D_CAM])
@@ -332,19 +352,18 @@ def forces(t, y, p, rollers, knots, roller_out, with_out):
         dy[ip] = v
         dy[ip + 1] = dy[1]
         dy[2 + 2 * n + 2] = load * v
-    dy[2 + 2 * n] = p_in
+    dy[2 + 2 * n] = torque * omega
     dy[2 + 2 * n + 1] = p_diss
-    return dy, rate
+    return dy, rate, torque
 
 
 @njit(cache=True)
-def mechanical_energy(t, y, p, rollers):
-    """Kinetic energy of nut and rollers plus the contacts' elastic energy [J]."""
+def mechanical_energy(t, y, p, rollers, motion):
+    """Kinetic energy of nut, rollers and payload plus the contacts' elastic energy [J]."""
     n = int(p[P_N])
     lead, pitch = p[P_LEAD], p[P_PITCH]
-    omega, ratio, s = p[P_OMEGA], p[P_RATIO], p[P_DIR]
-    phi_dot = ratio * omega
-    theta = omega * t
+    ratio, s = p[P_RATIO], p[P_DIR]
+    theta = _screw(t, motion)[0]
     x = y[0]
     energy = 0.5 * p[P_M_NUT] * y[1] ** 2
     if p[P_LINK_K] > 0.0:
@@ -353,7 +372,7 @@ def mechanical_energy(t, y, p, rollers):
     for i in range(n):
         z, w = y[2 + i], y[2 + n + i]
         energy += 0.5 * p[P_M_ROLLER] * w**2
-        phi = rollers[i, R_PHI0] + phi_dot * t
+        phi = rollers[i, R_PHI0] + ratio * theta
         a, inside = _sector(p, phi)
         play_s, _, play_n, _ = _plays(p, a, inside)
         pit = _spall(p, phi)[0]
@@ -377,7 +396,7 @@ def mechanical_energy(t, y, p, rollers):
 
 
 @njit(cache=True)
-def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_out):
+def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, roller_out):
     """Fixed outer steps of RK4, each cut into as many equal sub-steps as the stiffest active
     contact needs (rate × sub-step ≤ 0.5, from the penetration expected at the step's end);
     records every outer step. Returns the number of steps done (< n_steps: the guard's limit
@@ -390,16 +409,17 @@ def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_ou
     scratch = roller_out[0].copy()
     t = 0.0
     for k in range(n_steps):
-        dy, rate = forces(t, y, p, rollers, knots, roller_out[k], True)
+        dy, rate, torque = forces(t, y, p, rollers, knots, motion, roller_out[k], True)
         out[k, OUT_T] = t
         out[k, OUT_X] = y[0]
         out[k, OUT_V] = y[1]
         out[k, OUT_A] = dy[1]
-        out[k, OUT_POWER] = dy[2 + 2 * n]
+        out[k, OUT_TORQUE] = torque
         out[k, OUT_W_IN] = y[2 + 2 * n]
         out[k, OUT_W_DISS] = y[2 + 2 * n + 1]
         out[k, OUT_W_LOAD] = y[2 + 2 * n + 2]
-        out[k, OUT_ENERGY] = mechanical_energy(t, y, p, rollers)
+        out[k, OUT_ENERGY] = mechanical_energy(t, y, p, rollers, motion)
+        out[k, OUT_THETA], out[k, OUT_OMEGA] = _screw(t, motion)
         out[k, OUT_LOAD] = _load(t, p, knots)
         ip = 2 + 2 * n + 3
         out[k, OUT_ROD] = _rod(y, p, ip) if p[P_LINK_K] > 0.0 else out[k, OUT_LOAD]
@@ -408,7 +428,7 @@ def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_ou
         # look ahead one step with an Euler predictor: an impact starting inside the step
         for j in range(size):
             tmp[j] = y[j] + step * dy[j]
-        _, rate_end = forces(t + step, tmp, p, rollers, knots, scratch, False)
+        rate_end = forces(t + step, tmp, p, rollers, knots, motion, scratch, False)[1]
         rate = max(rate, rate_end)
         subs = max(1, int(math.ceil(rate * step / 0.5)))
         if subs > max_substeps:
@@ -416,19 +436,19 @@ def integrate(y0, p, rollers, knots, step, n_steps, max_substeps, out, roller_ou
         h = step / subs
         for sub in range(subs):
             # the first sub-step starts where the recorded forces were taken: reuse them
-            d1 = dy if sub == 0 else forces(t, y, p, rollers, knots, scratch, False)[0]
+            d1 = dy if sub == 0 else forces(t, y, p, rollers, knots, motion, scratch, False)[0]
             for j in range(size):
                 k1[j] = d1[j]
                 tmp[j] = y[j] + 0.5 * h * d1[j]
-            d2, _r = forces(t + 0.5 * h, tmp, p, rollers, knots, scratch, False)
+            d2 = forces(t + 0.5 * h, tmp, p, rollers, knots, motion, scratch, False)[0]
             for j in range(size):
                 k1[j] += 2.0 * d2[j]
                 tmp[j] = y[j] + 0.5 * h * d2[j]
-            d3, _r = forces(t + 0.5 * h, tmp, p, rollers, knots, scratch, False)
+            d3 = forces(t + 0.5 * h, tmp, p, rollers, knots, motion, scratch, False)[0]
             for j in range(size):
                 k1[j] += 2.0 * d3[j]
                 tmp[j] = y[j] + h * d3[j]
-            d4, _r = forces(t + h, tmp, p, rollers, knots, scratch, False)
+            d4 = forces(t + h, tmp, p, rollers, knots, motion, scratch, False)[0]
             for j in range(size):
                 y[j] += h * (k1[j] + d4[j]) / 6.0
             t += h

@@ -3,7 +3,8 @@ axially, the threads, the threadless sector and the two cam rings.
 
 Bodies and degrees of freedom
 -----------------------------
-The screw turns at a prescribed speed ω_s and is axially fixed (rigid); the carrier turns with it
+The screw turns at a prescribed speed ω_s(t) (constant or piecewise linear, forward or at rest)
+and is axially fixed (rigid); the carrier turns with it
 at the rolling ratio ω_c = d_s/(2d_c)·ω_s (eq. 25: no slip, the paper's own simulation is within
 1 % of it); the nut (with its cam rings) and every roller move axially — the N + 1 axial
 degrees of freedom, integrated by a guarded fixed-step RK4 (:mod:`._kernels`) — and the payload
@@ -51,7 +52,8 @@ between the platform and the far ring until the threads take it back.
 
 Idealised: the platform top holds a reset roller across the whole threadless area (2β) until the
 nut thread takes it back; the paper lays out one β per direction of rotation, so a real roller
-runs the second β free of the platform. Forward rotation only (the load may reverse): the
+runs the second β free of the platform. Forward rotation or rest only — the speed may vary
+(the motion's knots), the load may reverse: the
 mirrored reverse layout is in the kernels, but its exit, where the loaded flank pulls the
 landing roller into the platform edge, is not validated. Not modelled (yet): friction on the platform and in the threads (the paper's μ = 0.25–0.3 on the
 platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
@@ -201,7 +203,8 @@ class RecirculatingRun:
     work_in, dissipated, work_load, mechanical_energy : numpy.ndarray [J]
         Cumulative work of the prescribed motion, energy the dampers took, work against the
         load; kinetic plus elastic energy.
-    screw_speed, carrier_speed : float
+    screw_angle, screw_speed, carrier_speed : numpy.ndarray [rad, rad/s, rad/s]
+        The prescribed screw motion and the carrier's (rolling ratio).
     """
 
     time: np.ndarray
@@ -223,8 +226,9 @@ class RecirculatingRun:
     dissipated: np.ndarray
     work_load: np.ndarray
     mechanical_energy: np.ndarray
-    screw_speed: float
-    carrier_speed: float
+    screw_angle: np.ndarray
+    screw_speed: np.ndarray
+    carrier_speed: np.ndarray
 
     @property
     def energy_error(self) -> float:
@@ -243,7 +247,7 @@ class RecirculatingRun:
 def simulate_recirculating(
     design: PRSMDesign,
     *,
-    screw_speed: float,
+    screw_speed,
     load,
     duration: float,
     load_sine: tuple[float, float] = (0.0, 0.0),
@@ -259,15 +263,18 @@ def simulate_recirculating(
     reentry_edge: ReentryEdge | None = None,
     step: float = STEP,
 ) -> RecirculatingRun:
-    """Simulate a recirculating PRSM at a constant screw speed under a constant axial load.
+    """Simulate a recirculating PRSM: the screw turning forward (a constant speed or the
+    motion's knots) under an axial load.
 
     Parameters
     ----------
     design : PRSMDesign
         A recirculating design (its ``[recirculation]`` geometry, or paper 03's rules).
-    screw_speed : float [rad/s]
-        > 0: forward rotation (the left ring's platform resets the rollers); the load may
-        reverse.
+    screw_speed : float or array of shape (2 or 3, K) [rad/s; s, rad/s]
+        A constant speed > 0, or the motion's knots (times from 0, speeds ≥ 0; a third row
+        of angles, as ``OperatingProfile.motion_knots`` gives it, is recomputed), the speed
+        linear between knots: forward rotation or rest (the left ring's platform resets the
+        rollers); the load may reverse.
     load : float or array of shape (2, K) [N; s, N]
         Axial load on the nut (positive resists forward motion): a constant, or knots
         (times, loads) interpolated linearly (``OperatingProfile.load_knots``).
@@ -320,13 +327,7 @@ def simulate_recirculating(
         design.variant,
         "must be 'recirculating' (the standard PRSM runs in prsm_health.simulation.dynamics)",
     )
-    require(
-        isinstance(screw_speed, (int, float)) and math.isfinite(screw_speed) and screw_speed > 0,
-        "screw_speed",
-        screw_speed,
-        "must be a finite speed > 0 [rad/s]: forward rotation only so far (the reverse ring's "
-        "platform is laid out, its exit against the loaded flank not yet validated)",
-    )
+    motion = _motion_knots(screw_speed, duration)
     knots = _load_knots(load, duration)
     require(
         len(load_sine) == 2 and all(math.isfinite(v) for v in load_sine) and load_sine[1] >= 0,
@@ -366,7 +367,7 @@ def simulate_recirculating(
     )
     nominal = float(np.max(np.abs(knots[1]))) + abs(float(load_sine[0]))
     p, rollers, y0 = _parameters(
-        design, screw_speed, nominal, clearance, payload_mass, load_ramp, contact, nut_spall
+        design, motion[1, 0], nominal, clearance, payload_mass, load_ramp, contact, nut_spall
     )
     if linkage is not None:
         stiffness, ratio = linkage
@@ -394,7 +395,7 @@ def simulate_recirculating(
     n = design.n_rollers
     out = np.zeros((n_steps, K.OUT_SIZE))
     roller_out = np.zeros((n_steps, n, K.ROLLER_SIZE))
-    done = K.integrate(y0, p, rollers, knots, step, n_steps, MAX_SUBSTEPS, out, roller_out)
+    done = K.integrate(y0, p, rollers, knots, motion, step, n_steps, MAX_SUBSTEPS, out, roller_out)
     if done < n_steps:
         raise ConvergenceError(
             f"recirculating PRSM: at t = {done * step:.6g} s a contact needs more than "
@@ -402,13 +403,12 @@ def simulate_recirculating(
         )
     sector = roller_out[:, :, K.ROLLER_SECTOR].T > 0.5
     exits = np.sum(sector[:, :-1] & ~sector[:, 1:], axis=1)
-    omega = float(screw_speed)
     return RecirculatingRun(
         time=out[:, K.OUT_T],
         nut_position=out[:, K.OUT_X],
         nut_velocity=out[:, K.OUT_V],
         nut_acceleration=out[:, K.OUT_A],
-        drive_torque=out[:, K.OUT_POWER] / omega,
+        drive_torque=out[:, K.OUT_TORQUE],
         axial_load=out[:, K.OUT_LOAD],
         linkage_force=out[:, K.OUT_ROD],
         payload_position=out[:, K.OUT_XP],
@@ -423,9 +423,47 @@ def simulate_recirculating(
         dissipated=out[:, K.OUT_W_DISS],
         work_load=out[:, K.OUT_W_LOAD],
         mechanical_energy=out[:, K.OUT_ENERGY],
-        screw_speed=omega,
-        carrier_speed=speed_ratios(design).carrier * omega,
+        screw_angle=out[:, K.OUT_THETA],
+        screw_speed=out[:, K.OUT_OMEGA],
+        carrier_speed=speed_ratios(design).carrier * out[:, K.OUT_OMEGA],
     )
+
+
+def _motion_knots(screw_speed, duration: float) -> np.ndarray:
+    """The screw's motion as (3, K) knots [s, rad/s, rad], checked: forward or at rest."""
+    what = "forward rotation or rest only so far (the reverse ring's platform is laid out, "
+    what += "its exit against the loaded flank not yet validated)"
+    if isinstance(screw_speed, (int, float)):
+        require(
+            math.isfinite(screw_speed) and screw_speed > 0,
+            "screw_speed",
+            screw_speed,
+            f"must be a finite speed > 0 [rad/s]: {what}",
+        )
+        times, speeds = np.array([0.0, max(duration, 1e-9)]), np.full(2, float(screw_speed))
+    else:
+        given = np.asarray(screw_speed, dtype=float)
+        require(
+            given.ndim == 2
+            and given.shape[0] in (2, 3)
+            and given.shape[1] >= 2
+            and bool(np.all(np.isfinite(given[:2])))
+            and given[0, 0] == 0.0
+            and bool(np.all(np.diff(given[0]) > 0)),
+            "screw_speed",
+            f"array of shape {given.shape}",
+            "must be a speed [rad/s] or (2 or 3, K ≥ 2) knots: increasing times from 0 [s], "
+            "finite speeds [rad/s]",
+        )
+        times, speeds = given[0], given[1]
+        require(
+            bool(np.all(speeds >= 0.0)) and bool(np.any(speeds > 0.0)),
+            "screw_speed",
+            f"knots from {speeds.min():g} to {speeds.max():g} rad/s",
+            f"must be ≥ 0 and not all 0: {what}",
+        )
+    angles = np.concatenate(([0.0], np.cumsum(0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times))))
+    return np.ascontiguousarray(np.vstack([times, speeds, angles]))
 
 
 def _load_knots(load, duration: float) -> np.ndarray:
@@ -457,7 +495,7 @@ def _parameters(
     lead, pitch = design.screw_lead, design.pitch
     beta = orbital_angle(design)
     ratio = speed_ratios(design).carrier
-    direction = 1.0 if screw_speed > 0 else -1.0
+    direction = 1.0  # forward (the motion's knots are checked ≥ 0)
     room = cam_ring_spacing(design, geometry) - (
         geometry.roller_half_length_1 + geometry.roller_half_length_2
     )
@@ -493,7 +531,6 @@ def _parameters(
     p[K.P_LIFT_RAMP] = LIFT_RAMP_SHARE * beta
     p[K.P_COT_FLANK] = 1.0 / math.tan(design.contact_angle)
     p[K.P_DIR] = direction
-    p[K.P_OMEGA] = screw_speed
     p[K.P_RATIO] = ratio
     p[K.P_PHI_ENTRY] = -direction * beta  # §3.2: forward rotation enters at −β
     p[K.P_LOAD_RAMP] = load_ramp
@@ -541,9 +578,10 @@ def right_hand_side(
         design, screw_speed, load, clearance, payload_mass, load_ramp, contact
     )
     knots = _load_knots(load, 1.0)
+    motion = _motion_knots(screw_speed, 1.0)
     scratch = np.zeros((design.n_rollers, K.ROLLER_SIZE))
 
     def f(t, y):
-        return K.forces(t, np.asarray(y, float), p, rollers, knots, scratch, False)[0]
+        return K.forces(t, np.asarray(y, float), p, rollers, knots, motion, scratch, False)[0]
 
     return f, y0

@@ -3,7 +3,8 @@ dynamic model (:mod:`.model`): the same :class:`~prsm_health.core.run.Run` as th
 PRSM's — measured channels through the scenario's instrumentation, truth, labels, energy — for
 what the model covers, and one error naming the field for what it does not yet.
 
-Covered: a constant screw speed (forward) under the profile's axial load — constant, sinusoidal
+Covered: the profile's screw motion turning forward or at rest (constant, ramp, trapezoid, a
+health check of such phases) under its axial load — constant, sinusoidal
 or reversing —, the thread clearances, and the faults of a recirculating unit: a spall on the
 nut's loaded flank (on one thread turn of the n_t engaged: share 1/n_t, as the standard model's),
 cam-chamfer wear, platform height loss, re-entry-edge damage (:mod:`prsm_health.actuator.faults`).
@@ -62,7 +63,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     )
     run = simulate_recirculating(
         design,
-        screw_speed=float(profile.speed),
+        screw_speed=profile.motion_knots(),
         load=knots,
         load_sine=(amplitude, frequency),
         duration=profile.duration,
@@ -75,17 +76,16 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
         **faults,
     )
     n = int(round(profile.duration / h))  # the standard run's sample count at this step
-    t = run.time[:n]
     ratio = drive_train.gear_ratio
     rod = run.linkage_force[:n]
     zero = np.zeros(n)
     truth_raw = {
-        "motor_angle": ratio * profile.speed * t,
-        "motor_speed": np.full(n, ratio * profile.speed),
+        "motor_angle": ratio * run.screw_angle[:n],
+        "motor_speed": ratio * run.screw_speed[:n],
         "motor_torque": run.drive_torque[:n] / (ratio * drive_train.gear_efficiency),
-        "screw_angle": profile.speed * t,
-        "screw_speed": np.full(n, float(profile.speed)),
-        "carrier_speed": np.full(n, run.carrier_speed),
+        "screw_angle": run.screw_angle[:n],
+        "screw_speed": run.screw_speed[:n],
+        "carrier_speed": run.carrier_speed[:n],
         "nut_position": run.nut_position[:n],
         "nut_axial_accel": run.nut_acceleration[:n],
         "nut_tangential_accel": zero,
@@ -133,17 +133,33 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
             "friction": 0.0,
         },
         truth=truth,
+        # the controller commands the check's phases: which one each sample is in is known
+        check_phase=None if profile.check is None else profile.check.phase_at(time),
+        check=None if profile.check is None else profile.check.recorded(),
         operating=scenario.operating_point(),
     )
 
 
 def _require_covered(profile, health) -> None:
     """One error naming the first field the recirculating model does not cover yet."""
-    what = "the recirculating PRSM's model runs a constant forward speed so far"
-    require(profile.check is None, "profile.check", "a health check", f"{what}: no check yet")
-    require(profile.motion == "constant", "profile.motion", profile.motion, f"{what}: 'constant'")
+    what = "the recirculating PRSM's model turns the screw forward or rests so far"
     require(profile.drive == "prescribed", "profile.drive", profile.drive, f"{what}: 'prescribed'")
-    require(profile.speed > 0, "profile.speed", profile.speed, f"{what}: > 0 (forward)")
+    if profile.check is not None:
+        for phase in profile.check.phases:
+            require(
+                phase.motion != "reversing" and phase.speed >= 0,
+                "check.phases",
+                f"{phase.name!r} ({phase.motion}, {phase.speed:g} rad/s)",
+                f"{what}: every phase at a speed ≥ 0, none reversing",
+            )
+    else:
+        require(
+            profile.motion != "reversing",
+            "profile.motion",
+            profile.motion,
+            f"{what}: 'constant', 'ramp' or 'trapezoid'",
+        )
+        require(profile.speed > 0, "profile.speed", profile.speed, f"{what}: > 0 (forward)")
     nominal = HealthState()
     for f in dataclasses.fields(HealthState):
         if f.name in ("clearance_screw", "clearance_nut", "clearance_gear", "faults"):
