@@ -53,10 +53,10 @@ between the platform and the far ring until the threads take it back.
 Idealised: the platform top holds a reset roller across the whole threadless area (2β) until the
 nut thread takes it back; the paper lays out one β per direction of rotation, so a real roller
 runs the second β free of the platform. Forward rotation or rest only — the speed may vary
-(the motion's knots), the load may reverse: the
-mirrored reverse layout is in the kernels, but its exit, where the loaded flank pulls the
-landing roller into the platform edge, is not validated. Not modelled (yet): friction on the platform and in the threads (the paper's μ = 0.25–0.3 on the
-platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
+(the motion's knots), the load may reverse: the mirrored reverse layout is in the kernels, but
+its exit, where the loaded flank pulls the landing roller into the platform edge, is not
+validated. Not modelled (yet): friction on the platform and in the threads (the paper's
+μ = 0.25–0.3 on the platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
 (the carrier collisions of Fig. 32), radial and tilting motion; the screw's own axial and
 torsional compliance. The energy of every modelled contact is accounted for: the work of the
 prescribed screw/carrier motion equals the change of kinetic and elastic energy plus what the
