@@ -498,4 +498,29 @@ BUILT_IN: dict[str, HealthCheck] = {
             ),
         ),
     ),
+    # The recirculating PRSM's (paper 03): its model turns forward only (a phase turning back
+    # is refused), so no reversal — the clearance is read from the service's load reversals
+    # instead — and no torque pair (the model has no friction). Numbers for the paper03 preset
+    # (lead 1 mm: 0.6 s of check moves the nut ≈ 7 mm).
+    "recirculating-check": HealthCheck(
+        name="recirculating-check",
+        phases=(
+            # The nut's axial resonance on its threads without load, as the standard check's.
+            CheckPhase(
+                "no-load stroke", "constant", speed=60.0, load=0.0, duration=0.15, ramp_time=_RAMP
+            ),
+            # The reset comb at a commanded load, the phase the unit's baseline is compared in
+            # (docs/faults.md: one recording at one load cannot place a spall's strike against
+            # the resets' as well as the same unit at the same load can): paper 03's 40π rad/s,
+            # 40 % C_a, 0.3 s = 29 roller passages (N·f_c = 97 Hz), above the 8 the comb needs.
+            CheckPhase(
+                "high-load stroke",
+                "constant",
+                speed=40 * math.pi,
+                load="40 % C_a",
+                duration=0.3,
+                ramp_time=_RAMP,
+            ),
+        ),
+    ),
 }

@@ -43,9 +43,16 @@ DECIDING_RECORDING = {
     "high-load stroke: synchronous averages at the nut-pass and roller-spin periods)",
     "tooth_damage": "none the instrumentation can give: a damaged ring or roller-gear tooth "
     "changes the nut vibration below the accelerometer's noise (docs/faults.md)",
+    "cam_ring": "a steady stroke at a commanded load against the unit's own baseline (the "
+    "recirculating-check's high-load stroke: the reset comb's shape)",
+    "reentry_edge": "a steady stroke at a commanded load against the unit's own baseline (the "
+    "recirculating-check's high-load stroke: the reset comb's shape)",
 }
 #: What to record when the recording lacked a condition: the health check does all of them.
-RUN_THE_CHECK = "run the health check (prsm-health simulate --profile health-check shows it)"
+RUN_THE_CHECK = (
+    "run the health check (prsm-health simulate --profile health-check shows it; "
+    "recirculating-check for a recirculating PRSM)"
+)
 
 
 def not_observable(missing: list[str], *, has_check: bool) -> Undecided:

@@ -25,7 +25,9 @@ so a user-defined check is read the same way. Four roles:
   pass, the roller spin, the carrier and the screw revolution, and of its squared envelope at
   the nut pass, the roller spin and the carrier (an impact train stays periodic in the
   envelope when the resonance it rings is not phase-locked); kurtosis, crest factor and RMS
-  of that residual; the stroke-position profile (a screw spall).
+  of that residual; the stroke-position profile (a screw spall); for a recirculating PRSM, the
+  reset comb's shape (:mod:`prsm_health.signals.reset_comb`: a nut spall, a worn chamfer, a
+  chipped re-entry edge move where the passage's energy sits).
 
 :func:`check_indicators` returns every indicator of :data:`CHECK_INDICATORS`, NaN where the
 check lacks the phase or the recording the channel, with the reason.
@@ -89,7 +91,9 @@ from .check_roles import (
     role_shortfall,
 )
 from .features import extract_features, run_design
+from .indicator_table import SEARCH_SHARE
 from .lost_motion import lost_motion_step, settled_lost_motion_step, settled_samples
+from .reset_comb import RESET_COMB, reset_comb_indicators
 from .spectra import bandpass_rows, hilbert_envelope, welch_psd
 
 #: Band of the no-load spectral centroid [Hz]: around the nut's axial resonance on its threads
@@ -118,6 +122,10 @@ POSITION_BIN_SHARE = 0.25
 #: The reversal indicators of :func:`~prsm_health.signals.features.extract_features` kept
 #: (module docstring of :func:`check_indicators`).
 REVERSAL_FEATURES = ("lost_motion", "torque_rattle_rate", "drive_torque_ripple", "efficiency")
+#: The reset comb's indicators a recirculating PRSM's high-load phase gives (signals.reset_comb):
+#: its resets and whatever strikes on the comb's line (a nut spall, a chipped re-entry edge), at
+#: the commanded load; the load slope needs a load that varies, which a constant phase has not.
+COMB_FEATURES = tuple(k for k in RESET_COMB if k != "comb_load_slope")
 
 
 def _indicator_table() -> dict[str, str]:
@@ -149,6 +157,7 @@ def _indicator_table() -> dict[str, str]:
             "check_highload_position_contrast": "-",
         }
     )
+    units.update({f"check_highload_{k}": RESET_COMB[k] for k in COMB_FEATURES})
     return units
 
 
@@ -354,6 +363,9 @@ def _high_load(phase: Run, design: PRSMDesign, gear_ratio: float, out: dict) -> 
     profile = position_profile(y, position, width)
     out["check_highload_position_snr"] = profile.snr
     out["check_highload_position_contrast"] = profile.contrast
+    if design.variant == "recirculating":  # its resets' comb, at the commanded load
+        comb = reset_comb_indicators(phase.channels, design, SEARCH_SHARE)
+        out.update({f"check_highload_{k}": comb[k] for k in COMB_FEATURES})
     return None
 
 

@@ -113,3 +113,34 @@ def test_what_the_recirculating_model_does_not_cover_is_refused_by_name(profile,
     )
     with pytest.raises(ParameterError, match=field.replace(".", r"\.")):
         scenario.simulate()
+
+
+@pytest.mark.slow
+def test_recirculating_health_checks_train_a_check_part_that_reads_phase_by_phase(tmp_path, capsys):
+    # The shipped check recipes trimmed (5 units, 9 checks, 5 baselines; three classes the
+    # comb shows at one load — docs/faults.md), ≈ 20 s: generate, train the check part against
+    # the baselines, and a check recording is read phase by phase — the roles the forward-only
+    # check has, the clearance said not observable (no reversal).
+    def trimmed(name, samples):
+        data = tomllib.loads((ROOT / "datasets" / f"{name}.toml").read_text())
+        data["units"]["count"] = 5
+        data["sweep"]["samples"] = samples
+        if "fault_case" in data["sweep"]:
+            data["sweep"]["fault_case"] = ["none", "cam_wear", "reentry_edge"]
+        return Recipe.from_dict(data)
+
+    generate(trimmed("recirculating-check", 9), tmp_path / "checks", progress=False)
+    generate(trimmed("recirculating-check-baseline", 5), tmp_path / "base", progress=False)
+    model = tmp_path / "m.skops"
+    args = ["train", str(tmp_path / "checks"), "--baseline", str(tmp_path / "base")]
+    assert main([*args, "--out", str(model)]) == 0
+    capsys.readouterr()
+    recording = tmp_path / "check.parquet"
+    simulate = ["simulate", "--design", "paper03", "--profile", "recirculating-check"]
+    assert main([*simulate, "--out", str(recording)]) == 0
+    capsys.readouterr()
+    assert main(["diagnose", str(recording), "--model", str(model), "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    roles = answer["check_phases"]
+    assert roles == {"no_load": "no-load stroke", "high_load": "high-load stroke"}, answer
+    assert answer["observability"] == {"clearance": False, "fault": True}
