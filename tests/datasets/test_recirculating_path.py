@@ -144,3 +144,25 @@ def test_recirculating_health_checks_train_a_check_part_that_reads_phase_by_phas
     roles = answer["check_phases"]
     assert roles == {"no_load": "no-load stroke", "high_load": "high-load stroke"}, answer
     assert answer["observability"] == {"clearance": False, "fault": True}
+    # the same through the service and its dashboard (a real server on 127.0.0.1): the check
+    # uploaded for an asset, the asset's page and its latest diagnosis
+    import httpx
+
+    from prsm_health.apps.service import create_app
+    from prsm_health.apps.service.server import serve_in_thread
+
+    app = create_app(model, tmp_path / "history.sqlite", warmup=False)
+    with serve_in_thread(app) as url, httpx.Client(base_url=url, timeout=60) as client:
+        with open(recording, "rb") as f:
+            up = client.post(
+                "/v1/diagnose/file", files={"file": ("check.parquet", f)}, data={"asset_id": "rc-1"}
+            )
+        assert up.status_code == 200, up.text
+        served = up.json()["diagnosis"]
+        assert served["check_phases"] == roles and served["fault_class"] == answer["fault_class"]
+        asset = client.get("/v1/assets/rc-1").json()
+        assert (
+            asset["asset_id"] == "rc-1" and asset["latest"]["fault_class"] == served["fault_class"]
+        )
+        page = client.get("/assets/rc-1")
+        assert page.status_code == 200 and "rc-1" in page.text
