@@ -16,8 +16,7 @@ from prsm_health.core.errors import SimulationError
 from prsm_health.core.run import Run
 
 from ..decimation import decimate
-from ..instrumentation import bind_drive_train, sensor_rng
-from ..thermal import housing_temperature_signal
+from ..run_assembly import assemble_run, measure
 from . import _kernels
 from . import layout as L
 from .model import (
@@ -229,18 +228,10 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
     y = settled_state(model, h, options.settle_time)
     record = integrate(model, y, h, n_steps, progress=progress)
     truth_raw = _truth_from_record(record)
-    # derived after the kernel's signals: the housing at the temperature probe
-    truth_raw["housing_temperature"] = housing_temperature_signal(profile.temperature, truth_raw)
-    channels = bind_drive_train(instrumentation, scenario.drive_train).measure(
-        truth_raw,
-        1.0 / h,
-        sensor_rng(scenario.sensors_seed),
-    )
+    channels = measure(scenario, truth_raw, 1.0 / h)
     # the record's columns filtered together, in place (decimation's kernel)
     truth = _truth_from_record(decimate(record, factor))
     truth["housing_temperature"] = decimate(truth_raw["housing_temperature"], factor)
-    n_out = len(next(iter(truth.values())))
-    time = np.arange(n_out) / instrumentation.sample_rate
     nq = model.n_coordinates
     energy = {
         "drive": float(y[2 * nq + L.X_W_DRIVE]),
@@ -248,23 +239,17 @@ def simulate_scenario(scenario, *, progress: bool = False) -> Run:
         "dissipated": float(y[2 * nq + L.X_W_DISS]),
         "friction": float(y[2 * nq + L.X_W_FRIC]),
     }
-    return Run(
-        time=time,
+    return assemble_run(
+        scenario,
         channels=channels,
-        sample_rate=instrumentation.sample_rate,
-        labels={**scenario.labels(), **realised_clearances(model)},
-        scenario={
-            **scenario.to_dict(),
+        truth=truth,
+        energy=energy,
+        labels=realised_clearances(model),
+        model_info={
             "integration_step": h,
             "stable_step": h_stable,
             "highest_natural_frequency": f_max,
         },
-        energy=energy,
-        truth=truth,
-        # the controller commands the check's phases: which one each sample is in is known
-        check_phase=None if profile.check is None else profile.check.phase_at(time),
-        check=None if profile.check is None else profile.check.recorded(),
-        operating=scenario.operating_point(),
     )
 
 

@@ -31,8 +31,7 @@ from prsm_health.core.run import Run
 
 from ..decimation import decimate
 from ..dynamics.simulate import choose_step
-from ..instrumentation import bind_drive_train, sensor_rng
-from ..thermal import housing_temperature_signal
+from ..run_assembly import assemble_run, measure
 from .model import STEP, NutSpall, ReentryEdge, simulate_recirculating
 
 #: The load's rise from zero at the start [s]: the model starts unloaded (a step would ring the
@@ -97,12 +96,7 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
         "screw_axial_position": zero,
         "load_force": run.axial_load[:n],
     }
-    truth_raw["housing_temperature"] = housing_temperature_signal(profile.temperature, truth_raw)
-    channels = bind_drive_train(instrumentation, drive_train).measure(
-        truth_raw,
-        1.0 / h,
-        sensor_rng(scenario.sensors_seed),
-    )
+    channels = measure(scenario, truth_raw, 1.0 / h)
     names = [name for name in TRUTH_NAMES if name in truth_raw]
     decimated = decimate(np.column_stack([truth_raw[name] for name in names]), factor)
     truth = {name: decimated[:, k] for k, name in enumerate(names)}
@@ -114,29 +108,23 @@ def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
     exits = run.in_sector[:, :-1] & ~run.in_sector[:, 1:]
     count = np.concatenate([[0], np.cumsum(exits.sum(axis=0))])[: n_out * factor]
     truth["reset_count"] = count.reshape(n_out, factor)[:, -1].astype(float)
-    time = np.arange(n_out) / instrumentation.sample_rate
     clearances = {
         f"clearance_{side}_realised_{stat}": value
         for side, value in (("screw", health.clearance_screw), ("nut", health.clearance_nut))
         for stat in ("mean", "min", "max")
     }
-    return Run(
-        time=time,
+    return assemble_run(
+        scenario,
         channels=channels,
-        sample_rate=instrumentation.sample_rate,
-        labels={**scenario.labels(), **clearances},
-        scenario={**scenario.to_dict(), "integration_step": h, "model": "recirculating"},
+        truth=truth,
         energy={
             "drive": float(run.work_in[n - 1]),
             "load": float(run.work_load[n - 1]),
             "dissipated": float(run.dissipated[n - 1]),
             "friction": 0.0,
         },
-        truth=truth,
-        # the controller commands the check's phases: which one each sample is in is known
-        check_phase=None if profile.check is None else profile.check.phase_at(time),
-        check=None if profile.check is None else profile.check.recorded(),
-        operating=scenario.operating_point(),
+        labels=clearances,
+        model_info={"integration_step": h, "model": "recirculating"},
     )
 
 
