@@ -39,24 +39,23 @@ P_BETA = 16  # half the threadless sector's orbital angle [rad]
 P_LIFT = 17  # radial lift over the screw thread crest [m]
 P_LIFT_RAMP = 18  # orbital angle over which a lift (or the platform's edge) ramps [rad]
 P_COT_FLANK = 19  # axial play per radial lift: cos β / sin β of the flank
-P_DIR = 20  # +1 forward, −1 reverse
-P_RATIO = 21  # carrier / screw speed
-P_PHI_ENTRY = 22  # orbital angle where a roller enters the sector [rad]
-P_LOAD_RAMP = 23  # time over which the load rises from 0 [s] (the load: knots + sinusoid)
-P_SPALL_ANGLE = 24  # orbital angle where a nut-flank spall starts [rad]
-P_SPALL_WIDTH = 25  # its angular extent along the roller's path [rad] (0: no spall)
-P_SPALL_DEPTH = 26  # material missing from the nut flank [m]
-P_LOAD_SINE = 27  # amplitude of a sinusoid added to the load knots [N]
-P_LOAD_FREQUENCY = 28  # its frequency [Hz]
-P_SPALL_SHARE = 29  # share of the engaged thread turns the spall is on (1/n_t: one turn)
-P_CAM_WEAR = 30  # material worn off the chamfer at its entrance [m], tapering to 0 at its top
-P_PLATFORM_LOSS = 31  # height the platform lost [m]: the reset falls short by it
-P_EDGE_WIDTH = 32  # orbital extent of the damaged nut thread after the sector's exit [rad]
-P_EDGE_DEPTH = 33  # material missing from both nut flanks there [m]
-P_LINK_K = 34  # linkage stiffness nut–payload [N/m] (0: the payload rides rigidly on the nut)
-P_LINK_C = 35  # linkage damping [N·s/m]
-P_M_PAYLOAD = 36  # payload behind the linkage [kg]
-P_SIZE = 37
+P_RATIO = 20  # carrier / screw speed
+P_PHI_ENTRY = 21  # orbital angle where a roller enters the sector [rad]
+P_LOAD_RAMP = 22  # time over which the load rises from 0 [s] (the load: knots + sinusoid)
+P_SPALL_ANGLE = 23  # orbital angle where a nut-flank spall starts [rad]
+P_SPALL_WIDTH = 24  # its angular extent along the roller's path [rad] (0: no spall)
+P_SPALL_DEPTH = 25  # material missing from the nut flank [m]
+P_LOAD_SINE = 26  # amplitude of a sinusoid added to the load knots [N]
+P_LOAD_FREQUENCY = 27  # its frequency [Hz]
+P_SPALL_SHARE = 28  # share of the engaged thread turns the spall is on (1/n_t: one turn)
+P_CAM_WEAR = 29  # material worn off the chamfer at its entrance [m], tapering to 0 at its top
+P_PLATFORM_LOSS = 30  # height the platform lost [m]: the reset falls short by it
+P_EDGE_WIDTH = 31  # orbital extent of the damaged nut thread after the sector's exit [rad]
+P_EDGE_DEPTH = 32  # material missing from both nut flanks there [m]
+P_LINK_K = 33  # linkage stiffness nut–payload [N/m] (0: the payload rides rigidly on the nut)
+P_LINK_C = 34  # linkage damping [N·s/m]
+P_M_PAYLOAD = 35  # payload behind the linkage [kg]
+P_SIZE = 36
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
@@ -90,7 +89,7 @@ def _step_on(d, depth):
 @njit(cache=True, inline="always")
 def _sector(p, phi):
     """(angle travelled into the threadless sector a ∈ [0, 2π), in it?)."""
-    a = (p[P_DIR] * (phi - p[P_PHI_ENTRY])) % TWO_PI
+    a = (phi - p[P_PHI_ENTRY]) % TWO_PI
     return a, a < 2.0 * p[P_BETA]
 
 
@@ -129,9 +128,9 @@ def _spall(p, phi):
     width = p[P_SPALL_WIDTH]
     if width <= 0.0:
         return 0.0, 0.0
-    along = (p[P_DIR] * (phi - p[P_SPALL_ANGLE])) % TWO_PI
+    along = (phi - p[P_SPALL_ANGLE]) % TWO_PI
     value, slope = _trapezoid(along, width, 0.1 * width)
-    return p[P_SPALL_DEPTH] * value, p[P_SPALL_DEPTH] * slope * p[P_DIR]
+    return p[P_SPALL_DEPTH] * value, p[P_SPALL_DEPTH] * slope
 
 
 @njit(cache=True, inline="always")
@@ -239,7 +238,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
     n = int(p[P_N])
     lead, pitch = p[P_LEAD], p[P_PITCH]
     m_r, m_n = p[P_M_ROLLER], p[P_M_NUT]
-    ratio, s = p[P_RATIO], p[P_DIR]
+    ratio = p[P_RATIO]
     theta, omega = _screw(t, motion)
     a_dot_unit = abs(ratio)  # the sector angle grows at the carrier's speed (forward)
     x, v = y[0], y[1]
@@ -297,23 +296,19 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
                 f_side = -sign * force
             else:
                 f_screw = -sign * force
-        # ---- cam rings: the left ring's face at u = 0 (with its platform when forward), the
-        # right ring's at u = room (with its platform when reverse)
+        # ---- cam rings: the left ring's face at u = 0 with its platform (forward rotation's),
+        # the right ring's face at u = room
         u, u_dot = z - x, w - v
         rise, drise_da = _platform(p, a, inside)
         f_cam = 0.0
         for ring in range(2):
             if ring == 0:
-                surface = rise if s > 0 else 0.0
-                surface_unit = drise_da * a_dot_unit if s > 0 else 0.0  # per ω_s
-                d = surface - u
-                kin_unit = surface_unit
+                d = rise - u
+                kin_unit = drise_da * a_dot_unit  # the platform's rate per ω_s
                 push = 1.0
             else:
-                surface = p[P_ROOM] - (rise if s < 0 else 0.0)
-                surface_unit = -(drise_da * a_dot_unit) if s < 0 else 0.0
-                d = u - surface
-                kin_unit = -surface_unit
+                d = u - p[P_ROOM]
+                kin_unit = 0.0
                 push = -1.0
             d_dot = omega * kin_unit - push * u_dot
             if d > 0.0:
@@ -362,7 +357,7 @@ def mechanical_energy(t, y, p, rollers, motion):
     """Kinetic energy of nut, rollers and payload plus the contacts' elastic energy [J]."""
     n = int(p[P_N])
     lead, pitch = p[P_LEAD], p[P_PITCH]
-    ratio, s = p[P_RATIO], p[P_DIR]
+    ratio = p[P_RATIO]
     theta = _screw(t, motion)[0]
     x = y[0]
     energy = 0.5 * p[P_M_NUT] * y[1] ** 2
@@ -389,7 +384,7 @@ def mechanical_energy(t, y, p, rollers, motion):
             energy += 0.4 * p[P_K_THREAD] * max(d_n, 0.0) ** 2.5
         u = z - x
         rise, _ = _platform(p, a, inside)
-        for d in ((rise if s > 0 else 0.0) - u, u - (p[P_ROOM] - (rise if s < 0 else 0.0))):
+        for d in (rise - u, u - p[P_ROOM]):
             if d > 0.0:
                 energy += p[P_K_CAM] * d ** (p[P_E_CAM] + 1.0) / (p[P_E_CAM] + 1.0)
     return energy

@@ -53,9 +53,11 @@ between the platform and the far ring until the threads take it back.
 Idealised: the platform top holds a reset roller across the whole threadless area (2β) until the
 nut thread takes it back; the paper lays out one β per direction of rotation, so a real roller
 runs the second β free of the platform. Forward rotation or rest only — the speed may vary
-(the motion's knots), the load may reverse: the mirrored reverse layout is in the kernels, but
-its exit, where the loaded flank pulls the landing roller into the platform edge, is not
-validated. Not modelled (yet): friction on the platform and in the threads (the paper's
+(the motion's knots), the load may reverse. Turning back needs the second platform, on the other
+ring, for the other direction: the paper lays it out over the other β but does not dimension
+it, and with both platforms full height over the area the forward-reset roller (one lead from
+the first ring) would stand where the second one is — so their real layout differs, and is
+not modelled. Not modelled (yet): friction on the platform and in the threads (the paper's
 μ = 0.25–0.3 on the platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
 (the carrier collisions of Fig. 32), radial and tilting motion; the screw's own axial and
 torsional compliance. The energy of every modelled contact is accounted for: the work of the
@@ -431,8 +433,8 @@ def simulate_recirculating(
 
 def _motion_knots(screw_speed, duration: float) -> np.ndarray:
     """The screw's motion as (3, K) knots [s, rad/s, rad], checked: forward or at rest."""
-    what = "forward rotation or rest only so far (the reverse ring's platform is laid out, "
-    what += "its exit against the loaded flank not yet validated)"
+    what = "forward rotation or rest only (turning back needs the other direction's platform, "
+    what += "which paper 03 does not dimension)"
     if isinstance(screw_speed, (int, float)):
         require(
             math.isfinite(screw_speed) and screw_speed > 0,
@@ -495,7 +497,6 @@ def _parameters(
     lead, pitch = design.screw_lead, design.pitch
     beta = orbital_angle(design)
     ratio = speed_ratios(design).carrier
-    direction = 1.0  # forward (the motion's knots are checked ≥ 0)
     room = cam_ring_spacing(design, geometry) - (
         geometry.roller_half_length_1 + geometry.roller_half_length_2
     )
@@ -530,9 +531,8 @@ def _parameters(
     p[K.P_LIFT] = radial_lift(design)
     p[K.P_LIFT_RAMP] = LIFT_RAMP_SHARE * beta
     p[K.P_COT_FLANK] = 1.0 / math.tan(design.contact_angle)
-    p[K.P_DIR] = direction
     p[K.P_RATIO] = ratio
-    p[K.P_PHI_ENTRY] = -direction * beta  # §3.2: forward rotation enters at −β
+    p[K.P_PHI_ENTRY] = -beta  # §3.2: forward rotation enters at −β
     p[K.P_LOAD_RAMP] = load_ramp
     if nut_spall is not None:
         p[K.P_SPALL_ANGLE] = nut_spall.angle
@@ -541,11 +541,11 @@ def _parameters(
         p[K.P_SPALL_SHARE] = nut_spall.share
     # roller 1 at the sector's entrance, roller i (i − 1)·2π/N behind it (§3.2 steps 4–6)
     behind = np.arange(n) * 2.0 * math.pi / n
-    phi0 = p[K.P_PHI_ENTRY] - direction * behind
+    phi0 = p[K.P_PHI_ENTRY] - behind
     # each roller where its drift has brought it: against the platform's ring at the entrance,
     # one lead from it just after a reset (the far ring then L + p/N − L = p/N away)
     drift = lead * behind / (2.0 * math.pi)
-    u0 = drift if direction > 0 else room - drift
+    u0 = drift
     rollers = np.zeros((n, 3))
     rollers[:, K.R_PHI0] = phi0
     # centred in their grooves at the start (eqs. 35–37's assembly): e_s = e_n = 0
