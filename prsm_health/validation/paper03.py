@@ -83,7 +83,61 @@ def rows() -> list[Row]:
     out += _motion_rows(design, w_s, w_c, w_r, m, events, runs[LOADS_KN[0]])
     out += _design_rows(design)
     out += _force_rows(design, events, runs)
+    out += _sector_rows(design, runs[LOADS_KN[0]])
     return out
+
+
+def _sector_rows(design, run) -> list[Row]:
+    """Figs. 23, 26–27 and 32: the threads letting go in the threadless area (simulated), the
+    spin drop and the carrier collisions (not computable: say what is missing)."""
+    i = ROLLER - 1
+    inside = run.in_sector[i]
+    force = np.abs(run.screw_force[i]) + np.abs(run.nut_force[i])
+    free = float(np.mean(force[inside] == 0.0))
+    geometry = rc.RecirculatingGeometry.for_design(design)
+    contact = 0.25 * (geometry.platform_inner_diameter + 2 * geometry.platform_outer_radius)
+    offset = contact - design.orbit_diameter / 2
+    return [
+        reproduced(
+            PAPER,
+            "§4.3, Figs. 26–27",
+            f"share of roller {ROLLER}'s passage through the threadless area with no thread "
+            "force (simulated, 20 kN)",
+            "-",
+            1.0,
+            free,
+            0.05,
+            f"the paper's screw- and nut-side forces of the roller are zero across the area; "
+            f"simulated, both are exactly zero over {100 * free:.1f} % of it — the rest is the "
+            "lift's first ramp letting the loaded flanks go. 5 %: a trend read off a plot",
+        ),
+        not_computable(
+            PAPER,
+            "§4.2, Fig. 23",
+            "drop of the roller spin during the reset (mean over the run −265.57 against "
+            "−268.98 rad/s outside the threadless area)",
+            "rad/s",
+            3.41,
+            None,
+            "the model has no spin degree of freedom nor friction on the platform. Its sign "
+            "and size depend on where the platform meets the roller's end face, which the "
+            f"paper does not print: where eqs. (20)–(21) put the platform ({offset * 1e3:.2f} "
+            "mm outside the roller's axis for the preset), the paper's μ = 0.25–0.3 slips "
+            "the face forward and speeds the spin up (|ω_r| rises), the opposite of the "
+            "paper's drop, which needs the contact inside the axis",
+        ),
+        not_computable(
+            PAPER,
+            "§4.3, Fig. 32",
+            "roller–carrier collision force rising with the load (20 → 60 kN)",
+            "-",
+            None,
+            None,
+            "the carrier groove's gap is not given (Table 1 is not printed) and the axial "
+            "model has no tangential motion of the roller in its groove: the carrier turns "
+            "at the rolling ratio and carries the rollers without play",
+        ),
+    ]
 
 
 def _motion_rows(design, w_s, w_c, w_r, m, events, run) -> list[Row]:
