@@ -27,6 +27,8 @@ import numpy as np
 
 from prsm_health.actuator.design import preset, printed_eq14_limit
 from prsm_health.physics import recirculating as rc
+from prsm_health.physics.kinematics import speed_ratios
+from prsm_health.simulation.recirculating.model import platform_offset
 
 from . import Row, inconsistent, not_computable, reproduced
 
@@ -88,15 +90,21 @@ def rows() -> list[Row]:
 
 
 def _sector_rows(design, run) -> list[Row]:
-    """Figs. 23, 26–27 and 32: the threads letting go in the threadless area (simulated), the
-    spin drop and the carrier collisions (not computable: say what is missing)."""
+    """Figs. 23, 26–27 and 32 from the simulated run: the threads letting go in the threadless
+    area, the spin turned only there; the spin's mean drop and the carrier collisions not
+    computable (what is missing said)."""
     i = ROLLER - 1
     inside = run.in_sector[i]
     force = np.abs(run.screw_force[i]) + np.abs(run.nut_force[i])
     free = float(np.mean(force[inside] == 0.0))
-    geometry = rc.RecirculatingGeometry.for_design(design)
-    contact = 0.25 * (geometry.platform_inner_diameter + 2 * geometry.platform_outer_radius)
-    offset = contact - design.orbit_diameter / 2
+    offset = platform_offset(design, rc.RecirculatingGeometry.for_design(design))
+    spin = run.roller_spin[i]
+    rolling = speed_ratios(design).roller_spin * SCREW_SPEED
+    off = np.abs(spin - rolling) > 1.0
+    departures = int(off.sum())
+    inside_share = float((off & inside).sum() / max(departures, 1))
+    drop = float(abs(np.mean(spin[~inside])) - abs(np.mean(spin)))  # > 0: |ω_r| lower
+    peak = float(np.max(np.abs(spin)))
     return [
         reproduced(
             PAPER,
@@ -111,20 +119,34 @@ def _sector_rows(design, run) -> list[Row]:
             f"simulated, both are exactly zero over {100 * free:.1f} % of it — the rest is the "
             "lift's first ramp letting the loaded flanks go. 5 %: a trend read off a plot",
         ),
+        reproduced(
+            PAPER,
+            "§4.2, Fig. 23",
+            f"share of roller {ROLLER}'s spin departures from rolling (> 1 rad/s off eq. 27) that "
+            "fall in its passage through the threadless area (simulated, 20 kN)",
+            "-",
+            1.0,
+            inside_share,
+            0.01,
+            "the paper's spin changes abruptly only during the reset (0.06–0.07 s), at the "
+            "platform; simulated, the platform's friction turns the lifted roller and the "
+            f"threads take it back to rolling as it lands ({departures} samples off, all in the "
+            "area)",
+        ),
         not_computable(
             PAPER,
             "§4.2, Fig. 23",
-            "drop of the roller spin during the reset (mean over the run −265.57 against "
-            "−268.98 rad/s outside the threadless area)",
+            "drop of the roller spin's mean over the run by the reset (−265.57 against −268.98 "
+            "rad/s outside the threadless area)",
             "rad/s",
             3.41,
-            None,
-            "the model has no spin degree of freedom nor friction on the platform. Its sign "
-            "and size depend on where the platform meets the roller's end face, which the "
-            f"paper does not print: where eqs. (20)–(21) put the platform ({offset * 1e3:.2f} "
-            "mm outside the roller's axis for the preset), the paper's μ = 0.25–0.3 slips "
-            "the face forward and speeds the spin up (|ω_r| rises), the opposite of the "
-            "paper's drop, which needs the contact inside the axis",
+            drop,
+            "its sign and size depend on where the platform meets the roller's end face, which "
+            "the paper does not print. Where eqs. (20)–(21) put the platform (the middle of its "
+            f"annulus {offset * 1e3:.2f} mm outside the roller's axis for the preset), the "
+            "paper's friction (μ_s 0.3, μ_d 0.25) slips the face forward and speeds the spin up "
+            f"(to {peak:.0f} rad/s): the mean moves the other way, by {-drop:.2f} rad/s. The "
+            "paper's drop needs the contact inside the axis",
         ),
         not_computable(
             PAPER,

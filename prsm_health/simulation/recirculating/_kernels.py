@@ -6,7 +6,8 @@ Only float64 arrays and scalars cross this boundary; the parameter vector's layo
 State ``y``: nut position and velocity, each roller's absolute axial position and velocity,
 three energy accumulators (work of the prescribed screw/carrier motion, dissipated energy, work
 against the load), so that the energy balance is integrated by the same steps as the motion,
-then the payload's position and velocity (behind the linkage, or following the nut rigidly).
+the payload's position and velocity (behind the linkage, or following the nut rigidly), then
+each roller's spin (absolute angular speed about its axis).
 """
 
 from __future__ import annotations
@@ -55,7 +56,15 @@ P_EDGE_DEPTH = 32  # material missing from both nut flanks there [m]
 P_LINK_K = 33  # linkage stiffness nut–payload [N/m] (0: the payload rides rigidly on the nut)
 P_LINK_C = 34  # linkage damping [N·s/m]
 P_M_PAYLOAD = 35  # payload behind the linkage [kg]
-P_SIZE = 36
+P_MU_STATIC = 36  # paper 03 §4.1's Coulomb friction (ADAMS): static coefficient μ_s
+P_MU_DYNAMIC = 37  # dynamic coefficient μ_d
+P_V_STATIC = 38  # slip speed where μ_s is reached [m/s]
+P_V_DYNAMIC = 39  # slip speed from which μ_d holds [m/s]
+P_I_ROLLER = 40  # roller's moment of inertia about its axis [kg·m²]
+P_SPIN_RATIO = 41  # the rolling roller's spin per screw speed (eq. 27)
+P_R_ORBIT = 42  # orbit radius of the roller axes [m]
+P_R_FACE = 43  # radial offset of the cam-ring contact from the roller's axis [m]
+P_SIZE = 44
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
@@ -68,9 +77,9 @@ OUT_XP, OUT_VP = 11, 12  # payload position and velocity
 OUT_THETA, OUT_OMEGA = 13, 14  # screw angle [rad] and speed [rad/s]
 OUT_SIZE = 15
 #: Per roller per sample: relative position to the nut, screw-side and nut-side thread force,
-#: cam force (both rings), in the sector (1/0).
-ROLLER_U, ROLLER_F_SCREW, ROLLER_F_NUT, ROLLER_F_CAM, ROLLER_SECTOR = range(5)
-ROLLER_SIZE = 5
+#: cam force (both rings), in the sector (1/0), spin [rad/s].
+ROLLER_U, ROLLER_F_SCREW, ROLLER_F_NUT, ROLLER_F_CAM, ROLLER_SECTOR, ROLLER_SPIN = range(6)
+ROLLER_SIZE = 6
 
 
 @njit(cache=True, inline="always")
@@ -211,6 +220,21 @@ def _rod(y, p, ip):
 
 
 @njit(cache=True, inline="always")
+def _coulomb(slip, p):
+    """Friction coefficient against a slip speed [m/s], signed as the slip: ADAMS's Coulomb law
+    as paper 03 §4.1 sets it — a cubic STEP from −μ_s to μ_s across ±v_s, then from μ_s to
+    μ_d between v_s and v_d, μ_d beyond."""
+    speed = abs(slip)
+    v_s, v_d = p[P_V_STATIC], p[P_V_DYNAMIC]
+    if speed < v_s:
+        return p[P_MU_STATIC] * (2.0 * _step_on(slip + v_s, 2.0 * v_s) - 1.0)
+    mu = p[P_MU_DYNAMIC]
+    if speed < v_d:
+        mu = p[P_MU_STATIC] + (p[P_MU_DYNAMIC] - p[P_MU_STATIC]) * _step_on(speed - v_s, v_d - v_s)
+    return mu if slip > 0.0 else -mu
+
+
+@njit(cache=True, inline="always")
 def _hertz(d, d_dot, kin_unit, p):
     """One thread side penetrated by d [m] (≤ 0: apart) at rate d_dot, kin_unit·ω_s of it
     from the prescribed motion (kin_unit [m/rad]): (force [N], its torque on the screw's
@@ -242,7 +266,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
     theta, omega = _screw(t, motion)
     a_dot_unit = abs(ratio)  # the sector angle grows at the carrier's speed (forward)
     x, v = y[0], y[1]
-    dy = np.zeros(2 + 2 * n + 5)
+    dy = np.zeros(3 * n + 7)
     f_nut = 0.0
     torque = 0.0
     p_diss = 0.0
@@ -301,6 +325,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
         u, u_dot = z - x, w - v
         rise, drise_da = _platform(p, a, inside)
         f_cam = 0.0
+        cam_normal = 0.0
         for ring in range(2):
             if ring == 0:
                 d = rise - u
@@ -320,6 +345,19 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
                 c_eff = p[P_C_CAM] * _step_on(d, p[P_D_CAM])
                 rate = max(rate, math.sqrt(k_eff / m_r), c_eff / m_r)
                 f_cam += push * force
+                cam_normal += force
+        # ---- the roller's spin while it is out of the threads: the cam rings' friction turns
+        # it (paper 03 §4.1's law at the contact's offset from the roller's axis); its force
+        # is tangential — no axial effect —, its power from the prescribed carrier in the
+        # torque, what it slips in the dissipation, the spin's own in its kinetic energy. On
+        # the threads, rolling holds it (:func:`integrate` sets it to eq. 27's).
+        spin = y[2 + 2 * n + 5 + i]
+        slip = ratio * omega * p[P_R_ORBIT] + spin * p[P_R_FACE]  # the ring does not turn
+        f = -_coulomb(slip, p) * cam_normal
+        spin_torque = p[P_R_FACE] * f
+        p_diss -= f * slip
+        torque -= f * ratio * p[P_R_ORBIT]
+        dy[2 + 2 * n + 5 + i] = spin_torque / p[P_I_ROLLER]
         f_roller += f_cam
         f_nut -= f_cam
         dy[2 + i] = w
@@ -330,6 +368,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
             roller_out[i, ROLLER_F_NUT] = f_side
             roller_out[i, ROLLER_F_CAM] = f_cam
             roller_out[i, ROLLER_SECTOR] = 1.0 if inside else 0.0
+            roller_out[i, ROLLER_SPIN] = spin
     load = _load(t, p, knots)
     ip = 2 + 2 * n + 3  # the payload's states
     dy[0] = v
@@ -366,6 +405,7 @@ def mechanical_energy(t, y, p, rollers, motion):
         energy += 0.5 * p[P_M_PAYLOAD] * y[ip + 1] ** 2 + 0.5 * p[P_LINK_K] * (x - y[ip]) ** 2
     for i in range(n):
         z, w = y[2 + i], y[2 + n + i]
+        energy += 0.5 * p[P_I_ROLLER] * y[2 + 2 * n + 5 + i] ** 2
         energy += 0.5 * p[P_M_ROLLER] * w**2
         phi = rollers[i, R_PHI0] + ratio * theta
         a, inside = _sector(p, phi)
@@ -391,25 +431,50 @@ def mechanical_energy(t, y, p, rollers, motion):
 
 
 @njit(cache=True)
+def _roll(t, y, p, motion, rollers_then, step):
+    """Rolling holds the spin of a roller on its threads at eq. (27)'s: each roller that had a
+    thread force at the step's start is set to it at its end — the slip a landing roller makes
+    until the threads' friction has turned it, shorter than a step (paper 03's μ_s = 0.3 on a
+    1.7 kN share spins a 3.5 g roller up in microseconds), in one jump: the drive does
+    I·Ω_k·ΔΩ of work, ½·I·ΔΩ² slips away (the friction between a prescribed surface and a free
+    rotor until they roll). Returns the drive's torque for that work over the step [N·m]."""
+    n = int(p[P_N])
+    base = 2 + 2 * n + 5
+    omega = _screw(t, motion)[1]
+    rolling = p[P_SPIN_RATIO] * omega
+    work = 0.0
+    for i in range(n):
+        if rollers_then[i, ROLLER_F_SCREW] == 0.0 and rollers_then[i, ROLLER_F_NUT] == 0.0:
+            continue
+        jump = rolling - y[base + i]
+        work += p[P_I_ROLLER] * rolling * jump
+        y[2 + 2 * n] += p[P_I_ROLLER] * rolling * jump
+        y[2 + 2 * n + 1] += 0.5 * p[P_I_ROLLER] * jump * jump
+        y[base + i] = rolling
+    return work / (omega * step) if omega > 0.0 else 0.0
+
+
+@njit(cache=True)
 def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, roller_out):
     """Fixed outer steps of RK4, each cut into as many equal sub-steps as the stiffest active
     contact needs (rate × sub-step ≤ 0.5, from the penetration expected at the step's end);
     records every outer step. Returns the number of steps done (< n_steps: the guard's limit
     was reached at that step)."""
     n = int(p[P_N])
-    size = 2 + 2 * n + 5
+    size = 3 * n + 7
     y = y0.copy()
     k1 = np.zeros(size)
     tmp = np.zeros(size)
     scratch = roller_out[0].copy()
     t = 0.0
+    pending = 0.0  # the torque of the last step's spin-ups [N·m]
     for k in range(n_steps):
         dy, rate, torque = forces(t, y, p, rollers, knots, motion, roller_out[k], True)
         out[k, OUT_T] = t
         out[k, OUT_X] = y[0]
         out[k, OUT_V] = y[1]
         out[k, OUT_A] = dy[1]
-        out[k, OUT_TORQUE] = torque
+        out[k, OUT_TORQUE] = torque + pending
         out[k, OUT_W_IN] = y[2 + 2 * n]
         out[k, OUT_W_DISS] = y[2 + 2 * n + 1]
         out[k, OUT_W_LOAD] = y[2 + 2 * n + 2]
@@ -449,4 +514,5 @@ def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, r
             t += h
         # the step ends where it should, whatever rounding the sub-steps left
         t = (k + 1) * step
+        pending = _roll(t, y, p, motion, roller_out[k], step)
     return n_steps

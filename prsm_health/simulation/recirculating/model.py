@@ -32,6 +32,14 @@ Forces, each from one contact law and its energy
   top holds it, its exit edge drops over the last lift ramp. Every ring contact is the paper's
   ADAMS IMPACT law (eq. 38, §4.1: K = 1e5 N/mm, e = 1.5, C = 50 N·s/mm, d = 0.1 mm); the far
   ring's face stops a roller the push threw too far.
+- **Spin.** Each roller's spin about its axis: on its threads rolling holds it at eq. (27)'s
+  (set after every step — the threads' friction spins a landing roller up in microseconds —,
+  the drive's work I·Ω·ΔΩ and the slip's ½·I·ΔΩ² booked); lifted out of them, the cam rings'
+  friction turns it — the paper's ADAMS Coulomb law (§4.1: μ_s 0.3, μ_d 0.25 reached at 0.9
+  and 1.0 m/s of slip) at the middle of the platform's annulus (eqs. 20–21), where the
+  roller's face slips forward, so the platform speeds the spin up (Fig. 23's change at the
+  reset, the opposite sign to the paper's drop: docs/validation.md). Tangential: no axial
+  effect.
 - **Load.** An axial force on the nut, positive opposing forward motion (negative: assisting
   it, the other flanks carry it): constant, or the profile's knots plus a sinusoid (a reversing
   load swings it through zero: the rollers cross their clearance), ramped in over ``load_ramp``
@@ -57,17 +65,17 @@ runs the second β free of the platform. Forward rotation or rest only — the s
 ring, for the other direction: the paper lays it out over the other β but does not dimension
 it, and with both platforms full height over the area the forward-reset roller (one lead from
 the first ring) would stand where the second one is — so their real layout differs, and is
-not modelled. Not modelled (yet): friction on the platform and in the threads (the paper's
-μ = 0.25–0.3 on the platform: the spin drop of Fig. 23), the rollers' spin and the carrier grooves' tangential gap
-(the carrier collisions of Fig. 32), radial and tilting motion; the screw's own axial and
-torsional compliance. The energy of every modelled contact is accounted for: the work of the
-prescribed screw/carrier motion equals the change of kinetic and elastic energy plus what the
-dampers took plus the work against the load (:attr:`RecirculatingRun.energy_error`).
+not modelled. Not modelled: the threads' friction beyond rolling (sliding losses, the drive's
+efficiency), the carrier grooves' tangential gap (the carrier collisions of Fig. 32: the gap is
+not given), radial and tilting motion; the screw's own axial and torsional compliance. The
+energy of every modelled contact is accounted for: the work of the prescribed screw/carrier
+motion equals the change of kinetic and elastic energy plus what the dampers and the
+friction took plus the work against the load (:attr:`RecirculatingRun.energy_error`).
 
 References
 ----------
 Paper 03 — eqs. (8)–(11) threadless area and crossing, (25)–(31) motion, (35)–(37) assembly,
-(38) and §4.1 contact; paper 04 — thread stiffness.
+(38) and §4.1 contact and friction; paper 04 — thread stiffness.
 """
 
 from __future__ import annotations
@@ -104,6 +112,19 @@ THREAD_DAMPING_RATIO = 0.03
 THREAD_DAMPING_DEPTH = 1e-6
 #: Share of β over which the lift (and the platform's exit edge) ramps.
 LIFT_RAMP_SHARE = 0.25
+#: Paper 03 §4.1's Coulomb friction of its ADAMS model (every contact): static and dynamic
+#: coefficients, the slip speeds [m/s] where each is reached.
+FRICTION_STATIC, FRICTION_DYNAMIC = 0.3, 0.25
+SLIP_STATIC, SLIP_DYNAMIC = 0.9, 1.0
+
+
+def platform_offset(design: PRSMDesign, geometry: RecirculatingGeometry) -> float:
+    """Radial offset of the cam-ring contact from the roller's axis [m], outward positive: the
+    middle of the platform's annulus, d_t1/2 … R_t1 (eqs. 20–21), less the orbit radius — an
+    engineering choice where the paper prints no contact point (the spin's change at the reset
+    follows its sign: outside the axis the platform's friction speeds the spin up)."""
+    middle = 0.5 * (geometry.platform_inner_diameter / 2 + geometry.platform_outer_radius)
+    return middle - design.orbit_diameter / 2
 
 
 @dataclass(frozen=True)
@@ -200,6 +221,8 @@ class RecirculatingRun:
         Axial force on each roller from the screw thread, the nut thread, the cam rings.
     in_sector : numpy.ndarray of bool
         Whether each roller is in the threadless sector.
+    roller_spin : numpy.ndarray [rad/s]
+        Each roller's angular speed about its axis (absolute; eq. 27's while it rolls).
     resets : numpy.ndarray of int
         Crossings of the sector each roller completed.
     work_in, dissipated, work_load, mechanical_energy : numpy.ndarray [J]
@@ -223,6 +246,7 @@ class RecirculatingRun:
     nut_force: np.ndarray
     cam_force: np.ndarray
     in_sector: np.ndarray
+    roller_spin: np.ndarray
     resets: np.ndarray
     work_in: np.ndarray
     dissipated: np.ndarray
@@ -420,6 +444,7 @@ def simulate_recirculating(
         nut_force=roller_out[:, :, K.ROLLER_F_NUT].T.copy(),
         cam_force=roller_out[:, :, K.ROLLER_F_CAM].T.copy(),
         in_sector=sector,
+        roller_spin=roller_out[:, :, K.ROLLER_SPIN].T.copy(),
         resets=exits.astype(int),
         work_in=out[:, K.OUT_W_IN],
         dissipated=out[:, K.OUT_W_DISS],
@@ -534,6 +559,13 @@ def _parameters(
     p[K.P_RATIO] = ratio
     p[K.P_PHI_ENTRY] = -beta  # §3.2: forward rotation enters at −β
     p[K.P_LOAD_RAMP] = load_ramp
+    # the roller's spin: paper 03 §4.1's friction at the cam rings, rolling on the threads
+    p[K.P_MU_STATIC], p[K.P_MU_DYNAMIC] = FRICTION_STATIC, FRICTION_DYNAMIC
+    p[K.P_V_STATIC], p[K.P_V_DYNAMIC] = SLIP_STATIC, SLIP_DYNAMIC
+    p[K.P_I_ROLLER] = design.masses.roller_inertia
+    p[K.P_SPIN_RATIO] = speed_ratios(design).roller_spin
+    p[K.P_R_ORBIT] = design.orbit_diameter / 2
+    p[K.P_R_FACE] = platform_offset(design, geometry)
     if nut_spall is not None:
         p[K.P_SPALL_ANGLE] = nut_spall.angle
         p[K.P_SPALL_WIDTH] = 2.0 * nut_spall.length / design.orbit_diameter
@@ -552,9 +584,10 @@ def _parameters(
     rollers[:, K.R_C_SCREW] = u0 + lead * phi0 / (2.0 * math.pi)
     rollers[:, K.R_C_NUT] = u0 + lead * phi0 / (2.0 * math.pi)
     v0 = lead * screw_speed / (2.0 * math.pi)
-    y0 = np.zeros(2 + 2 * n + 5)
+    y0 = np.zeros(3 * n + 7)
     y0[1] = v0
-    y0[-1] = v0  # the payload moves with the nut, the linkage unstretched
+    y0[2 + 2 * n + 4] = v0  # the payload moves with the nut, the linkage unstretched
+    y0[2 + 2 * n + 5 :] = speed_ratios(design).roller_spin * screw_speed  # rolling (eq. 27)
     y0[2 : 2 + n] = u0
     y0[2 + n : 2 + 2 * n] = v0 - lead * ratio * screw_speed / (2.0 * math.pi)
     return p, rollers, y0
