@@ -115,8 +115,8 @@ def _trapezoid(a, end, ramp):
 
 
 @njit(cache=True, inline="always")
-def _plays(p, a, inside):
-    """Axial play the lift adds on the screw side and the nut side [m], and d/da of each: the
+def _lift_play(p, a, inside):
+    """Axial play the lift adds on each thread side, screw and nut alike [m], and d/da: the
     roller is lifted out of both threads across the threadless area (2β), the lift rising and
     falling over a ramp at each end so the threads let go and take the roller back gradually.
 
@@ -124,10 +124,10 @@ def _plays(p, a, inside):
     crossing, the roller is held on the platform until the nut thread takes it back; what it
     leaves out is said in :mod:`.model`."""
     if not inside:
-        return 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0
     scale = p[P_LIFT] * p[P_COT_FLANK]
     value, slope = _trapezoid(a, 2.0 * p[P_BETA], p[P_LIFT_RAMP])
-    return scale * value, scale * slope, scale * value, scale * slope
+    return scale * value, scale * slope
 
 
 @njit(cache=True, inline="always")
@@ -235,6 +235,20 @@ def _coulomb(slip, p):
 
 
 @njit(cache=True, inline="always")
+def _impact(d, d_dot, kin_unit, p):
+    """One cam-ring contact penetrated by d [m] (≤ 0: apart) at rate d_dot, kin_unit·ω_s of it
+    from the prescribed motion: paper 03's IMPACT law (eq. 38), returned as :func:`_hertz`."""
+    if d <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    elastic = p[P_K_CAM] * d ** p[P_E_CAM]
+    damping = p[P_C_CAM] * _step_on(d, p[P_D_CAM])
+    force = max(elastic + damping * d_dot, 0.0)
+    k_eff = p[P_E_CAM] * p[P_K_CAM] * d ** (p[P_E_CAM] - 1.0)
+    rate = max(math.sqrt(k_eff / p[P_M_ROLLER]), damping / p[P_M_ROLLER])
+    return force, force * kin_unit, (force - elastic) * d_dot, rate
+
+
+@njit(cache=True, inline="always")
 def _hertz(d, d_dot, kin_unit, p):
     """One thread side penetrated by d [m] (≤ 0: apart) at rate d_dot, kin_unit·ω_s of it
     from the prescribed motion (kin_unit [m/rad]): (force [N], its torque on the screw's
@@ -275,7 +289,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
         z, w = y[2 + i], y[2 + n + i]
         phi = rollers[i, R_PHI0] + ratio * theta
         a, inside = _sector(p, phi)
-        play_s, dplay_s, play_n, dplay_n = _plays(p, a, inside)
+        play, dplay = _lift_play(p, a, inside)
         pit, dpit = _spall(p, phi)
         f_roller = 0.0
         f_screw = 0.0
@@ -287,14 +301,14 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
                 e = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
                 e_dot_free = w  # the part from the state
                 e_kin_unit = -lead * (1.0 - ratio) / TWO_PI  # per ω_s, the prescribed motion's
-                b = p[P_B_SCREW] + play_s
-                play_unit = dplay_s * a_dot_unit
+                b = p[P_B_SCREW] + play
+                play_unit = dplay * a_dot_unit
             else:
                 e = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
                 e_dot_free = w - v
                 e_kin_unit = lead * ratio / TWO_PI
-                b = p[P_B_NUT] + play_n + edge
-                play_unit = (dplay_n + dedge) * a_dot_unit
+                b = p[P_B_NUT] + play + edge
+                play_unit = (dplay + dedge) * a_dot_unit
             sign = 1.0 if e >= 0.0 else -1.0
             d = abs(e) - b
             kin_unit = sign * e_kin_unit - play_unit
@@ -336,16 +350,12 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
                 kin_unit = 0.0
                 push = -1.0
             d_dot = omega * kin_unit - push * u_dot
-            if d > 0.0:
-                elastic = p[P_K_CAM] * d ** p[P_E_CAM]
-                force = max(elastic + p[P_C_CAM] * _step_on(d, p[P_D_CAM]) * d_dot, 0.0)
-                torque += force * kin_unit
-                p_diss += (force - elastic) * d_dot
-                k_eff = p[P_E_CAM] * p[P_K_CAM] * d ** (p[P_E_CAM] - 1.0)
-                c_eff = p[P_C_CAM] * _step_on(d, p[P_D_CAM])
-                rate = max(rate, math.sqrt(k_eff / m_r), c_eff / m_r)
-                f_cam += push * force
-                cam_normal += force
+            force, torque_part, power_diss, contact_rate = _impact(d, d_dot, kin_unit, p)
+            torque += torque_part
+            p_diss += power_diss
+            rate = max(rate, contact_rate)
+            f_cam += push * force
+            cam_normal += force
         # ---- the roller's spin while it is out of the threads: the cam rings' friction turns
         # it (paper 03 §4.1's law at the contact's offset from the roller's axis); its force
         # is tangential — no axial effect —, its power from the prescribed carrier in the
@@ -409,12 +419,12 @@ def mechanical_energy(t, y, p, rollers, motion):
         energy += 0.5 * p[P_M_ROLLER] * w**2
         phi = rollers[i, R_PHI0] + ratio * theta
         a, inside = _sector(p, phi)
-        play_s, _, play_n, _ = _plays(p, a, inside)
+        play = _lift_play(p, a, inside)[0]
         pit = _spall(p, phi)[0]
         e_s = _wrap(z - lead * (theta - phi) / TWO_PI - rollers[i, R_C_SCREW], pitch)
         e_n = _wrap(z - x + lead * phi / TWO_PI - rollers[i, R_C_NUT], pitch)
-        d_s = abs(e_s) - p[P_B_SCREW] - play_s
-        d_n = abs(e_n) - p[P_B_NUT] - play_n - _edge(p, a)[0]
+        d_s = abs(e_s) - p[P_B_SCREW] - play
+        d_n = abs(e_n) - p[P_B_NUT] - play - _edge(p, a)[0]
         energy += 0.4 * p[P_K_THREAD] * max(d_s, 0.0) ** 2.5
         if e_n >= 0.0 and pit > 0.0:  # the spalled turn's share closes later
             share = p[P_SPALL_SHARE]
