@@ -3,11 +3,12 @@
 Only float64 arrays and scalars cross this boundary; the parameter vector's layout is
 :data:`P_*` below, the physics in :mod:`.model` (which documents every term and cites paper 03).
 
-State ``y``: nut position and velocity, each roller's absolute axial position and velocity,
-three energy accumulators (work of the prescribed screw/carrier motion, dissipated energy, work
-against the load), so that the energy balance is integrated by the same steps as the motion,
-the payload's position and velocity (behind the linkage, or following the nut rigidly), then
-each roller's spin (absolute angular speed about its axis).
+State ``y`` (its layout: :func:`y_work`, :func:`y_payload`, :func:`y_spin`): nut position and
+velocity, each roller's absolute axial position and velocity, three energy accumulators (work
+of the prescribed screw/carrier motion, dissipated energy, work against the load), so that the
+energy balance is integrated by the same steps as the motion, the payload's position and
+velocity (behind the linkage, or following the nut rigidly), then each roller's spin (absolute
+angular speed about its axis).
 """
 
 from __future__ import annotations
@@ -65,6 +66,35 @@ P_SPIN_RATIO = 41  # the rolling roller's spin per screw speed (eq. 27)
 P_R_ORBIT = 42  # orbit radius of the roller axes [m]
 P_R_FACE = 43  # radial offset of the cam-ring contact from the roller's axis [m]
 P_SIZE = 44
+
+# ---- state layout: nut position and velocity, the rollers' positions (n) and velocities (n),
+# the drive's work, the dissipated energy, the load's work, the payload's position and velocity,
+# the rollers' spins (n)
+
+
+@njit(cache=True, inline="always")
+def y_work(n):
+    """Index of the drive's work in the state (+1: the dissipated energy, +2: the load's)."""
+    return 2 + 2 * n
+
+
+@njit(cache=True, inline="always")
+def y_payload(n):
+    """Index of the payload's position in the state (+1: its velocity)."""
+    return 2 + 2 * n + 3
+
+
+@njit(cache=True, inline="always")
+def y_spin(n):
+    """Index of the first roller's spin in the state."""
+    return 2 + 2 * n + 5
+
+
+@njit(cache=True, inline="always")
+def state_size(n):
+    """Length of the state of n rollers."""
+    return 3 * n + 7
+
 
 #: Per-roller arrays (rows of ``rollers``): start orbital angle, screw- and nut-side offsets.
 R_PHI0, R_C_SCREW, R_C_NUT = 0, 1, 2
@@ -280,7 +310,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
     theta, omega = _screw(t, motion)
     a_dot_unit = abs(ratio)  # the sector angle grows at the carrier's speed (forward)
     x, v = y[0], y[1]
-    dy = np.zeros(3 * n + 7)
+    dy = np.zeros(state_size(n))
     f_nut = 0.0
     torque = 0.0
     p_diss = 0.0
@@ -361,13 +391,13 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
         # is tangential — no axial effect —, its power from the prescribed carrier in the
         # torque, what it slips in the dissipation, the spin's own in its kinetic energy. On
         # the threads, rolling holds it (:func:`integrate` sets it to eq. 27's).
-        spin = y[2 + 2 * n + 5 + i]
+        spin = y[y_spin(n) + i]
         slip = ratio * omega * p[P_R_ORBIT] + spin * p[P_R_FACE]  # the ring does not turn
         f = -_coulomb(slip, p) * cam_normal
         spin_torque = p[P_R_FACE] * f
         p_diss -= f * slip
         torque -= f * ratio * p[P_R_ORBIT]
-        dy[2 + 2 * n + 5 + i] = spin_torque / p[P_I_ROLLER]
+        dy[y_spin(n) + i] = spin_torque / p[P_I_ROLLER]
         f_roller += f_cam
         f_nut -= f_cam
         dy[2 + i] = w
@@ -380,7 +410,8 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
             roller_out[i, ROLLER_SECTOR] = 1.0 if inside else 0.0
             roller_out[i, ROLLER_SPIN] = spin
     load = _load(t, p, knots)
-    ip = 2 + 2 * n + 3  # the payload's states
+    ip = y_payload(n)
+    iw = y_work(n)
     dy[0] = v
     if p[P_LINK_K] > 0.0:  # the load acts on the payload, the linkage on the nut
         relative = v - y[ip + 1]
@@ -389,15 +420,15 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
         dy[1] = (f_nut - f_rod) / m_n
         dy[ip] = y[ip + 1]
         dy[ip + 1] = (f_rod - load) / p[P_M_PAYLOAD]
-        dy[2 + 2 * n + 2] = load * y[ip + 1]
+        dy[iw + 2] = load * y[ip + 1]
         rate = max(rate, math.sqrt(p[P_LINK_K] / m_n), p[P_LINK_C] / m_n)
     else:  # the payload (in the nut's mass) follows the nut
         dy[1] = (f_nut - load) / m_n
         dy[ip] = v
         dy[ip + 1] = dy[1]
-        dy[2 + 2 * n + 2] = load * v
-    dy[2 + 2 * n] = torque * omega
-    dy[2 + 2 * n + 1] = p_diss
+        dy[iw + 2] = load * v
+    dy[iw] = torque * omega
+    dy[iw + 1] = p_diss
     return dy, rate, torque
 
 
@@ -411,11 +442,11 @@ def mechanical_energy(t, y, p, rollers, motion):
     x = y[0]
     energy = 0.5 * p[P_M_NUT] * y[1] ** 2
     if p[P_LINK_K] > 0.0:
-        ip = 2 + 2 * n + 3
+        ip = y_payload(n)
         energy += 0.5 * p[P_M_PAYLOAD] * y[ip + 1] ** 2 + 0.5 * p[P_LINK_K] * (x - y[ip]) ** 2
     for i in range(n):
         z, w = y[2 + i], y[2 + n + i]
-        energy += 0.5 * p[P_I_ROLLER] * y[2 + 2 * n + 5 + i] ** 2
+        energy += 0.5 * p[P_I_ROLLER] * y[y_spin(n) + i] ** 2
         energy += 0.5 * p[P_M_ROLLER] * w**2
         phi = rollers[i, R_PHI0] + ratio * theta
         a, inside = _sector(p, phi)
@@ -449,7 +480,7 @@ def _roll(t, y, p, motion, rollers_then, step):
     I·Ω_k·ΔΩ of work, ½·I·ΔΩ² slips away (the friction between a prescribed surface and a free
     rotor until they roll). Returns the drive's torque for that work over the step [N·m]."""
     n = int(p[P_N])
-    base = 2 + 2 * n + 5
+    base, iw = y_spin(n), y_work(n)
     omega = _screw(t, motion)[1]
     rolling = p[P_SPIN_RATIO] * omega
     work = 0.0
@@ -458,8 +489,8 @@ def _roll(t, y, p, motion, rollers_then, step):
             continue
         jump = rolling - y[base + i]
         work += p[P_I_ROLLER] * rolling * jump
-        y[2 + 2 * n] += p[P_I_ROLLER] * rolling * jump
-        y[2 + 2 * n + 1] += 0.5 * p[P_I_ROLLER] * jump * jump
+        y[iw] += p[P_I_ROLLER] * rolling * jump
+        y[iw + 1] += 0.5 * p[P_I_ROLLER] * jump * jump
         y[base + i] = rolling
     return work / (omega * step) if omega > 0.0 else 0.0
 
@@ -471,7 +502,8 @@ def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, r
     records every outer step. Returns the number of steps done (< n_steps: the guard's limit
     was reached at that step)."""
     n = int(p[P_N])
-    size = 3 * n + 7
+    size = state_size(n)
+    iw, ip = y_work(n), y_payload(n)
     y = y0.copy()
     k1 = np.zeros(size)
     tmp = np.zeros(size)
@@ -485,13 +517,12 @@ def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, r
         out[k, OUT_V] = y[1]
         out[k, OUT_A] = dy[1]
         out[k, OUT_TORQUE] = torque + pending
-        out[k, OUT_W_IN] = y[2 + 2 * n]
-        out[k, OUT_W_DISS] = y[2 + 2 * n + 1]
-        out[k, OUT_W_LOAD] = y[2 + 2 * n + 2]
+        out[k, OUT_W_IN] = y[iw]
+        out[k, OUT_W_DISS] = y[iw + 1]
+        out[k, OUT_W_LOAD] = y[iw + 2]
         out[k, OUT_ENERGY] = mechanical_energy(t, y, p, rollers, motion)
         out[k, OUT_THETA], out[k, OUT_OMEGA] = _screw(t, motion)
         out[k, OUT_LOAD] = _load(t, p, knots)
-        ip = 2 + 2 * n + 3
         out[k, OUT_ROD] = _rod(y, p, ip) if p[P_LINK_K] > 0.0 else out[k, OUT_LOAD]
         out[k, OUT_XP] = y[ip]
         out[k, OUT_VP] = y[ip + 1]

@@ -584,10 +584,10 @@ def _parameters(
     rollers[:, K.R_C_SCREW] = u0 + lead * phi0 / (2.0 * math.pi)
     rollers[:, K.R_C_NUT] = u0 + lead * phi0 / (2.0 * math.pi)
     v0 = lead * screw_speed / (2.0 * math.pi)
-    y0 = np.zeros(3 * n + 7)
+    y0 = np.zeros(K.state_size(n))
     y0[1] = v0
-    y0[2 + 2 * n + 4] = v0  # the payload moves with the nut, the linkage unstretched
-    y0[2 + 2 * n + 5 :] = speed_ratios(design).roller_spin * screw_speed  # rolling (eq. 27)
+    y0[K.y_payload(n) + 1] = v0  # the payload moves with the nut, the linkage unstretched
+    y0[K.y_spin(n) :] = speed_ratios(design).roller_spin * screw_speed  # rolling (eq. 27)
     y0[2 : 2 + n] = u0
     y0[2 + n : 2 + 2 * n] = v0 - lead * ratio * screw_speed / (2.0 * math.pi)
     return p, rollers, y0
