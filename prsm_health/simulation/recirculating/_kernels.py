@@ -294,14 +294,14 @@ def _hertz(d, d_dot, kin_unit, p):
 
 
 @njit(cache=True)
-def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
-    """Accelerations, the energy accumulators' rates, the largest contact rate [1/s] and the
-    torque the prescribed screw (and, rolling, carrier) motion takes [N·m].
+def forces(t, y, p, rollers, knots, motion, roller_out, with_out, dy):
+    """The state's rates into ``dy`` (every entry written: the caller owns it, no allocation
+    on the hot path); returns the largest contact rate [1/s] and the torque the prescribed
+    screw (and, rolling, carrier) motion takes [N·m].
 
     Every prescribed rate is ω_s times a geometric factor (the carrier turns at ratio·ω_s),
     so the torque is Σ force × factor and the power it puts in torque × ω_s — defined at rest.
-    Returns (dy, rate, torque); ``roller_out`` (rollers × ROLLER_SIZE) filled when
-    ``with_out``.
+    ``roller_out`` (rollers × ROLLER_SIZE) filled when ``with_out``.
     """
     n = int(p[P_N])
     lead, pitch = p[P_LEAD], p[P_PITCH]
@@ -310,7 +310,6 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
     theta, omega = _screw(t, motion)
     a_dot_unit = abs(ratio)  # the sector angle grows at the carrier's speed (forward)
     x, v = y[0], y[1]
-    dy = np.zeros(state_size(n))
     f_nut = 0.0
     torque = 0.0
     p_diss = 0.0
@@ -429,7 +428,7 @@ def forces(t, y, p, rollers, knots, motion, roller_out, with_out):
         dy[iw + 2] = load * v
     dy[iw] = torque * omega
     dy[iw + 1] = p_diss
-    return dy, rate, torque
+    return rate, torque
 
 
 @njit(cache=True)
@@ -507,11 +506,13 @@ def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, r
     y = y0.copy()
     k1 = np.zeros(size)
     tmp = np.zeros(size)
+    dy = np.zeros(size)  # the rates where the step starts (recorded, the first sub-step's)
+    stage = np.zeros(size)  # a stage's rates, used as soon as computed
     scratch = roller_out[0].copy()
     t = 0.0
     pending = 0.0  # the torque of the last step's spin-ups [N·m]
     for k in range(n_steps):
-        dy, rate, torque = forces(t, y, p, rollers, knots, motion, roller_out[k], True)
+        rate, torque = forces(t, y, p, rollers, knots, motion, roller_out[k], True, dy)
         out[k, OUT_T] = t
         out[k, OUT_X] = y[0]
         out[k, OUT_V] = y[1]
@@ -529,7 +530,7 @@ def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, r
         # look ahead one step with an Euler predictor: an impact starting inside the step
         for j in range(size):
             tmp[j] = y[j] + step * dy[j]
-        rate_end = forces(t + step, tmp, p, rollers, knots, motion, scratch, False)[1]
+        rate_end = forces(t + step, tmp, p, rollers, knots, motion, scratch, False, stage)[0]
         rate = max(rate, rate_end)
         subs = max(1, int(math.ceil(rate * step / 0.5)))
         if subs > max_substeps:
@@ -537,21 +538,24 @@ def integrate(y0, p, rollers, knots, motion, step, n_steps, max_substeps, out, r
         h = step / subs
         for sub in range(subs):
             # the first sub-step starts where the recorded forces were taken: reuse them
-            d1 = dy if sub == 0 else forces(t, y, p, rollers, knots, motion, scratch, False)[0]
+            d1 = dy
+            if sub > 0:
+                forces(t, y, p, rollers, knots, motion, scratch, False, stage)
+                d1 = stage
             for j in range(size):
                 k1[j] = d1[j]
                 tmp[j] = y[j] + 0.5 * h * d1[j]
-            d2 = forces(t + 0.5 * h, tmp, p, rollers, knots, motion, scratch, False)[0]
+            forces(t + 0.5 * h, tmp, p, rollers, knots, motion, scratch, False, stage)
             for j in range(size):
-                k1[j] += 2.0 * d2[j]
-                tmp[j] = y[j] + 0.5 * h * d2[j]
-            d3 = forces(t + 0.5 * h, tmp, p, rollers, knots, motion, scratch, False)[0]
+                k1[j] += 2.0 * stage[j]
+                tmp[j] = y[j] + 0.5 * h * stage[j]
+            forces(t + 0.5 * h, tmp, p, rollers, knots, motion, scratch, False, stage)
             for j in range(size):
-                k1[j] += 2.0 * d3[j]
-                tmp[j] = y[j] + h * d3[j]
-            d4 = forces(t + h, tmp, p, rollers, knots, motion, scratch, False)[0]
+                k1[j] += 2.0 * stage[j]
+                tmp[j] = y[j] + h * stage[j]
+            forces(t + h, tmp, p, rollers, knots, motion, scratch, False, stage)
             for j in range(size):
-                y[j] += h * (k1[j] + d4[j]) / 6.0
+                y[j] += h * (k1[j] + stage[j]) / 6.0
             t += h
         # the step ends where it should, whatever rounding the sub-steps left
         t = (k + 1) * step

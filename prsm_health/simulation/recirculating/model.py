@@ -615,6 +615,8 @@ def right_hand_side(
     scratch = np.zeros((design.n_rollers, K.ROLLER_SIZE))
 
     def f(t, y):
-        return K.forces(t, np.asarray(y, float), p, rollers, knots, motion, scratch, False)[0]
+        dy = np.empty(len(y0))
+        K.forces(t, np.asarray(y, float), p, rollers, knots, motion, scratch, False, dy)
+        return dy
 
     return f, y0
