@@ -54,6 +54,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 from prsm_health.core.check_phases import CheckPhases, PhaseSpan
 from prsm_health.core.errors import ParameterError, require, require_known_keys, require_range
@@ -309,9 +310,7 @@ class HealthCheck:
         [rad] (the trapezoidal integral of the speed, exact for the piecewise-linear speed the
         kernel interpolates) — the format of OperatingProfile.motion_knots."""
         times, speeds, _ = self._speed_knots()
-        angles = np.concatenate(
-            ([0.0], np.cumsum(0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times)))
-        )
+        angles = cumulative_trapezoid(speeds, times, initial=0.0)
         return np.vstack([times, speeds, angles])
 
     def load_knots(self) -> tuple[np.ndarray, float, float]:

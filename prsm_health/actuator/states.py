@@ -15,6 +15,7 @@ import math
 from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 from prsm_health.core.errors import (
     ParameterError,
@@ -437,9 +438,8 @@ class OperatingProfile:
             speeds.append(speeds[-1])
         times = np.asarray(times, dtype=float)
         speeds = np.asarray(speeds, dtype=float)
-        angles = np.concatenate(
-            ([0.0], np.cumsum(0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times)))
-        )
+        # the angle: the speed's exact integral (trapezoids: the speed is linear between knots)
+        angles = cumulative_trapezoid(speeds, times, initial=0.0)
         return np.vstack([times, speeds, angles])
 
     def load_knots(self) -> tuple[np.ndarray, float, float]:

@@ -84,6 +84,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 
 from prsm_health.actuator.design import PRSMDesign
 from prsm_health.core.errors import ConvergenceError, require, require_positive
@@ -489,7 +490,7 @@ def _motion_knots(screw_speed, duration: float) -> np.ndarray:
             f"knots from {speeds.min():g} to {speeds.max():g} rad/s",
             f"must be ≥ 0 and not all 0: {what}",
         )
-    angles = np.concatenate(([0.0], np.cumsum(0.5 * (speeds[1:] + speeds[:-1]) * np.diff(times))))
+    angles = cumulative_trapezoid(speeds, times, initial=0.0)  # exact: linear between knots
     return np.ascontiguousarray(np.vstack([times, speeds, angles]))
 
 
