@@ -392,10 +392,6 @@ def simulate_recirculating(
         f"must be in [0, {0.4 * design.pitch:g}) m: below 0.4 pitch (from p/2 the reset fails "
         "and the roller jams against the ring, which the model does not follow)",
     )
-    nominal = float(np.max(np.abs(knots[1]))) + abs(float(load_sine[0]))
-    p, rollers, y0 = _parameters(
-        design, motion[1, 0], nominal, clearance, payload_mass, load_ramp, contact, nut_spall
-    )
     if linkage is not None:
         stiffness, ratio = linkage
         require_positive("linkage stiffness", stiffness)
@@ -406,18 +402,22 @@ def simulate_recirculating(
             "must be ≥ 0",
         )
         require(payload_mass > 0, "payload_mass", payload_mass, "must be > 0 behind a linkage")
-        p[K.P_M_NUT] = design.masses.nut_mass
-        p[K.P_M_PAYLOAD] = payload_mass
-        p[K.P_LINK_K] = stiffness
-        p[K.P_LINK_C] = 2.0 * ratio * math.sqrt(stiffness * payload_mass)
-    p[K.P_CAM_WEAR] = cam_wear
-    p[K.P_PLATFORM_LOSS] = platform_loss
-    if reentry_edge is not None:
-        p[K.P_EDGE_WIDTH] = 2.0 * reentry_edge.length / design.orbit_diameter
-        p[K.P_EDGE_DEPTH] = reentry_edge.depth
-    p[K.P_LOAD_SINE], p[K.P_LOAD_FREQUENCY] = float(load_sine[0]), float(load_sine[1])
-    if clearance_nut is not None:
-        p[K.P_B_NUT] = clearance_nut
+    p, rollers, y0 = _parameters(
+        design,
+        motion[1, 0],
+        float(np.max(np.abs(knots[1]))) + abs(float(load_sine[0])),
+        clearance=clearance,
+        clearance_nut=clearance_nut,
+        payload_mass=payload_mass,
+        linkage=linkage,
+        load_ramp=load_ramp,
+        load_sine=load_sine,
+        contact=contact,
+        nut_spall=nut_spall,
+        cam_wear=cam_wear,
+        platform_loss=platform_loss,
+        reentry_edge=reentry_edge,
+    )
     n_steps = int(round(duration / step)) + 1
     n = design.n_rollers
     out = np.zeros((n_steps, K.OUT_SIZE))
@@ -514,10 +514,25 @@ def _load_knots(load, duration: float) -> np.ndarray:
 
 
 def _parameters(
-    design, screw_speed, nominal_load, clearance, payload_mass, load_ramp, contact, nut_spall=None
+    design,
+    screw_speed,
+    nominal_load,
+    *,
+    clearance,
+    clearance_nut=None,
+    payload_mass=0.0,
+    linkage=None,
+    load_ramp,
+    load_sine=(0.0, 0.0),
+    contact,
+    nut_spall=None,
+    cam_wear=0.0,
+    platform_loss=0.0,
+    reentry_edge=None,
 ):
-    """(parameter vector, per-roller table, initial state); ``nominal_load`` [N] the largest
-    load, which sets the threads' Hertz constant."""
+    """(parameter vector, per-roller table, initial state) of :func:`simulate_recirculating`'s
+    checked arguments: ``screw_speed`` [rad/s] the speed at t = 0, ``nominal_load`` [N] the
+    largest load, which sets the threads' Hertz constant."""
     geometry = RecirculatingGeometry.for_design(design)
     n = design.n_rollers
     lead, pitch = design.screw_lead, design.pitch
@@ -544,7 +559,6 @@ def _parameters(
     p[K.P_M_NUT] = design.masses.nut_mass + payload_mass
     p[K.P_K_THREAD] = k_hertz
     p[K.P_B_SCREW] = clearance
-    p[K.P_B_NUT] = clearance
     p[K.P_C_THREAD] = 2.0 * THREAD_DAMPING_RATIO * math.sqrt(k_lin * m_r)
     p[K.P_D_THREAD] = THREAD_DAMPING_DEPTH
     p[K.P_K_CAM] = contact.stiffness
@@ -567,6 +581,19 @@ def _parameters(
     p[K.P_SPIN_RATIO] = speed_ratios(design).roller_spin
     p[K.P_R_ORBIT] = design.orbit_diameter / 2
     p[K.P_R_FACE] = platform_offset(design, geometry)
+    p[K.P_B_NUT] = clearance if clearance_nut is None else clearance_nut
+    p[K.P_LOAD_SINE], p[K.P_LOAD_FREQUENCY] = float(load_sine[0]), float(load_sine[1])
+    if linkage is not None:  # the payload behind it, no longer in the nut's mass
+        stiffness, damping_ratio = linkage
+        p[K.P_M_NUT] = design.masses.nut_mass
+        p[K.P_M_PAYLOAD] = payload_mass
+        p[K.P_LINK_K] = stiffness
+        p[K.P_LINK_C] = 2.0 * damping_ratio * math.sqrt(stiffness * payload_mass)
+    p[K.P_CAM_WEAR] = cam_wear
+    p[K.P_PLATFORM_LOSS] = platform_loss
+    if reentry_edge is not None:
+        p[K.P_EDGE_WIDTH] = 2.0 * reentry_edge.length / design.orbit_diameter
+        p[K.P_EDGE_DEPTH] = reentry_edge.depth
     if nut_spall is not None:
         p[K.P_SPALL_ANGLE] = nut_spall.angle
         p[K.P_SPALL_WIDTH] = 2.0 * nut_spall.length / design.orbit_diameter
@@ -605,11 +632,17 @@ def right_hand_side(
     contact: ImpactContact = PAPER03_CONTACT,
 ):
     """(f, y0): the model's right-hand side f(t, y) → dy/dt and its initial state, for any ODE
-    solver (the benchmark drives scipy's with it). ``y``: nut position and velocity, the
-    rollers' positions, their velocities, the three energy accumulators, then the payload's
-    position and velocity."""
+    solver (the benchmark drives scipy's with it). ``y``: the kernels' state (its layout:
+    :mod:`._kernels`); the rolling :func:`simulate_recirculating` sets on the threads after
+    each step is not in a right-hand side, so a solver's spins run free."""
     p, rollers, y0 = _parameters(
-        design, screw_speed, load, clearance, payload_mass, load_ramp, contact
+        design,
+        screw_speed,
+        load,
+        clearance=clearance,
+        payload_mass=payload_mass,
+        load_ramp=load_ramp,
+        contact=contact,
     )
     knots = _load_knots(load, 1.0)
     motion = _motion_knots(screw_speed, 1.0)
