@@ -82,7 +82,7 @@ from prsm_health.actuator.design import PRSMDesign
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.physics.recirculating import orbital_angle
 
-from .angle_domain import prsm_periods, synchronous_average
+from .angle_domain import periodic_snr, prsm_periods, synchronous_average
 from .spectra import hilbert_envelope
 
 #: The indicators and their units, in the feature table's order.
@@ -299,16 +299,16 @@ def reset_comb_indicators(
 
 def _indicators(found: CombAverage, design: PRSMDesign, out: dict) -> dict[str, float]:
     """The indicators of a window's :class:`CombAverage` into ``out``."""
-    tsa, periods = found.average, found.periods
-    n, bins = periods.shape
-    p_tsa = float(np.var(tsa))
-    total = float(np.mean((periods - np.mean(periods)) ** 2))
-    residual = periods - tsa
-    noise = float(np.sum(residual * residual)) / (bins * (n - 1))
-    out["comb_rms"] = math.sqrt(p_tsa)
-    if total > 0:
-        # the noise the average still holds, σ²(bins − 1)/(bins·n), taken out (McFadden 1987)
-        out["comb_sync_share"] = max(0.0, p_tsa - noise * (bins - 1) / (bins * n)) / total
+    n, bins = found.periods.shape
+    out["comb_rms"] = math.sqrt(float(np.var(found.average)))
+    # the synchronous power over the whole, from the average's debiased SNR (periodic_snr:
+    # E_p/σ̂² less the noise the average still holds, McFadden 1987): the whole is
+    # E_p + σ̂²·(n − 1)/n, so the share is SNR/(SNR + 1 − 1/(bins·n)) — 1 without a residual
+    snr = periodic_snr(found.periods)
+    if snr == math.inf:
+        out["comb_sync_share"] = 1.0
+    elif math.isfinite(snr):
+        out["comb_sync_share"] = max(0.0, snr) / (snr + 1.0 - 1.0 / (bins * n))
     energy = energy_profile(found.power)
     out["comb_outside_share"] = outside_share(energy, reset_window_share(design))
     amplitude = np.sqrt(np.maximum(energy, 0.0))  # the moving average may round below 0
