@@ -7,10 +7,12 @@ changes (RMS of its rate of change) and where its power lies in the recording's 
 (shares of the detrended signal's power in the lower tenth, the next fifth and the rest of
 [0, Nyquist]: unit-free, so the same at 25 Hz or 20 kHz). Across channels: the drive torque
 per direction of motion (its forward and backward means and their gap — twice the friction
-torque of a reversible screw, Coulomb's law) and per load level (its slope against the axial
-load, the screw's torque per newton L/(2π·η)), and the following error of the nut against the
-screw angle (the position minus the kinematic travel, detrended: lost motion and elastic
-lag). No mean of a position or an angle: where the stroke sits says nothing of the actuator.
+torque of a reversible screw under a load that does not change with the direction, Coulomb's
+law) and per load level (its slope against the axial load: the motor's torque per newton,
+L/(2π·η·N) through a reduction N, η the driving efficiency of paper 02 — under a reversing
+load a mix of the driving and the back-driving ones), and the following error of the nut
+against the screw angle (the position minus the kinematic travel, detrended: lost motion and
+elastic lag). No mean of a position or an angle: where the stroke sits says nothing of the actuator.
 """
 
 from __future__ import annotations
@@ -20,15 +22,20 @@ from scipy.signal import detrend, periodogram
 
 from prsm_health.core.run import Run
 
+from .percentiles import percentiles
+
 #: The slow channels each get the per-channel indicators.
 CHANNELS = ("nut_position", "screw_speed", "drive_torque", "axial_load")
 #: Unit of each channel (for the indicators' units).
 _UNITS = {"nut_position": "m", "screw_speed": "rad/s", "drive_torque": "N·m", "axial_load": "N"}
-#: Band edges as shares of the Nyquist frequency.
+#: Band edges as shares of the Nyquist frequency: the lowest tenth (the duty: load and speed
+#: profiles), the next fifth (the drive's and the linkage's modes at a slow rig's rates), the
+#: rest (what a slow rate aliases in) — shares, so one table serves 25 Hz and 20 kHz.
 BANDS = (0.0, 0.1, 0.3, 1.0)
-#: Share of the largest |speed| below which a sample counts as not moving (no direction).
+#: Share of the largest |speed| below which a sample counts as not moving (no direction): the
+#: speed estimate's noise and a reversal's ramp stay out of the per-direction means.
 MOVING_SHARE = 0.05
-#: Fewest samples an indicator is computed from.
+#: Fewest samples an indicator is computed from (a mean or a slope of fewer is noise).
 MIN_SAMPLES = 16
 
 
@@ -70,7 +77,7 @@ def generic_indicators(run: Run, nut_per_rad: float | None) -> dict[str, float]:
         if x is None or len(x) < MIN_SAMPLES:
             continue
         x = np.asarray(x, float)
-        low, high = np.percentile(x, [1.0, 99.0])
+        low, high = percentiles(x, [1.0, 99.0])
         out[f"{channel}_std"] = float(np.std(x))
         out[f"{channel}_range"] = float(high - low)
         out[f"{channel}_rate_rms"] = float(np.sqrt(np.mean(np.diff(x) ** 2)) * rate)
@@ -89,7 +96,7 @@ def generic_indicators(run: Run, nut_per_rad: float | None) -> dict[str, float]:
     position, angle = ch.get("nut_position"), ch.get("screw_angle")
     if position is not None and angle is not None and nut_per_rad:
         error = detrend(position - nut_per_rad * angle)  # offset and lead error out
-        low, high = np.percentile(error, [1.0, 99.0])
+        low, high = percentiles(error, [1.0, 99.0])
         out["following_error_std"] = float(np.std(error))
         out["following_error_range"] = float(high - low)
     return out
