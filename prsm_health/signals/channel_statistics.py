@@ -1,7 +1,7 @@
 """Plain statistics of every measured channel of a window, whatever its rate: what a first
 classifier on any rig reads (mean, standard deviation, extremes per channel) — the inputs of
 the plain baseline that ``train`` cross-validates beside every fault model
-(:mod:`prsm_health.training.plain_baseline`), and that the diagnosis computes like any other
+(:mod:`prsm_health.training.fault_candidates`), and that the diagnosis computes like any other
 indicator group (``statistics``) so that a shipped baseline diagnoses by the same path.
 
 They are not condition indicators (the mean of a position says where the stroke sits, not how
@@ -38,10 +38,12 @@ def channel_statistics(run) -> dict[str, float]:
     """:data:`CHANNEL_STATISTICS` of ``run`` (each channel's finite samples; NaN for a channel
     it lacks or without any finite sample); truth signals are not read."""
     out = dict.fromkeys(CHANNEL_STATISTICS, np.nan)
-    for name, values in run.channels.items():
-        values = np.asarray(values, dtype=float)
+    for channel in CHANNELS:
+        if channel.name not in run.channels:
+            continue
+        values = np.asarray(run.channels[channel.name], dtype=float)
         values = values[np.isfinite(values)]
-        if values.size and f"{PREFIX}{name}_mean" in out:
+        if values.size:
             for statistic in STATISTICS:
-                out[f"{PREFIX}{name}_{statistic}"] = float(getattr(np, statistic)(values))
+                out[f"{PREFIX}{channel.name}_{statistic}"] = float(getattr(np, statistic)(values))
     return out

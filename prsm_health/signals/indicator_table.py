@@ -45,8 +45,10 @@ ORDER_TRACKING_SPREAD = 0.05
 #: Share of the sample rate up to which a spectral line or mode is searched: below the
 #: anti-alias filter's roll-off (a logger's decimation passes 0.4–0.45 × its rate).
 SEARCH_SHARE = 0.45
-#: Where the nut's dominant axial mode is searched [Hz] (paper 01's axial mode of a healthy
-#: nut lies inside it for the shipped designs' loads).
+#: Where the nut's dominant axial mode is searched [Hz]: paper 01's axial mode of a healthy nut
+#: lies inside it at the paper01 preset's loads; the other presets' lie above it at service
+#: loads (axial_baseline_frequency: paper02 1.8–3.8, paper03 3.0–6.2, paper04 2.7–5.2 kHz from
+#: 100 N to 20 kN), where the search finds the strongest line below 2 kHz instead.
 AXIAL_SEARCH = (100.0, 2000.0)
 #: Frequency of the nut's bounces across a reversal that the torque rattle counts [Hz]: about
 #: 200 Hz in the simulated reversals (measured 2026-12-02 on the import round trip's rig).

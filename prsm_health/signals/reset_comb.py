@@ -39,8 +39,8 @@ Why the shape indicators read the energy profile and not the TSA: each impact ri
 its threads (its axial mode: 5.6 kHz in the simulated paper03 at 20 kN, a period of 0.18 ms),
 and the TSA keeps that ring only while the impacts stay locked to the passage phase within a
 fraction of its period. Under a steady load they do (≈ 96 % of the measured power is
-synchronous once the start has settled); under a load that varies they do not — the roller's place in its clearance moves
-the instant the chamfer meets it — and the TSA cancels (simulated, 20 kN sine through zero: the
+synchronous once the start has settled); under a load that varies they do not — the roller's
+place in its clearance moves the instant the chamfer meets it — and the TSA cancels (simulated, 20 kN sine through zero: the
 synchronous share falls to ≈ 0 and the TSA's envelope peak *fell* with the load, slope ≈ −0.8,
 where the pulses themselves do not). The energy profile does not depend on the ring's phase: it
 keeps the pulses' places and sizes under any load, and it is the natural object for "the share
@@ -67,7 +67,9 @@ References
 Paper 03, eqs. 9–11 (the threadless sector and the crossing). P. D. McFadden, "A revised
 model for the extraction of periodic waveforms by time domain averaging", Mechanical Systems
 and Signal Processing 1(1) (1987) 83–95 — the synchronous average; what is not synchronous is
-reduced as 1/n in power.
+reduced as 1/n in power. P. D. McFadden, M. M. Toozhy, "Application of synchronous averaging
+to vibration monitoring of rolling element bearings", Mechanical Systems and Signal Processing
+14(6) (2000) 891–906 — the synchronous average of the squared envelope (the energy profile).
 """
 
 from __future__ import annotations
