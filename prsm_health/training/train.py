@@ -28,7 +28,7 @@ import numpy as np
 from prsm_health.core.errors import PRSMHealthError, require
 from prsm_health.core.jsonable import dumps
 from prsm_health.signals.features import FEATURES, GROUPS, dataset_features
-from prsm_health.signals.indicator_table import NOT_INDICATORS, usable_groups
+from prsm_health.signals.indicator_table import NOT_INDICATORS
 
 from .fault_candidates import BY_NAME, choose, cross_validate_candidates, make_classifier
 
@@ -577,7 +577,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         sparse_feature_errors,
         x_train,
         f"{dataset_dir}: cannot train: --cv {cv}",
-        fit_minimum(train_rows, cv=cv, target=target),
+        fewest,
         words=("indicator", "training runs"),
     )
     notes: list[str] = []
@@ -597,7 +597,7 @@ def _train(dataset_dir, out, *, target, name, cv, progress, random_state) -> dic
         # finite in too few training runs for every cross-validation fit: left out
         "indicators_too_sparse": too_sparse,
         # what the dataset's channels and rate let each indicator group read
-        "indicator_groups": usable_groups(ds.channels, ds.sample_rate),
+        "indicator_groups": ds.indicator_groups,
     }
     bundle: dict = {"feature_names": features, "clearance": None, "fault": None}
     # How far a window's indicators lie from the training windows (diagnosis: OOD score),
