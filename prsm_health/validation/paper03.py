@@ -27,8 +27,6 @@ import numpy as np
 
 from prsm_health.actuator.design import preset, printed_eq14_limit
 from prsm_health.physics import recirculating as rc
-from prsm_health.physics.kinematics import speed_ratios
-from prsm_health.simulation.recirculating.model import platform_offset
 
 from . import Row, inconsistent, not_computable, reproduced
 
@@ -85,22 +83,21 @@ def rows() -> list[Row]:
     out += _motion_rows(design, w_s, w_c, w_r, m, events, runs[LOADS_KN[0]])
     out += _design_rows(design)
     out += _force_rows(design, events, runs)
-    out += _sector_rows(design, runs[LOADS_KN[0]])
+    out += _sector_rows(design, w_r, runs[LOADS_KN[0]])
     return out
 
 
-def _sector_rows(design, run) -> list[Row]:
+def _sector_rows(design, w_r, run) -> list[Row]:
     """Figs. 23, 26–27 and 32 from the simulated run: the threads letting go in the threadless
     area, the spin turned only there; the spin's mean drop and the carrier collisions not
-    computable (what is missing said)."""
+    computable (what is missing said). ``w_r``: eq. (27)'s rolling spin [rad/s]."""
     i = ROLLER - 1
     inside = run.in_sector[i]
     force = np.abs(run.screw_force[i]) + np.abs(run.nut_force[i])
     free = float(np.mean(force[inside] == 0.0))
-    offset = platform_offset(design, rc.RecirculatingGeometry.for_design(design))
+    offset = rc.platform_contact_offset(design, rc.RecirculatingGeometry.for_design(design))
     spin = run.roller_spin[i]
-    rolling = speed_ratios(design).roller_spin * SCREW_SPEED
-    off = np.abs(spin - rolling) > 1.0
+    off = np.abs(spin - w_r) > 1.0
     departures = int(off.sum())
     inside_share = float((off & inside).sum() / max(departures, 1))
     drop = float(abs(np.mean(spin[~inside])) - abs(np.mean(spin)))  # > 0: |ω_r| lower

@@ -173,8 +173,8 @@ def test_a_chipped_reentry_edge_delays_the_landing_to_the_intact_thread(design, 
     # (up to p/N = 83 µm) holds the load off the landing roller until the intact thread:
     # measured 0.98 β after the exit for a 1 mm (= 1.0 β of orbit) chip 0.15 mm deep, against
     # 0.001 β for an intact edge; the bounds are a tenth of β wide.
+    from prsm_health.actuator.faults import ReentryEdgeDamage
     from prsm_health.physics.recirculating import orbital_angle
-    from prsm_health.simulation.recirculating import ReentryEdge
 
     beta = orbital_angle(design)
     chipped = simulate_recirculating(
@@ -182,7 +182,7 @@ def test_a_chipped_reentry_edge_delays_the_landing_to_the_intact_thread(design, 
         screw_speed=SPEED,
         load=2e4,
         duration=0.1,
-        reentry_edge=ReentryEdge(length=1e-3, depth=0.15e-3),
+        reentry_edge=ReentryEdgeDamage(length=1e-3, depth=0.15e-3),
     )
     assert chipped.energy_error < 1e-2 and chipped.resets.sum() >= 10
     share = 2e4 / (design.n_rollers - 1)

@@ -624,6 +624,16 @@ def roller_axial_offsets(design: PRSMDesign, geometry: RecirculatingGeometry) ->
     )
 
 
+def platform_contact_offset(design: PRSMDesign, geometry: RecirculatingGeometry) -> float:
+    """Radial offset of the platform's contact on a roller's end face from the roller's axis
+    [m], outward positive: the middle of the platform's annulus, d_t1/2 … R_t1 (eqs. 20–21),
+    less the orbit radius d_c/2 — an engineering choice where the paper prints no contact point
+    (the sign decides which way the platform's friction turns the spin: outside the axis the
+    face slips forward and the spin speeds up)."""
+    middle = 0.5 * (geometry.platform_inner_diameter / 2 + geometry.platform_outer_radius)
+    return middle - design.orbit_diameter / 2
+
+
 def cam_ring_spacing(design: PRSMDesign, geometry: RecirculatingGeometry) -> float:
     """Axial spacing of the two cam rings h = s1 + s2 + lead/N + lead [m].
 

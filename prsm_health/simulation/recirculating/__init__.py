@@ -4,7 +4,6 @@
 from .model import (
     NutSpall,
     RecirculatingRun,
-    ReentryEdge,
     right_hand_side,
     simulate_recirculating,
 )
@@ -12,7 +11,6 @@ from .model import (
 __all__ = [
     "NutSpall",
     "RecirculatingRun",
-    "ReentryEdge",
     "right_hand_side",
     "simulate_recirculating",
 ]

@@ -49,7 +49,7 @@ Faults, each a change of one surface (:mod:`prsm_health.actuator.faults` maps a 
 faults onto them): a **nut spall** (:class:`NutSpall`: the loaded flank lower over an arc, on
 a share of the turns); **cam-chamfer wear** (the chamfer's entrance worn down, tapering to its
 top: met later, climbed faster); **platform height loss** (the top lower: the push falls short
-of a lead, the threads must finish the reset); a damaged **re-entry edge** (:class:`ReentryEdge`:
+of a lead, the threads must finish the reset); a damaged **re-entry edge** (:class:`~prsm_health.actuator.faults.ReentryEdgeDamage`:
 both nut flanks lower over a stretch after the exit: the landing roller takes its share back
 later, at the intact thread). What the model shows of them (docs/faults.md): the worn chamfer
 moves the entry pulse by the geometry's β·w/(stroke + w); an edge chip deeper than the landing
@@ -87,6 +87,7 @@ import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
 from prsm_health.actuator.design import PRSMDesign
+from prsm_health.actuator.faults import ReentryEdgeDamage
 from prsm_health.core.errors import ConvergenceError, require, require_positive
 from prsm_health.physics.kinematics import speed_ratios
 from prsm_health.physics.recirculating import (
@@ -95,6 +96,7 @@ from prsm_health.physics.recirculating import (
     RecirculatingGeometry,
     cam_ring_spacing,
     orbital_angle,
+    platform_contact_offset,
     radial_lift,
     reset_stroke,
 )
@@ -113,19 +115,13 @@ THREAD_DAMPING_RATIO = 0.03
 THREAD_DAMPING_DEPTH = 1e-6
 #: Share of β over which the lift (and the platform's exit edge) ramps.
 LIFT_RAMP_SHARE = 0.25
+#: The load's rise from zero at the start [s]: the model starts unloaded (a step would ring the
+#: nut on its threads for the whole run).
+LOAD_RAMP = 5e-3
 #: Paper 03 §4.1's Coulomb friction of its ADAMS model (every contact): static and dynamic
 #: coefficients, the slip speeds [m/s] where each is reached.
 FRICTION_STATIC, FRICTION_DYNAMIC = 0.3, 0.25
 SLIP_STATIC, SLIP_DYNAMIC = 0.9, 1.0
-
-
-def platform_offset(design: PRSMDesign, geometry: RecirculatingGeometry) -> float:
-    """Radial offset of the cam-ring contact from the roller's axis [m], outward positive: the
-    middle of the platform's annulus, d_t1/2 … R_t1 (eqs. 20–21), less the orbit radius — an
-    engineering choice where the paper prints no contact point (the spin's change at the reset
-    follows its sign: outside the axis the platform's friction speeds the spin up)."""
-    middle = 0.5 * (geometry.platform_inner_diameter / 2 + geometry.platform_outer_radius)
-    return middle - design.orbit_diameter / 2
 
 
 @dataclass(frozen=True)
@@ -172,32 +168,6 @@ class NutSpall:
             self.share,
             "must be in (0, 1]: the share of the engaged thread turns the spall is on",
         )
-
-
-@dataclass(frozen=True)
-class ReentryEdge:
-    """Damage at the nut thread's re-entry edge: where the threadless area ends (a = 2β) every
-    landing roller strikes the first stretch of nut thread as it takes the load back, and the
-    edge wears or chips there. Material missing from both flanks over ``length`` of the
-    rollers' path after the exit: a landing roller re-engages later — after its lift has
-    closed — and harder, the loaded flank snapping its share of the load back at the intact
-    thread's start (the strike grows with the load).
-
-    Parameters
-    ----------
-    length : float [m]
-        Extent of the damaged thread along the rollers' path (an arc of the orbit radius).
-    depth : float [m]
-        Material missing from each flank, > 0 (on every engaged turn: each turn's edge takes
-        the same landings).
-    """
-
-    length: float
-    depth: float
-
-    def __post_init__(self):
-        require_positive("reentry_edge.length", self.length)
-        require_positive("reentry_edge.depth", self.depth)
 
 
 @dataclass(frozen=True)
@@ -281,13 +251,13 @@ def simulate_recirculating(
     clearance: float = 5e-6,
     clearance_nut: float | None = None,
     payload_mass: float = 0.0,
-    load_ramp: float = 5e-3,
+    load_ramp: float = LOAD_RAMP,
     linkage: tuple[float, float] | None = None,
     contact: ImpactContact = PAPER03_CONTACT,
     nut_spall: NutSpall | None = None,
     cam_wear: float = 0.0,
     platform_loss: float = 0.0,
-    reentry_edge: ReentryEdge | None = None,
+    reentry_edge: ReentryEdgeDamage | None = None,
     step: float = STEP,
 ) -> RecirculatingRun:
     """Simulate a recirculating PRSM: the screw turning forward (a constant speed or the
@@ -336,8 +306,9 @@ def simulate_recirculating(
         whatever the load). Below 0.4 of the pitch: at p/2 the landing roller's nearest groove
         is the one it left — the reset fails and the roller jams against the ring at its next
         pass (not modelled: refused).
-    reentry_edge : ReentryEdge or None
-        Damage at the nut thread's re-entry edge (None: intact).
+    reentry_edge : ReentryEdgeDamage or None
+        Damage at the nut thread's re-entry edge (the health state's fault of
+        :mod:`prsm_health.actuator.faults`; None: intact).
     step : float [s]
         Outer step; the guard sub-steps where a contact needs it.
 
@@ -580,7 +551,7 @@ def _parameters(
     p[K.P_I_ROLLER] = design.masses.roller_inertia
     p[K.P_SPIN_RATIO] = speed_ratios(design).roller_spin
     p[K.P_R_ORBIT] = design.orbit_diameter / 2
-    p[K.P_R_FACE] = platform_offset(design, geometry)
+    p[K.P_R_FACE] = platform_contact_offset(design, geometry)
     p[K.P_B_NUT] = clearance if clearance_nut is None else clearance_nut
     p[K.P_LOAD_SINE], p[K.P_LOAD_FREQUENCY] = float(load_sine[0]), float(load_sine[1])
     if linkage is not None:  # the payload behind it, no longer in the nut's mass
@@ -628,7 +599,7 @@ def right_hand_side(
     load: float,
     clearance: float = 5e-6,
     payload_mass: float = 0.0,
-    load_ramp: float = 5e-3,
+    load_ramp: float = LOAD_RAMP,
     contact: ImpactContact = PAPER03_CONTACT,
 ):
     """(f, y0): the model's right-hand side f(t, y) → dy/dt and its initial state, for any ODE

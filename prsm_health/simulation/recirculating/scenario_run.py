@@ -32,11 +32,7 @@ from prsm_health.core.run import Run
 from ..decimation import decimate
 from ..dynamics.simulate import choose_step
 from ..run_assembly import assemble_run, measure
-from .model import STEP, NutSpall, ReentryEdge, simulate_recirculating
-
-#: The load's rise from zero at the start [s]: the model starts unloaded (a step would ring the
-#: nut on its threads for the whole run).
-LOAD_RAMP = 5e-3
+from .model import LOAD_RAMP, STEP, NutSpall, simulate_recirculating
 
 
 def simulate_recirculating_scenario(scenario, *, progress: bool = False) -> Run:
@@ -194,5 +190,5 @@ def _fault_arguments(design, health) -> dict:
         elif fault.kind == "platform_loss":
             out["platform_loss"] = fault.height
         elif fault.kind == "reentry_edge":
-            out["reentry_edge"] = ReentryEdge(length=fault.length, depth=fault.depth)
+            out["reentry_edge"] = fault
     return out
