@@ -27,6 +27,11 @@ NAME_PROBABILITY = 0.5
 #: How the class-set part of a fault-class warning begins.
 SET_NOTE = "not ruled out at "
 
+#: What brings out the recirculating PRSM's own faults: its resets' comb at one commanded load.
+_RESET_COMB_RECORDING = (
+    "a steady stroke at a commanded load against the unit's own baseline (the "
+    "recirculating-check's high-load stroke: the reset comb's shape)"
+)
 #: The recording that brings out each class's signature (docs/faults.md "At realistic duty",
 #: the built-in health check of :mod:`prsm_health.actuator.health_check`).
 DECIDING_RECORDING = {
@@ -43,10 +48,8 @@ DECIDING_RECORDING = {
     "high-load stroke: synchronous averages at the nut-pass and roller-spin periods)",
     "tooth_damage": "none the instrumentation can give: a damaged ring or roller-gear tooth "
     "changes the nut vibration below the accelerometer's noise (docs/faults.md)",
-    "cam_ring": "a steady stroke at a commanded load against the unit's own baseline (the "
-    "recirculating-check's high-load stroke: the reset comb's shape)",
-    "reentry_edge": "a steady stroke at a commanded load against the unit's own baseline (the "
-    "recirculating-check's high-load stroke: the reset comb's shape)",
+    "cam_ring": _RESET_COMB_RECORDING,
+    "reentry_edge": _RESET_COMB_RECORDING,
 }
 #: What to record when the recording lacked a condition: the health check does all of them.
 RUN_THE_CHECK = (

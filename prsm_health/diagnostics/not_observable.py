@@ -76,9 +76,7 @@ def shown(diagnosis) -> dict:
     never a number — and each target's state in words (:data:`OBSERVABLE`, or
     :func:`not_observable_text`). The keys are always there (a schema inferred from one
     message holds for all)."""
-    c = part(diagnosis, "clearance") or {}
-    if not isinstance(c, Mapping):
-        c = c.to_json()
+    c = part(diagnosis, "clearance") or {}  # a ClearanceInterval is a Mapping too
     seen_clearance, seen_fault = observable(diagnosis, "clearance"), observable(diagnosis, "fault")
     probabilities = part(diagnosis, "class_probabilities") or {}
     return {
