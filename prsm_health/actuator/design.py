@@ -872,6 +872,9 @@ PRESETS = {
 }
 
 DEFAULT_PRESET = "paper01"
+#: The preset a design of each variant starts from (``design template --variant``): the
+#: recirculating PRSM's is paper 03's.
+VARIANT_PRESETS = {"standard": DEFAULT_PRESET, "recirculating": "paper03"}
 
 
 def preset(name: str = DEFAULT_PRESET) -> PRSMDesign:

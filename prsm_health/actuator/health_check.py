@@ -54,7 +54,6 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
 from prsm_health.core.check_phases import CheckPhases, PhaseSpan
 from prsm_health.core.errors import ParameterError, require, require_known_keys, require_range
@@ -310,6 +309,8 @@ class HealthCheck:
         [rad] (the trapezoidal integral of the speed, exact for the piecewise-linear speed the
         kernel interpolates) — the format of OperatingProfile.motion_knots."""
         times, speeds, _ = self._speed_knots()
+        from scipy.integrate import cumulative_trapezoid  # here: the CLI's --help loads no scipy
+
         angles = cumulative_trapezoid(speeds, times, initial=0.0)
         return np.vstack([times, speeds, angles])
 

@@ -15,7 +15,6 @@ import math
 from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
 
 from prsm_health.core.errors import (
     ParameterError,
@@ -439,6 +438,8 @@ class OperatingProfile:
         times = np.asarray(times, dtype=float)
         speeds = np.asarray(speeds, dtype=float)
         # the angle: the speed's exact integral (trapezoids: the speed is linear between knots)
+        from scipy.integrate import cumulative_trapezoid  # here: the CLI's --help loads no scipy
+
         angles = cumulative_trapezoid(speeds, times, initial=0.0)
         return np.vstack([times, speeds, angles])
 

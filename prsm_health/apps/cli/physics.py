@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import textwrap
 
-from prsm_health.actuator.design import DEFAULT_PRESET, preset
+from prsm_health.actuator.design import VARIANT_PRESETS, preset
 from prsm_health.actuator.design_files import design_rows, design_to_toml, load_design
 from prsm_health.core.errors import PRSMHealthError
 from prsm_health.physics.friction import FrictionParameters, simulate_friction
@@ -24,9 +24,6 @@ from prsm_health.simulation.instrumentation import list_profiles, load_instrumen
 from prsm_health.validation import _fmt, collect, summary, to_markdown
 
 from .output import print_json, print_table
-
-#: The preset the recirculating design template starts from.
-RECIRCULATING_PRESET = "paper03"
 
 
 # ----------------------------------------------------------------------------- validate
@@ -64,15 +61,13 @@ def _print_validation_text(rows, width: int = 100) -> None:
 
 # ----------------------------------------------------------------------------- design
 def design_template(args) -> int:
-    name = args.preset or (
-        RECIRCULATING_PRESET if args.variant == "recirculating" else DEFAULT_PRESET
-    )
+    start = VARIANT_PRESETS[args.variant or "standard"]
+    name = args.preset or start
     design = preset(name)
     if args.variant is not None and design.variant != args.variant:
         raise PRSMHealthError(
             f"--from {name} is a {design.variant} design, not {args.variant}: leave --from out "
-            f"(the {args.variant} template starts from "
-            f"{RECIRCULATING_PRESET if args.variant == 'recirculating' else DEFAULT_PRESET})"
+            f"(the {args.variant} template starts from {start})"
         )
     if design.variant == "recirculating":
         design = with_explicit_geometry(design)

@@ -3,7 +3,7 @@ kinematics, stiffness, friction."""
 
 from __future__ import annotations
 
-from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS
+from prsm_health.actuator.design import DEFAULT_PRESET, PRESETS, VARIANT_PRESETS
 from prsm_health.actuator.states import DEFAULT_SPEED
 
 from .options import (
@@ -31,7 +31,8 @@ def add_physics_commands(command) -> None:
         "--from",
         dest="preset",
         default=None,
-        default_text=f"{DEFAULT_PRESET}; paper03 with --variant recirculating",
+        default_text=f"{VARIANT_PRESETS['standard']}; {VARIANT_PRESETS['recirculating']} with "
+        "--variant recirculating",
         choices=sorted(PRESETS),
         help="preset to copy",
     )
