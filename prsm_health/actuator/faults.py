@@ -227,14 +227,17 @@ class CamWear:
     """Wear of a recirculating PRSM's cam-ring chamfer (paper 03 §2: the chamfer that pushes
     each roller one lead forward across the threadless area): every reset strikes the chamfer's
     entrance, and the strikes wear it down there, tapering to nothing at the platform's top.
-    The roller meets the worn chamfer later and climbs it faster: the reset's entry pulse comes
-    later in the passage and harder, whatever the load
-    (:mod:`prsm_health.simulation.recirculating.model`).
+    The chamfer rises by the stroke s (one lead) over the first β of the threadless area
+    (eqs. 9–11); worn, its surface is max(0, (s + w)·a/β − w) at the orbital angle a into the
+    area: the roller meets it β·w/(s + w) later and climbs it (s + w)/s times faster — the
+    reset's entry pulse later in the passage and harder, whatever the load
+    (:mod:`prsm_health.simulation.recirculating.model`, which refuses w > s/2 for the design).
 
     Parameters
     ----------
     depth : float [m]
-        Axial depth worn off at the chamfer's entrance (the severity), ≤ half the reset stroke.
+        Axial depth w worn off at the chamfer's entrance (the severity), ≤ half the reset
+        stroke (checked against the design when simulated).
     """
 
     kind: ClassVar[str] = "cam_wear"
@@ -260,7 +263,8 @@ class PlatformLoss:
     Parameters
     ----------
     height : float [m]
-        Height lost (the severity), below 0.4 of the thread pitch.
+        Height lost (the severity), below 0.4 of the thread pitch (checked against the design
+        when simulated: :mod:`prsm_health.simulation.recirculating.model`).
     """
 
     kind: ClassVar[str] = "platform_loss"
