@@ -15,7 +15,7 @@ path), a worn cam chamfer (0.1–0.3 mm), a chipped re-entry edge (0.5–1.5 mm 
 For each fault against the healthy units: every indicator's AUC (> 0.5: higher for the faulty
 units) and two-sided AUC (distance from the healthy units' median — for a healthy unit, the
 median of the others —: a fault that moves an indicator either way counts), the best five; and the AUC of a random forest (100 trees, as the
-shipped fault models) on all the indicators, cross-validated by 5 stratified folds (each unit
+shipped fault models' forest candidate) on all the indicators, cross-validated by 5 stratified folds (each unit
 in exactly one test fold: the probabilities of units never used in training). Prints JSON.
 """
 
@@ -80,9 +80,11 @@ def unit(job) -> dict:
 
 
 def auc(healthy, faulty) -> float:
-    """P(faulty > healthy) + ½ P(tie) (Mann–Whitney)."""
-    h, f = np.asarray(healthy)[:, None], np.asarray(faulty)[None, :]
-    return float(np.mean(f > h) + 0.5 * np.mean(f == h))
+    """ROC AUC of the faulty against the healthy values: P(faulty > healthy), ties half."""
+    from sklearn.metrics import roc_auc_score
+
+    h, f = np.asarray(healthy, float), np.asarray(faulty, float)
+    return float(roc_auc_score(np.r_[np.zeros(len(h)), np.ones(len(f))], np.r_[h, f]))
 
 
 def _forest_auc(healthy: np.ndarray, faulty: np.ndarray, seed: int) -> float:
@@ -91,9 +93,15 @@ def _forest_auc(healthy: np.ndarray, faulty: np.ndarray, seed: int) -> float:
     from sklearn.metrics import roc_auc_score
     from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
+    from prsm_health.diagnostics.estimators import FOREST_TREES, FaultClassifier
+
     x = np.vstack([healthy, faulty])
     y = np.r_[np.zeros(len(healthy)), np.ones(len(faulty))]
-    forest = RandomForestClassifier(n_estimators=100, max_leaf_nodes=31, random_state=seed)
+    forest = RandomForestClassifier(
+        n_estimators=FOREST_TREES,
+        max_leaf_nodes=FaultClassifier().max_leaf_nodes,
+        random_state=seed,
+    )
     folds = StratifiedKFold(n_splits=5, shuffle=True, random_state=seed)
     p = cross_val_predict(forest, x, y, cv=folds, method="predict_proba")[:, 1]
     return float(roc_auc_score(y, p))

@@ -173,7 +173,9 @@ def auc(healthy, faulty) -> float:
     f = np.asarray([v for v in faulty if np.isfinite(v)])
     if len(h) == 0 or len(f) == 0:
         return math.nan
-    return float(np.mean(f[:, None] > h[None, :]) + 0.5 * np.mean(f[:, None] == h[None, :]))
+    from sklearn.metrics import roc_auc_score
+
+    return float(roc_auc_score(np.r_[np.zeros(len(h)), np.ones(len(f))], np.r_[h, f]))
 
 
 def two_sided_auc(healthy, faulty) -> float:
